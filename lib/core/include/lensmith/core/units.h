@@ -1,0 +1,28 @@
+// Unit conversions: one named function per unit pair, so no inline `/ 1000` hides a unit change.
+// Lens geometry is in millimetres, wavelengths in nanometres, scene depth in metres.
+#pragma once
+
+#include <limits>
+
+namespace lensmith {
+
+inline constexpr double kInfinity = std::numeric_limits<double>::infinity();
+inline constexpr double kPi = 3.14159265358979323846;
+
+constexpr double mm_from_m(double metres) { return metres * 1000.0; }
+constexpr double m_from_mm(double millimetres) { return millimetres / 1000.0; }
+constexpr double mm_from_cm(double centimetres) { return centimetres * 10.0; }
+constexpr double mm_from_inch(double inches) { return inches * 25.4; }
+constexpr double um_from_nm(double nanometres) { return nanometres / 1000.0; }
+constexpr double nm_from_um(double micrometres) { return micrometres * 1000.0; }
+constexpr double um_from_mm(double millimetres) { return millimetres * 1000.0; }
+constexpr double mm_from_nm(double nanometres) { return nanometres / 1.0e6; }
+constexpr double rad_from_deg(double degrees) { return degrees * (kPi / 180.0); }
+constexpr double deg_from_rad(double radians) { return radians * (180.0 / kPi); }
+
+// Fraunhofer lines used for nd, Vd and primary colour (nm; Schott catalogue values).
+inline constexpr double kWavelengthD_nm = 587.5618;  // helium d
+inline constexpr double kWavelengthF_nm = 486.1327;  // hydrogen F
+inline constexpr double kWavelengthC_nm = 656.2725;  // hydrogen C
+
+}  // namespace lensmith

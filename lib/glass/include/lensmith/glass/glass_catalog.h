@@ -1,0 +1,54 @@
+// Glass catalogues by vendor (Schott, Ohara, Hoya, CDGM, Hikari, Sumita from the refractiveindex.info
+// database, CC0; lenses/glass/README.md) and name lookup that never guesses: an unknown name is an
+// error naming the closest catalogue names.
+#pragma once
+
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "lensmith/glass/glass.h"
+
+namespace lensmith {
+
+class GlassCatalog {
+ public:
+  // The catalogues compiled into the library (lenses/glass/*.json), vendors in the default search
+  // order: SCHOTT, OHARA, HOYA, CDGM, HIKARI, SUMITA. Built once, thread-safe.
+  static const GlassCatalog& builtin();
+
+  // Parses one catalogue in lensmith's compact JSON form (docs/glass.md). `source_name` is used in
+  // error messages. Throws GlassError (or LensFileError with a position) on malformed input.
+  static GlassCatalog from_json(std::string_view json_text, const std::string& source_name);
+
+  // Appends every glass of `other`; its vendors come after the ones already present in search order.
+  void merge(const GlassCatalog& other);
+
+  // Looks up a glass by name, case-insensitively. With a vendor, only that vendor's catalogue is
+  // searched. Without one, vendors are searched in `vendor_order` (names of vendors, e.g. from a
+  // Zemax GCAT line) and then in the catalogue's default order; the first match wins.
+  // Returns nullptr when nothing matches.
+  const Glass* find(std::string_view name, std::string_view vendor = {},
+                    std::span<const std::string> vendor_order = {}) const;
+
+  // As find(), but throws GlassError when nothing matches, e.g.
+  //   unknown glass "NBK7"; closest catalogue names: N-BK7 (SCHOTT), N-BK7HT (SCHOTT), ...
+  const Glass& get(std::string_view name, std::string_view vendor = {},
+                   std::span<const std::string> vendor_order = {}) const;
+
+  // Up to `count` catalogue names closest to `name` (ignoring case, '-', ' ' and '_', then by
+  // edit distance), formatted "NAME (VENDOR)".
+  std::vector<std::string> closest_names(std::string_view name, std::size_t count = 5) const;
+
+  // Vendors in default search order (upper case, e.g. "SCHOTT").
+  const std::vector<std::string>& vendors() const { return vendors_; }
+  const std::vector<Glass>& glasses() const { return glasses_; }
+  std::size_t size() const { return glasses_.size(); }
+
+ private:
+  std::vector<Glass> glasses_;
+  std::vector<std::string> vendors_;
+};
+
+}  // namespace lensmith

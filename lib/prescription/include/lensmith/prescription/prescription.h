@@ -1,0 +1,95 @@
+// A sequential lens prescription: surfaces object side first, the object-space medium, and the
+// system data a designer sets (aperture, field, wavelengths, object distance). It validates itself.
+// Formats: docs/lens-format.md (native JSON), Zemax .zmx, pbrt .dat, lentil lenses.json.
+#pragma once
+
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "lensmith/core/units.h"
+#include "lensmith/prescription/material.h"
+#include "lensmith/prescription/surface.h"
+
+namespace lensmith {
+
+// How the size of the axial beam is set.
+struct ApertureSpec {
+  enum class Kind {
+    EntrancePupilDiameter,  // value = entrance-pupil diameter, mm
+    ImageSpaceFNumber,      // value = EFL / EPD for an object at infinity (Zemax "Image Space F/#")
+    FloatByStop,            // the stop's clear semi-diameter sets the beam; value unused
+  };
+  Kind kind = Kind::FloatByStop;
+  double value = 0.0;
+
+  friend bool operator==(const ApertureSpec&, const ApertureSpec&) = default;
+  std::string to_string() const;
+};
+
+// The field of view: a kind and the field points (the largest |value| is the maximum field).
+struct FieldSpec {
+  enum class Kind {
+    AngleDeg,        // object-space chief-ray angle, degrees (object at infinity or finite)
+    ObjectHeightMm,  // object height, mm (finite object only)
+    ImageHeightMm,   // paraxial image height, mm
+  };
+  Kind kind = Kind::AngleDeg;
+  std::vector<double> values;  // field points, at least one; units per kind
+
+  double max_value() const;    // largest |value|
+  friend bool operator==(const FieldSpec&, const FieldSpec&) = default;
+  std::string to_string() const;
+};
+
+struct Prescription {
+  std::string name;
+  std::string source;  // patent, book and page, or URL
+  std::string notes;
+
+  std::vector<Surface> surfaces;        // object side first; surface k of the docs is surfaces[k-1]
+  MaterialSpec object_material;         // object-space medium (air unless immersion)
+  Glass object_medium = Glass::air();   // object_material resolved
+
+  // Distance from the object plane to the vertex of surface 1, mm; +infinity = object at infinity.
+  double object_distance_mm = kInfinity;
+  // When true the image plane sits at the paraxial focus of the primary wavelength and the last
+  // surface's thickness_mm is not used (pbrt files and lenses whose file gives no image distance).
+  bool image_at_paraxial_focus = false;
+
+  ApertureSpec aperture;
+  std::optional<FieldSpec> field;       // absent when the source gives none
+  std::vector<double> wavelengths_nm{kWavelengthF_nm, kWavelengthD_nm, kWavelengthC_nm};
+  std::size_t primary_wavelength_index = 1;  // into wavelengths_nm
+
+  double primary_wavelength_nm() const { return wavelengths_nm.at(primary_wavelength_index); }
+  // 0-based index of the surface flagged as stop, or empty when none is flagged.
+  std::optional<std::size_t> flagged_stop_index() const;
+  // z of the vertex of surface k (0-based index), mm, z = 0 at surface 1.
+  double vertex_z_mm(std::size_t surface_index) const;
+  // z of the last vertex, mm.
+  double last_vertex_z_mm() const;
+
+  // Throws PrescriptionError naming the surface (1-based) or system field and the violated
+  // constraint, e.g. "surface 3: semi_diameter_mm = -2: must be > 0". Checks: at least one surface,
+  // finite curvatures and thicknesses, positive semi-diameters, at most one stop, conic and
+  // asphere coefficients finite, indices > 0 at the primary wavelength, aperture value > 0 and a
+  // stop semi-diameter when the aperture floats by stop, field values finite and an object-height
+  // field only for a finite object, wavelengths in (100, 20000) nm, primary index in range,
+  // object distance > 0.
+  void validate() const;
+
+  // Resolves every MaterialSpec against `catalogue` (throws GlassError with the surface number).
+  void resolve_materials(const GlassCatalog& catalogue);
+
+  // Every length multiplied by `factor` > 0 (radii, thicknesses, semi-diameters, aspheric terms,
+  // finite object distance, EPD and object/image-height fields). Throws PrescriptionError.
+  Prescription scaled(double factor) const;
+
+  friend bool operator==(const Prescription&, const Prescription&) = default;
+  std::string to_string() const;  // a surface table, for test failures and debugging
+  friend std::ostream& operator<<(std::ostream& os, const Prescription& p) { return os << p.to_string(); }
+};
+
+}  // namespace lensmith
