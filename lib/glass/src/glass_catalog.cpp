@@ -1,1 +1,317 @@
-// in progress
+// Glass catalogues: reading lensmith's compact JSON (docs/glass.md, written by
+// tools/convert_glass_catalogs.py from the refractiveindex.info database) and looking glasses up
+// by name. A name that is not found is an error listing the closest names; nothing is guessed.
+#include "lensmith/glass/glass_catalog.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <tuple>
+
+#include "lensmith/core/embedded_file.h"
+#include "lensmith/core/errors.h"
+#include "lensmith/core/located_json.h"
+#include "lensmith/core/units.h"
+
+namespace lensmith {
+
+// Generated from lenses/glass/*.json by cmake/EmbedFiles.cmake (lib/glass/CMakeLists.txt).
+std::span<const EmbeddedFile> embedded_glass_catalogues();
+
+namespace {
+
+constexpr std::string_view kFormatName = "lensmith-glass-catalog";
+constexpr int kFormatVersion = 1;
+// Search order when no vendor is named (docs/glass.md). SCHOTT comes first because bare names in
+// patents and lens databases (SF5, F2, LAK9) usually mean Schott's glass; OHARA, HOYA, CDGM, HIKARI
+// and SUMITA follow, so a SCHOTT name never resolves to another maker's namesake by accident.
+constexpr std::string_view kDefaultVendorOrder[] = {"SCHOTT", "OHARA", "HOYA", "CDGM", "HIKARI", "SUMITA"};
+constexpr std::size_t kDefaultSuggestions = 5;
+
+std::string upper(std::string_view text) {
+  std::string out(text);
+  for (char& c : out) {
+    if (c >= 'a' && c <= 'z') c = static_cast<char>(c - 'a' + 'A');
+  }
+  return out;
+}
+
+// The form in which names are compared for suggestions: "n-bk7", "N BK7" and "NBK7" all become
+// "NBK7", because lens files and patents write separators inconsistently.
+std::string normalise(std::string_view name) {
+  std::string out;
+  out.reserve(name.size());
+  for (char c : upper(name)) {
+    if (c != '-' && c != ' ' && c != '_') out += c;
+  }
+  return out;
+}
+
+// Edit distance (insertions, deletions, substitutions each cost 1), two-row dynamic programme.
+std::size_t levenshtein(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> previous(b.size() + 1);
+  std::vector<std::size_t> current(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) previous[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    current[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t substitution = previous[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1);
+      current[j] = std::min({previous[j] + 1, current[j - 1] + 1, substitution});
+    }
+    std::swap(previous, current);
+  }
+  return previous[b.size()];
+}
+
+std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& item : items) out += (out.empty() ? "" : ", ") + item;
+  return out;
+}
+
+// Catalogue wavelengths are printed in micrometres with at most 6 decimals. Rounding the converted
+// value to 1e-6 nm removes the binary conversion error, so 0.32611 um becomes the double nearest
+// 326.11 nm and a user who asks for exactly 326.11 nm is inside the range.
+double nm_from_catalogue_um(double micrometres) {
+  constexpr double kStepsPerNm = 1.0e6;
+  return std::round(nm_from_um(micrometres) * kStepsPerNm) / kStepsPerNm;
+}
+
+// An array of numbers at `key`, with errors at the offending element.
+std::vector<double> read_numbers(JsonObjectReader& reader, const std::string& key) {
+  const std::size_t size = reader.get_array_size(key);
+  const nlohmann::json& array = reader.value().at(key);
+  std::vector<double> values;
+  values.reserve(size);
+  for (std::size_t i = 0; i < size; ++i) {
+    const nlohmann::json& item = array[i];
+    if (!item.is_number()) {
+      throw LensFileError(reader.document().where(reader.child_pointer(key) + "/" + std::to_string(i)),
+                          reader.child_path(key) + "[" + std::to_string(i) + "]: expected a number, got " +
+                              json_type_phrase(item));
+    }
+    values.push_back(item.get<double>());
+  }
+  return values;
+}
+
+Glass::Status read_status(JsonObjectReader& reader) {
+  const auto text = reader.get_optional_string("status");
+  if (!text) return Glass::Status::Unspecified;
+  for (auto status : {Glass::Status::Unspecified, Glass::Status::Standard, Glass::Status::Preferred,
+                      Glass::Status::Obsolete, Glass::Status::Special}) {
+    if (*text == Glass::status_name(status)) return status;
+  }
+  reader.fail("status", "\"" + *text + "\" is not one of standard, preferred, obsolete, special, unspecified");
+}
+
+Glass read_glass(const LocatedJson& doc, std::size_t index, const std::string& vendor) {
+  JsonObjectReader reader(doc, "/glasses/" + std::to_string(index), "glasses[" + std::to_string(index) + "]");
+  const std::string name = reader.get_string("name");
+  if (name.empty()) reader.fail("name", "must not be empty");
+
+  const double formula_number = reader.get_number("formula");
+  if (formula_number != 1 && formula_number != 2 && formula_number != 3) {
+    reader.fail("formula", "must be 1, 2 or 3 (refractiveindex.info formula numbers), got " + nlohmann::json(formula_number).dump());
+  }
+  const auto formula = static_cast<Glass::Formula>(static_cast<int>(formula_number));
+
+  const std::vector<double> coefficients = read_numbers(reader, "coefficients");
+  if (coefficients.size() % 2 != 1) {
+    reader.fail("coefficients", "has " + std::to_string(coefficients.size()) +
+                                    " numbers; the formula needs C1 followed by pairs (an odd count)");
+  }
+  const std::vector<double> range_um = read_numbers(reader, "range_um");
+  if (range_um.size() != 2 || !(range_um[0] > 0.0) || !(range_um[1] > range_um[0])) {
+    reader.fail("range_um", "must be [min, max] in micrometres with 0 < min < max");
+  }
+
+  const auto nd = reader.get_optional_number("nd");
+  const auto vd = reader.get_optional_number("vd");
+  if (nd.has_value() != vd.has_value()) reader.fail(nd ? "nd" : "vd", "give both nd and vd, or neither");
+  const Glass::Status status = read_status(reader);
+  std::string replaced_by = reader.get_optional_string("replaced_by").value_or("");
+  reader.finish({"name", "formula", "coefficients", "range_um", "nd", "vd", "status", "replaced_by"});
+
+  constexpr double kNotGiven = std::numeric_limits<double>::quiet_NaN();
+  Glass glass;
+  try {
+    glass = Glass::from_formula(name, vendor, formula, coefficients,
+                                WavelengthRange{nm_from_catalogue_um(range_um[0]), nm_from_catalogue_um(range_um[1])},
+                                nd.value_or(kNotGiven), vd.value_or(kNotGiven));
+  } catch (const GlassError& e) {
+    reader.fail("", e.what());
+  }
+  glass.set_catalog_status(status, std::move(replaced_by));
+  return glass;
+}
+
+}  // namespace
+
+const GlassCatalog& GlassCatalog::builtin() {
+  // A function-local static is initialised once, and thread-safely (C++11 [stmt.dcl]/4).
+  static const GlassCatalog catalog = [] {
+    std::vector<GlassCatalog> parts;
+    for (const EmbeddedFile& file : embedded_glass_catalogues()) {
+      parts.push_back(from_json(file.text, "lenses/glass/" + std::string(file.path)));
+    }
+    // Default vendors in their fixed order; any other shipped catalogue after them, by vendor name.
+    auto rank = [](const GlassCatalog& part) {
+      const std::string& vendor = part.vendors().front();
+      const auto* it = std::find(std::begin(kDefaultVendorOrder), std::end(kDefaultVendorOrder), vendor);
+      return std::make_tuple(static_cast<std::size_t>(it - std::begin(kDefaultVendorOrder)), vendor);
+    };
+    std::sort(parts.begin(), parts.end(), [&](const auto& a, const auto& b) { return rank(a) < rank(b); });
+    GlassCatalog all;
+    for (const auto& part : parts) all.merge(part);
+    return all;
+  }();
+  return catalog;
+}
+
+GlassCatalog GlassCatalog::from_json(std::string_view json_text, const std::string& source_name) {
+  const LocatedJson doc = LocatedJson::parse(json_text, source_name);
+  JsonObjectReader root(doc, "", "");
+  const std::string format = root.get_string("format");
+  if (format != kFormatName) {
+    root.fail("format", "expected \"" + std::string(kFormatName) + "\", got \"" + format + "\"");
+  }
+  const double version = root.get_number("version");
+  if (version != kFormatVersion) {
+    root.fail("version", "version " + nlohmann::json(version).dump() + " is not supported; this lensmith reads version " +
+                             std::to_string(kFormatVersion));
+  }
+  const std::string vendor = upper(root.get_string("vendor"));
+  if (vendor.empty()) root.fail("vendor", "must not be empty");
+  // Provenance, for people reading the file; lensmith does not interpret it.
+  root.get_optional_string("source");
+  root.get_optional_string("licence");
+  const std::size_t count = root.get_array_size("glasses");
+  root.finish({"format", "version", "vendor", "source", "licence", "glasses"});
+
+  GlassCatalog catalog;
+  catalog.vendors_.push_back(vendor);
+  catalog.glasses_.reserve(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    Glass glass = read_glass(doc, i, vendor);
+    if (catalog.find(glass.name(), vendor) != nullptr) {
+      JsonObjectReader reader(doc, "/glasses/" + std::to_string(i), "glasses[" + std::to_string(i) + "]");
+      reader.fail("name", "glass \"" + glass.name() + "\" appears twice in the " + vendor +
+                              " catalogue (names are compared ignoring case)");
+    }
+    catalog.add(std::move(glass));
+  }
+  return catalog;
+}
+
+void GlassCatalog::merge(const GlassCatalog& other) {
+  // Check first, so that a failed merge leaves this catalogue unchanged.
+  for (const Glass& glass : other.glasses_) {
+    if (find(glass.name(), glass.vendor()) != nullptr) {
+      throw GlassError("cannot merge glass catalogues: " + glass.vendor() + " " + glass.name() +
+                       " is in both (names are compared ignoring case)");
+    }
+  }
+  for (const std::string& vendor : other.vendors_) {
+    if (vendor_rank(vendor) == vendors_.size()) vendors_.push_back(vendor);
+  }
+  glasses_.reserve(glasses_.size() + other.glasses_.size());
+  for (const Glass& glass : other.glasses_) add(glass);
+}
+
+void GlassCatalog::add(Glass glass) {
+  if (vendor_rank(glass.vendor()) == vendors_.size()) vendors_.push_back(glass.vendor());
+  by_name_[upper(glass.name())].push_back(glasses_.size());
+  normalised_names_.push_back(normalise(glass.name()));
+  glasses_.push_back(std::move(glass));
+}
+
+std::size_t GlassCatalog::vendor_rank(std::string_view vendor_upper) const {
+  return static_cast<std::size_t>(std::find(vendors_.begin(), vendors_.end(), vendor_upper) - vendors_.begin());
+}
+
+const Glass* GlassCatalog::find(std::string_view name, std::string_view vendor,
+                                std::span<const std::string> vendor_order) const {
+  const auto it = by_name_.find(upper(name));
+  if (it == by_name_.end()) return nullptr;
+  const std::vector<std::size_t>& candidates = it->second;
+  auto at_vendor = [&](std::string_view vendor_upper) -> const Glass* {
+    for (std::size_t index : candidates) {
+      if (glasses_[index].vendor() == vendor_upper) return &glasses_[index];
+    }
+    return nullptr;
+  };
+  if (!vendor.empty()) return at_vendor(upper(vendor));
+  for (const std::string& preferred : vendor_order) {
+    if (const Glass* glass = at_vendor(upper(preferred))) return glass;
+  }
+  // Default order: the candidate whose vendor comes first in vendors_.
+  const auto best = std::min_element(candidates.begin(), candidates.end(), [&](std::size_t a, std::size_t b) {
+    return vendor_rank(glasses_[a].vendor()) < vendor_rank(glasses_[b].vendor());
+  });
+  return &glasses_[*best];
+}
+
+const Glass& GlassCatalog::get(std::string_view name, std::string_view vendor,
+                               std::span<const std::string> vendor_order) const {
+  if (const Glass* glass = find(name, vendor, vendor_order)) return *glass;
+  const std::string quoted = "\"" + std::string(name) + "\"";
+  if (vendor.empty()) {
+    const auto closest = closest_names(name, kDefaultSuggestions);
+    throw GlassError("unknown glass " + quoted +
+                     (closest.empty() ? "; the glass catalogue is empty" : "; closest catalogue names: " + join(closest)));
+  }
+  const std::string vendor_upper = upper(vendor);
+  // The name may exist at another vendor (SF5 is SCHOTT and HIKARI, not HOYA): say where.
+  std::vector<std::string> elsewhere;
+  if (const auto it = by_name_.find(upper(name)); it != by_name_.end()) {
+    for (std::size_t index : it->second) elsewhere.push_back(glasses_[index].name() + " (" + glasses_[index].vendor() + ")");
+  }
+  const std::string where_else = elsewhere.empty() ? "" : "; the name exists only as " + join(elsewhere);
+  if (vendor_rank(vendor_upper) == vendors_.size()) {
+    throw GlassError("unknown glass vendor \"" + std::string(vendor) + "\" for glass " + quoted +
+                     "; catalogue vendors: " + join(vendors_) + where_else);
+  }
+  const auto closest = closest_names_at(name, vendor_upper, kDefaultSuggestions);
+  throw GlassError("unknown glass " + quoted + " in the " + vendor_upper + " catalogue" + where_else +
+                   (closest.empty() ? "" : "; closest " + vendor_upper + " names: " + join(closest)));
+}
+
+std::vector<std::string> GlassCatalog::closest_names(std::string_view name, std::size_t count) const {
+  return closest_names_at(name, {}, count);
+}
+
+std::vector<std::string> GlassCatalog::closest_names_at(std::string_view name, std::string_view vendor_upper,
+                                                        std::size_t count) const {
+  const std::string query = normalise(name);
+  struct Candidate {
+    std::size_t distance;
+    std::string name_upper;
+    std::size_t vendor_rank;
+    std::size_t index;
+  };
+  std::vector<Candidate> candidates;
+  candidates.reserve(glasses_.size());
+  for (std::size_t i = 0; i < glasses_.size(); ++i) {
+    if (!vendor_upper.empty() && glasses_[i].vendor() != vendor_upper) continue;
+    // An exact match after normalising has distance 0 and so ranks first.
+    candidates.push_back({levenshtein(query, normalised_names_[i]), upper(glasses_[i].name()),
+                          vendor_rank(glasses_[i].vendor()), i});
+  }
+  const std::size_t kept = std::min(count, candidates.size());
+  std::partial_sort(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(kept), candidates.end(),
+                    [](const Candidate& a, const Candidate& b) {
+                      return std::tie(a.distance, a.name_upper, a.vendor_rank, a.index) <
+                             std::tie(b.distance, b.name_upper, b.vendor_rank, b.index);
+                    });
+  std::vector<std::string> out;
+  out.reserve(kept);
+  for (std::size_t i = 0; i < kept; ++i) {
+    const Glass& glass = glasses_[candidates[i].index];
+    out.push_back(glass.name() + " (" + glass.vendor() + ")");
+  }
+  return out;
+}
+
+}  // namespace lensmith

@@ -1,1 +1,72 @@
-// in progress
+#include "lensmith/prescription/lens_file.h"
+
+#include <algorithm>
+#include <cctype>
+
+#include "lensmith/core/text_file.h"
+#include "lensmith/prescription/lens_json.h"
+#include "lensmith/prescription/lentil_reader.h"
+#include "lensmith/prescription/pbrt_reader.h"
+#include "lensmith/prescription/zemax_reader.h"
+
+namespace lensmith {
+
+namespace {
+
+std::string lower_extension(const std::string& path) {
+  const auto slash = path.find_last_of("/\\");
+  const auto dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return {};
+  std::string ext = path.substr(dot);
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+// A lentil database is a JSON object of entries, each holding "optical-elements-patent"; a native
+// lens file has "format": "lensmith-lens". Look at the text rather than parse it twice.
+bool looks_like_lentil(std::string_view text) {
+  return text.find("\"optical-elements-patent\"") != std::string_view::npos &&
+         text.find("\"lensmith-lens\"") == std::string_view::npos;
+}
+
+}  // namespace
+
+LensFormat lens_format_from_path(const std::string& path) {
+  const std::string ext = lower_extension(path.substr(0, path.find('#')));
+  if (ext == ".json") return LensFormat::Json;
+  if (ext == ".zmx") return LensFormat::Zemax;
+  if (ext == ".dat") return LensFormat::Pbrt;
+  throw LensFileError({path, 0, 0}, "unknown lens file type \"" + ext +
+                                        "\"; expected .json (lensmith or lentil), .zmx (Zemax) or .dat (pbrt)");
+}
+
+LensReadResult read_lens_file(const std::string& path_with_id, const GlassCatalog& catalogue) {
+  std::string path = path_with_id;
+  std::string entry_id;
+  if (auto hash = path_with_id.rfind('#'); hash != std::string::npos && lower_extension(path_with_id.substr(0, hash)) == ".json") {
+    path = path_with_id.substr(0, hash);
+    entry_id = path_with_id.substr(hash + 1);
+  }
+  const LensFormat format = lens_format_from_path(path);
+  const std::string bytes = read_file_bytes(path);
+  switch (format) {
+    case LensFormat::Zemax: return read_zemax(bytes, path, catalogue);
+    case LensFormat::Pbrt: return read_pbrt(decode_text(bytes, path), path);
+    case LensFormat::Json:
+    case LensFormat::Lentil: {
+      const std::string text = decode_text(bytes, path);
+      if (looks_like_lentil(text)) {
+        if (entry_id.empty()) {
+          throw LensFileError({path, 0, 0}, "this is a lentil lens database; name an entry after '#', e.g. " + path + "#0001 "
+                                            "(`lensmith lenses --lentil " + path + "` lists them)");
+        }
+        return read_lentil(text, path, entry_id, catalogue);
+      }
+      if (!entry_id.empty()) throw LensFileError({path, 0, 0}, "'#" + entry_id + "' given, but this is not a lentil database");
+      return read_lens_json(text, path, catalogue);
+    }
+  }
+  throw LensFileError({path, 0, 0}, "unsupported lens format");
+}
+
+}  // namespace lensmith

@@ -1,1 +1,215 @@
-// in progress
+#include "lensmith/prescription/prescription.h"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "lensmith/core/errors.h"
+
+namespace lensmith {
+
+namespace {
+
+std::string number(double v) {
+  char buffer[48];
+  std::snprintf(buffer, sizeof buffer, "%.10g", v);
+  return buffer;
+}
+
+[[noreturn]] void reject_surface(std::size_t index, const std::string& field, double value, const std::string& rule) {
+  throw PrescriptionError("surface " + std::to_string(index + 1) + ": " + field + " = " + number(value) + ": " + rule);
+}
+
+[[noreturn]] void reject_system(const std::string& field, double value, const std::string& rule) {
+  throw PrescriptionError(field + " = " + number(value) + ": " + rule);
+}
+
+// Wavelengths that optical glass catalogues can be meaningful for, nm.
+constexpr double kMinWavelength_nm = 100.0;
+constexpr double kMaxWavelength_nm = 20000.0;
+
+}  // namespace
+
+std::string ApertureSpec::to_string() const {
+  switch (kind) {
+    case Kind::EntrancePupilDiameter: return "entrance-pupil diameter " + number(value) + " mm";
+    case Kind::ImageSpaceFNumber: return "image-space f/" + number(value);
+    case Kind::FloatByStop: return "float by stop size";
+  }
+  return "?";
+}
+
+double FieldSpec::max_value() const {
+  double m = 0.0;
+  for (double v : values) m = std::max(m, std::abs(v));
+  return m;
+}
+
+std::string FieldSpec::to_string() const {
+  std::string unit = kind == Kind::AngleDeg ? " deg (angle)" : kind == Kind::ObjectHeightMm ? " mm (object height)" : " mm (paraxial image height)";
+  std::string s;
+  for (double v : values) s += (s.empty() ? "" : ", ") + number(v);
+  return s + unit;
+}
+
+std::optional<std::size_t> Prescription::flagged_stop_index() const {
+  for (std::size_t i = 0; i < surfaces.size(); ++i) {
+    if (surfaces[i].is_stop) return i;
+  }
+  return std::nullopt;
+}
+
+double Prescription::vertex_z_mm(std::size_t surface_index) const {
+  double z = 0.0;
+  for (std::size_t i = 0; i < surface_index && i < surfaces.size(); ++i) z += surfaces[i].thickness_mm;
+  return z;
+}
+
+double Prescription::last_vertex_z_mm() const { return surfaces.empty() ? 0.0 : vertex_z_mm(surfaces.size() - 1); }
+
+void Prescription::validate() const {
+  if (surfaces.empty()) throw PrescriptionError("surfaces: a lens needs at least one surface");
+  int stops = 0;
+  for (std::size_t i = 0; i < surfaces.size(); ++i) {
+    const Surface& s = surfaces[i];
+    const bool last = i + 1 == surfaces.size();
+    if (!std::isfinite(s.curvature_per_mm)) reject_surface(i, "curvature_per_mm", s.curvature_per_mm, "must be finite (use 0 for a plane)");
+    if (!(last && image_at_paraxial_focus)) {
+      if (!std::isfinite(s.thickness_mm)) reject_surface(i, "thickness_mm", s.thickness_mm, "must be finite");
+    }
+    if (s.semi_diameter_mm) {
+      if (!std::isfinite(*s.semi_diameter_mm) || *s.semi_diameter_mm <= 0.0) {
+        reject_surface(i, "semi_diameter_mm", *s.semi_diameter_mm, "must be finite and > 0");
+      }
+      // A sphere cannot be wider than its radius: z(r) is undefined for r > |R|.
+      const double c = s.curvature_per_mm;
+      const double kc2 = (1.0 + s.conic) * c * c;
+      if (kc2 > 0.0 && *s.semi_diameter_mm * *s.semi_diameter_mm * kc2 > 1.0 + 1e-12) {
+        reject_surface(i, "semi_diameter_mm", *s.semi_diameter_mm,
+                       "larger than the surface allows (" + number(1.0 / std::sqrt(kc2)) + " mm for this radius and conic)");
+      }
+    }
+    if (!std::isfinite(s.conic)) reject_surface(i, "conic", s.conic, "must be finite");
+    for (std::size_t j = 0; j < s.even_asphere.size(); ++j) {
+      if (!std::isfinite(s.even_asphere[j])) reject_surface(i, "even_asphere.a" + std::to_string(2 * (j + 1)), s.even_asphere[j], "must be finite");
+    }
+    if (s.material.kind == MaterialSpec::Kind::Model) {
+      if (!std::isfinite(s.material.nd) || s.material.nd < 1.0 || s.material.nd > 5.0) {
+        reject_surface(i, "material.nd", s.material.nd, "must lie in [1, 5]");
+      }
+      if (s.material.vd && (!std::isfinite(*s.material.vd) || *s.material.vd <= 0.0)) {
+        reject_surface(i, "material.vd", *s.material.vd, "must be finite and > 0");
+      }
+    }
+    if (s.is_stop) ++stops;
+  }
+  if (stops > 1) throw PrescriptionError("surfaces: " + std::to_string(stops) + " surfaces are flagged as the stop; at most one may be");
+
+  if (!(object_distance_mm > 0.0)) reject_system("object_distance_mm", object_distance_mm, "must be > 0 (or infinity)");
+
+  if (wavelengths_nm.empty()) throw PrescriptionError("wavelengths_nm: at least one wavelength is needed");
+  for (std::size_t i = 0; i < wavelengths_nm.size(); ++i) {
+    const double w = wavelengths_nm[i];
+    if (!(w > kMinWavelength_nm && w < kMaxWavelength_nm)) {
+      reject_system("wavelengths_nm[" + std::to_string(i) + "]", w, "must lie in (100, 20000) nm");
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (wavelengths_nm[j] == w) reject_system("wavelengths_nm[" + std::to_string(i) + "]", w, "appears twice");
+    }
+  }
+  if (primary_wavelength_index >= wavelengths_nm.size()) {
+    throw PrescriptionError("primary wavelength index " + std::to_string(primary_wavelength_index + 1) + " is beyond the " +
+                            std::to_string(wavelengths_nm.size()) + " wavelengths given");
+  }
+
+  switch (aperture.kind) {
+    case ApertureSpec::Kind::EntrancePupilDiameter:
+      if (!std::isfinite(aperture.value) || aperture.value <= 0.0) reject_system("aperture.entrance_pupil_diameter_mm", aperture.value, "must be finite and > 0");
+      break;
+    case ApertureSpec::Kind::ImageSpaceFNumber:
+      if (!std::isfinite(aperture.value) || aperture.value <= 0.0) reject_system("aperture.f_number", aperture.value, "must be finite and > 0");
+      break;
+    case ApertureSpec::Kind::FloatByStop: {
+      auto stop = flagged_stop_index();
+      if (stop && !surfaces[*stop].semi_diameter_mm) {
+        throw PrescriptionError("aperture: floats by stop size, but the stop (surface " + std::to_string(*stop + 1) +
+                                ") has no semi_diameter_mm");
+      }
+      if (!stop) {
+        bool any = false;
+        for (const auto& s : surfaces) any = any || s.semi_diameter_mm.has_value();
+        if (!any) throw PrescriptionError("aperture: floats by stop size, but no surface is flagged as stop and none has a semi_diameter_mm");
+      }
+      break;
+    }
+  }
+
+  if (field) {
+    if (field->values.empty()) throw PrescriptionError("field: at least one field point is needed");
+    for (std::size_t i = 0; i < field->values.size(); ++i) {
+      const double v = field->values[i];
+      if (!std::isfinite(v)) reject_system("field.values[" + std::to_string(i) + "]", v, "must be finite");
+      if (field->kind == FieldSpec::Kind::AngleDeg && std::abs(v) >= 90.0) {
+        reject_system("field.max_angle_deg", v, "must lie in (-90, 90) degrees");
+      }
+    }
+    if (field->kind == FieldSpec::Kind::ObjectHeightMm && std::isinf(object_distance_mm)) {
+      throw PrescriptionError("field: an object-height field needs a finite object distance (the object is at infinity)");
+    }
+  }
+}
+
+void Prescription::resolve_materials(const GlassCatalog& catalogue) {
+  try {
+    object_medium = object_material.resolve(catalogue);
+  } catch (const GlassError& e) {
+    throw GlassError(std::string("object space: ") + e.what());
+  }
+  for (std::size_t i = 0; i < surfaces.size(); ++i) {
+    try {
+      surfaces[i].medium = surfaces[i].material.resolve(catalogue);
+    } catch (const GlassError& e) {
+      throw GlassError("surface " + std::to_string(i + 1) + ": " + e.what());
+    }
+  }
+}
+
+Prescription Prescription::scaled(double factor) const {
+  if (!std::isfinite(factor) || factor <= 0.0) reject_system("scale factor", factor, "must be finite and > 0");
+  Prescription p = *this;
+  for (Surface& s : p.surfaces) {
+    s.curvature_per_mm /= factor;
+    s.thickness_mm *= factor;
+    if (s.semi_diameter_mm) *s.semi_diameter_mm *= factor;
+    // z = a_{2k} r^{2k} scales as length: a_{2k} -> a_{2k} * factor^(1 - 2k).
+    for (std::size_t j = 0; j < s.even_asphere.size(); ++j) {
+      s.even_asphere[j] *= std::pow(factor, 1.0 - 2.0 * static_cast<double>(j + 1));
+    }
+  }
+  p.object_distance_mm *= factor;
+  if (p.aperture.kind == ApertureSpec::Kind::EntrancePupilDiameter) p.aperture.value *= factor;
+  if (p.field && p.field->kind != FieldSpec::Kind::AngleDeg) {
+    for (double& v : p.field->values) v *= factor;
+  }
+  return p;
+}
+
+std::string Prescription::to_string() const {
+  std::ostringstream os;
+  os << (name.empty() ? std::string("(unnamed lens)") : name) << "\n";
+  os << "  object distance: " << (std::isinf(object_distance_mm) ? std::string("infinity") : number(object_distance_mm) + " mm")
+     << ", aperture: " << aperture.to_string() << ", field: " << (field ? field->to_string() : std::string("none")) << "\n";
+  os << "  wavelengths (nm):";
+  for (std::size_t i = 0; i < wavelengths_nm.size(); ++i) {
+    os << ' ' << number(wavelengths_nm[i]) << (i == primary_wavelength_index ? "*" : "");
+  }
+  os << "\n";
+  for (std::size_t i = 0; i < surfaces.size(); ++i) {
+    os << "  " << (i + 1) << ": " << surfaces[i].to_string();
+    if (i + 1 == surfaces.size() && image_at_paraxial_focus) os << " (image at paraxial focus)";
+    os << "\n";
+  }
+  return os.str();
+}
+
+}  // namespace lensmith

@@ -6,6 +6,7 @@
 #include <array>
 #include <ostream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace lensmith {
@@ -28,6 +29,13 @@ class Glass {
     ModelCauchy = 100,  // model glass from nd, Vd: n = A + B / l^2 (docs/glass.md)
     Constant = 101,     // n independent of wavelength (air, or an index without dispersion data)
   };
+
+  // Availability as the vendor's catalogue states it: the Zemax AGF status codes 0..3
+  // (docs/glass.md, "Status"). Unspecified for glasses from data sheets that give none and for
+  // model, constant and air.
+  enum class Status { Unspecified, Standard, Preferred, Obsolete, Special };
+  // "unspecified", "standard", "preferred", "obsolete", "special": the words of the JSON format.
+  static std::string_view status_name(Status status);
 
   // Air: n = 1 at every wavelength (catalogue indices are relative to air).
   static Glass air();
@@ -65,7 +73,15 @@ class Glass {
   double catalog_vd() const { return catalog_vd_; }
   bool is_air() const { return formula_ == Formula::Constant && constant_index_ == 1.0 && name_ == "air"; }
 
-  friend bool operator==(const Glass&, const Glass&) = default;
+  Status status() const { return status_; }
+  // The glass the vendor names as this one's successor ("N-SF15" for SF15), or "" when none.
+  const std::string& replaced_by() const { return replaced_by_; }
+  // Records the catalogue status (used by GlassCatalog when it reads a catalogue).
+  void set_catalog_status(Status status, std::string replaced_by = {});
+
+  // Equal when every field is equal; a missing catalogue nd or Vd (NaN) equals a missing one, so
+  // a glass always equals its copy.
+  friend bool operator==(const Glass& a, const Glass& b);
   // "SCHOTT N-BK7 (formula 2, 300-2500 nm, nd 1.51680, Vd 64.17)"
   std::string to_string() const;
   friend std::ostream& operator<<(std::ostream& os, const Glass& g) { return os << g.to_string(); }
@@ -79,6 +95,8 @@ class Glass {
   double catalog_nd_ = 0.0;
   double catalog_vd_ = 0.0;
   double constant_index_ = 1.0;
+  Status status_ = Status::Unspecified;
+  std::string replaced_by_;
 };
 
 }  // namespace lensmith

@@ -6,6 +6,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include "lensmith/glass/glass.h"
@@ -23,6 +24,8 @@ class GlassCatalog {
   static GlassCatalog from_json(std::string_view json_text, const std::string& source_name);
 
   // Appends every glass of `other`; its vendors come after the ones already present in search order.
+  // Throws GlassError when a glass of `other` has the vendor and name (ignoring case) of one
+  // already present, rather than letting one silently shadow the other.
   void merge(const GlassCatalog& other);
 
   // Looks up a glass by name, case-insensitively. With a vendor, only that vendor's catalogue is
@@ -47,8 +50,20 @@ class GlassCatalog {
   std::size_t size() const { return glasses_.size(); }
 
  private:
+  // Appends one glass, keeping the lookup tables in step. Throws GlassError on a duplicate.
+  void add(Glass glass);
+  // Position of `vendor_upper` in vendors_, or vendors_.size() when absent.
+  std::size_t vendor_rank(std::string_view vendor_upper) const;
+  // closest_names() restricted to one vendor (all vendors when `vendor_upper` is empty).
+  std::vector<std::string> closest_names_at(std::string_view name, std::string_view vendor_upper,
+                                            std::size_t count) const;
+
   std::vector<Glass> glasses_;
   std::vector<std::string> vendors_;
+  // Upper-case name -> indices into glasses_, in insertion order: find() costs one hash lookup.
+  std::unordered_map<std::string, std::vector<std::size_t>> by_name_;
+  // Each name upper-cased without '-', ' ' and '_' (parallel to glasses_), for closest_names().
+  std::vector<std::string> normalised_names_;
 };
 
 }  // namespace lensmith

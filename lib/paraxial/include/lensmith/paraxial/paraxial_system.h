@@ -43,7 +43,7 @@ struct ParaxialRayTable {
 struct Pupil {
   double z_mm = 0.0;         // z of the pupil (z = 0 at surface 1)
   double diameter_mm = 0.0;
-  double magnification = 1.0;  // pupil diameter / stop diameter (paraxial)
+  double magnification = 1.0;  // pupil diameter / stop diameter (paraxial, signed: < 0 = inverted image of the stop)
 };
 
 struct ParaxialOptions {

@@ -1,0 +1,58 @@
+// Prescription::validate names the surface and field it rejects; scaled() scales every length.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include "lensmith/core/errors.h"
+#include "lensmith/prescription/lens_library.h"
+
+using namespace lensmith;
+using Catch::Contains;
+
+namespace {
+Prescription sasian() { return LensLibrary::load("sasian-triplet").prescription; }
+}  // namespace
+
+TEST_CASE("prescription: a negative semi-diameter is rejected naming the surface", "[prescription]") {
+  Prescription p = sasian();
+  p.surfaces[3].semi_diameter_mm = -2.0;
+  CHECK_THROWS_WITH(p.validate(), Contains("surface 4: semi_diameter_mm = -2: must be finite and > 0"));
+}
+
+TEST_CASE("prescription: a non-finite thickness is rejected naming the surface", "[prescription]") {
+  Prescription p = sasian();
+  p.surfaces[1].thickness_mm = std::nan("");
+  CHECK_THROWS_WITH(p.validate(), Contains("surface 2: thickness_mm = nan: must be finite"));
+}
+
+TEST_CASE("prescription: object distance must be positive", "[prescription]") {
+  Prescription p = sasian();
+  p.object_distance_mm = -100.0;
+  CHECK_THROWS_WITH(p.validate(), Contains("object_distance_mm = -100: must be > 0"));
+}
+
+TEST_CASE("prescription: a primary wavelength index beyond the list is rejected", "[prescription]") {
+  Prescription p = sasian();
+  p.primary_wavelength_index = 3;
+  CHECK_THROWS_WITH(p.validate(), Contains("primary wavelength index 4 is beyond the 3 wavelengths"));
+}
+
+TEST_CASE("prescription: scaling multiplies lengths and divides curvatures", "[prescription]") {
+  Prescription p = sasian();
+  p.surfaces[0].even_asphere[1] = 1e-5;  // r^4 term: scales as factor^-3
+  const Prescription q = p.scaled(2.0);
+  CHECK_THAT(q.surfaces[0].curvature_per_mm, Catch::Matchers::WithinRel(p.surfaces[0].curvature_per_mm / 2.0, 1e-15));
+  CHECK(q.surfaces[0].thickness_mm == 2.0 * p.surfaces[0].thickness_mm);
+  CHECK(*q.surfaces[0].semi_diameter_mm == 2.0 * *p.surfaces[0].semi_diameter_mm);
+  CHECK_THAT(q.surfaces[0].even_asphere[1], Catch::Matchers::WithinRel(1e-5 / 8.0, 1e-15));
+  CHECK(q.aperture.value == 25.0);
+  CHECK_THROWS_AS(p.scaled(0.0), PrescriptionError);
+}
+
+TEST_CASE("prescription: the flagged stop and vertex positions", "[prescription]") {
+  const Prescription p = sasian();
+  REQUIRE(p.flagged_stop_index());
+  CHECK(*p.flagged_stop_index() == 2);
+  // Sum of the first five thicknesses of the Sasian triplet (REFERENCE-VALUES.md section 2).
+  CHECK_THAT(p.last_vertex_z_mm(), Catch::Matchers::WithinAbs(4.831 + 5.86 + 0.975 + 4.822 + 3.127, 1e-12));
+}

@@ -1,0 +1,16 @@
+#!/bin/sh
+# Installs everything lensmith needs to build, test and fuzz on Debian 12 (run as root, or with sudo).
+# Each package and what it is for is listed in README.md, section "Dependencies".
+set -eu
+if [ "$(id -u)" -ne 0 ]; then
+  if command -v sudo >/dev/null 2>&1; then exec sudo "$0" "$@"; fi
+  echo "install-deps.sh: run as root (apt-get needs it)" >&2
+  exit 1
+fi
+export DEBIAN_FRONTEND=noninteractive
+apt-get update -qq
+apt-get install -y -qq --no-install-recommends \
+  ca-certificates cmake ninja-build g++ pkg-config \
+  libeigen3-dev libceres-dev libopenimageio-dev nlohmann-json3-dev libcli11-dev catch2 libbenchmark-dev \
+  clang libclang-rt-14-dev >/dev/null
+echo "install-deps.sh: dependencies installed"
