@@ -7,7 +7,9 @@ one YAML file per glass. Output: one JSON file per vendor, `lenses/glass/<vendor
 format described in docs/glass.md ("lensmith-glass-catalog", version 1).
 
 Rules (docs/glass.md and lenses/glass/README.md explain them):
-  * The glass name is the YAML file name without `.yml` (N-BK7.yml -> "N-BK7").
+  * The glass name is the YAML file name without `.yml` (N-BK7.yml -> "N-BK7"), except that a
+    trailing "star" is the database's file-safe spelling of "*" (CDGM H-K9Lstar.yml -> "H-K9L*",
+    the name CDGM and Zemax files use).
   * Only the first DATA entry of type `formula 1`, `formula 2` or `formula 3` is kept; tabulated
     k (and tabulated n) are dropped. A file without such an entry is skipped and reported.
   * Numbers are copied as the exact text of the YAML (coefficients, wavelength range, nd, Vd), so
@@ -127,7 +129,7 @@ def check_glass_code(name, code, nd, vd, where, notes):
 def read_glass(path, group, vendor_folder, notes):
     """One YAML file -> (glass dict with number tokens, reference text) or (None, reason)."""
     where = f"{vendor_folder}/{group}/{path.name}"
-    name = path.stem
+    name = re.sub(r"star$", "*", path.stem)
     if not GLASS_NAME.fullmatch(name):
         raise ConversionError(f"{where}: {name!r} does not look like a glass name")
     with path.open(encoding="utf-8") as stream:

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <tuple>
 
@@ -70,6 +71,13 @@ std::string join(const std::vector<std::string>& items) {
   return out;
 }
 
+// A number for messages, as short as it can be written: "2", "2.5", "1e-07".
+std::string number_text(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
 // Catalogue wavelengths are printed in micrometres with at most 6 decimals. Rounding the converted
 // value to 1e-6 nm removes the binary conversion error, so 0.32611 um becomes the double nearest
 // 326.11 nm and a user who asks for exactly 326.11 nm is inside the range.
@@ -113,7 +121,7 @@ Glass read_glass(const LocatedJson& doc, std::size_t index, const std::string& v
 
   const double formula_number = reader.get_number("formula");
   if (formula_number != 1 && formula_number != 2 && formula_number != 3) {
-    reader.fail("formula", "must be 1, 2 or 3 (refractiveindex.info formula numbers), got " + nlohmann::json(formula_number).dump());
+    reader.fail("formula", "must be 1, 2 or 3 (refractiveindex.info formula numbers), got " + number_text(formula_number));
   }
   const auto formula = static_cast<Glass::Formula>(static_cast<int>(formula_number));
 
@@ -179,7 +187,7 @@ GlassCatalog GlassCatalog::from_json(std::string_view json_text, const std::stri
   }
   const double version = root.get_number("version");
   if (version != kFormatVersion) {
-    root.fail("version", "version " + nlohmann::json(version).dump() + " is not supported; this lensmith reads version " +
+    root.fail("version", "version " + number_text(version) + " is not supported; this lensmith reads version " +
                              std::to_string(kFormatVersion));
   }
   const std::string vendor = upper(root.get_string("vendor"));

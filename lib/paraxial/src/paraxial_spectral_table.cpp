@@ -17,6 +17,8 @@ namespace lensmith {
 namespace {
 
 std::string number(double value, int decimals) {
+  // Print a value that rounds to zero as 0, not -0.
+  if (std::abs(value) < 0.5 * std::pow(10.0, -decimals)) value = 0.0;
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
   return buffer;
@@ -72,8 +74,10 @@ ParaxialSpectralTable::ParaxialSpectralTable(const Prescription& lens, const Spe
   samples_.resize(static_cast<std::size_t>(options.samples));
   const double step_nm = (options.max_wavelength_nm - options.min_wavelength_nm) / (options.samples - 1);
   for (std::size_t s = 0; s < samples_.size(); ++s) {
-    const double wavelength_nm = s + 1 == samples_.size() ? options.max_wavelength_nm
-                                                          : options.min_wavelength_nm + step_nm * static_cast<double>(s);
+    // The last sample is set to the maximum exactly, free of the rounding in min + step * s.
+    const double wavelength_nm = s + 1 == samples_.size()
+                                     ? options.max_wavelength_nm
+                                     : options.min_wavelength_nm + step_nm * static_cast<double>(s);
     bool extrapolated = !lens.object_medium.covers(wavelength_nm);
     for (std::size_t k = 0; k < count; ++k) {
       indices[k] = media[k]->index(wavelength_nm);

@@ -121,6 +121,8 @@ using paraxial_detail::KernelMatrices;
 std::string number(double value, int decimals) {
   if (std::isinf(value)) return value > 0 ? "infinity" : "-infinity";
   if (std::isnan(value)) return "nan";
+  // Print a value that rounds to zero as 0, not -0.
+  if (std::abs(value) < 0.5 * std::pow(10.0, -decimals)) value = 0.0;
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
   return buffer;
@@ -148,9 +150,10 @@ std::vector<double> indices_at(const Prescription& lens, double wavelength_nm) {
 // Traces a paraxial ray (Welford 4.2: n'u' = n u - y (n' - n) c, y+ = y + t u') and fills a table.
 // `image_gap_mm` is the last vertex to the image plane where the image height is taken.
 ParaxialRayTable trace_ray(std::span<const double> curvatures, std::span<const double> thicknesses,
-                           std::span<const double> indices, double n_object, double object_slope,
-                           double object_height_mm, double y1_mm, double image_gap_mm) {
+                           std::span<const double> indices, double n_object, double object_distance_mm,
+                           double object_slope, double object_height_mm, double y1_mm, double image_gap_mm) {
   ParaxialRayTable table;
+  table.object_distance_mm = object_distance_mm;
   table.object_slope = object_slope;
   table.object_height_mm = object_height_mm;
   table.y1_mm = y1_mm;
@@ -177,7 +180,7 @@ std::size_t find_limiting_surface(const Prescription& lens, std::span<const doub
                                   std::span<const double> thicknesses, std::span<const double> indices,
                                   double n_object, double object_distance_mm) {
   const bool at_infinity = std::isinf(object_distance_mm);
-  const ParaxialRayTable ray = trace_ray(curvatures, thicknesses, indices, n_object,
+  const ParaxialRayTable ray = trace_ray(curvatures, thicknesses, indices, n_object, object_distance_mm,
                                          at_infinity ? 0.0 : 1.0 / object_distance_mm, 0.0, 1.0, 0.0);
   std::optional<std::size_t> best;
   double best_ratio = kInfinity;
@@ -250,10 +253,19 @@ ParaxialSystem::ParaxialSystem(const Prescription& lens, const ParaxialOptions& 
     stop_flagged_ = false;
   }
   const std::size_t stop_index = static_cast<std::size_t>(stop_surface_ - 1);
+  stop_semi_diameter_mm_ = lens.surfaces[stop_index].semi_diameter_mm;
 
-  const KernelMatrices m = paraxial_detail::compose_matrices(curvatures_, thicknesses_, indices_, n_object_, stop_index);
+  const KernelMatrices m =
+      paraxial_detail::compose_matrices(curvatures_, thicknesses_, indices_, n_object_, stop_index);
   matrix_ = m.system;
-  paraxial_detail::cardinal_points(m, n_object_, n_image_, z_last_mm_);  // throws for an afocal system
+  // Throws ComputationError for an afocal system.
+  const CardinalPoints cardinal = paraxial_detail::cardinal_points(m, n_object_, n_image_, z_last_mm_);
+  z_front_focal_mm_ = cardinal.z_front_focal_mm;
+  z_rear_focal_mm_ = cardinal.z_rear_focal_mm;
+  z_front_principal_mm_ = cardinal.z_front_principal_mm;
+  z_rear_principal_mm_ = cardinal.z_rear_principal_mm;
+  z_front_nodal_mm_ = cardinal.z_front_nodal_mm;
+  z_rear_nodal_mm_ = cardinal.z_rear_nodal_mm;
   const paraxial_detail::PupilImages pupils = paraxial_detail::pupil_images(m, n_object_, n_image_, z_last_mm_);
   if (!std::isfinite(pupils.z_entrance_mm)) {
     throw ComputationError("the entrance pupil lies at infinity (stop at the rear focal point of the surfaces "
@@ -308,16 +320,16 @@ ParaxialSystem::ParaxialSystem(const Prescription& lens, const ParaxialOptions& 
   const double pupil_radius = 0.5 * epd_mm_;
   const double z_ep = entrance_pupil_.z_mm;
   if (at_infinity) {
-    marginal_ = trace_ray(curvatures_, thicknesses_, indices_, n_object_, 0.0, 0.0, pupil_radius,
-                          image_plane_distance_mm_);
+    marginal_ = trace_ray(curvatures_, thicknesses_, indices_, n_object_, object_distance_mm_, 0.0, 0.0,
+                          pupil_radius, image_plane_distance_mm_);
   } else {
     const double object_to_pupil = object_distance_mm_ + z_ep;
     if (object_to_pupil == 0.0) {
       throw ComputationError("the object plane coincides with the entrance pupil: no marginal ray");
     }
     const double slope = pupil_radius / object_to_pupil;
-    marginal_ = trace_ray(curvatures_, thicknesses_, indices_, n_object_, slope, 0.0, slope * object_distance_mm_,
-                          image_plane_distance_mm_);
+    marginal_ = trace_ray(curvatures_, thicknesses_, indices_, n_object_, object_distance_mm_, slope, 0.0,
+                          slope * object_distance_mm_, image_plane_distance_mm_);
   }
 
   // Chief ray: from the edge of the field through the centre of the entrance pupil, rising in
@@ -329,13 +341,14 @@ ParaxialSystem::ParaxialSystem(const Prescription& lens, const ParaxialOptions& 
     // -s (d + z_ep) at a finite object plane.
     auto chief_with_slope = [&](double slope) {
       const double object_height = at_infinity ? 0.0 : -slope * (object_distance_mm_ + z_ep);
-      return trace_ray(curvatures_, thicknesses_, indices_, n_object_, slope, object_height, -slope * z_ep,
-                       image_plane_distance_mm_);
+      return trace_ray(curvatures_, thicknesses_, indices_, n_object_, object_distance_mm_, slope, object_height,
+                       -slope * z_ep, image_plane_distance_mm_);
     };
     double slope = 0.0;
     switch (lens.field->kind) {
       case FieldSpec::Kind::AngleDeg:
         slope = std::tan(rad_from_deg(value));
+        field_description_ = number(value, 4) + " deg object-space angle";
         break;
       case FieldSpec::Kind::ObjectHeightMm: {
         if (at_infinity) {
@@ -346,6 +359,7 @@ ParaxialSystem::ParaxialSystem(const Prescription& lens, const ParaxialOptions& 
           throw ComputationError("the object plane coincides with the entrance pupil: no chief ray");
         }
         slope = value / object_to_pupil;
+        field_description_ = number(value, 4) + " mm object height (object point at y = -" + number(value, 4) + ")";
         break;
       }
       case FieldSpec::Kind::ImageHeightMm: {
@@ -356,6 +370,7 @@ ParaxialSystem::ParaxialSystem(const Prescription& lens, const ParaxialOptions& 
           throw ComputationError("the chief ray meets the axis at the paraxial image: image-height field undefined");
         }
         slope = value / landing;
+        field_description_ = number(value, 4) + " mm paraxial image height";
         break;
       }
     }
@@ -366,14 +381,14 @@ ParaxialSystem::ParaxialSystem(const Prescription& lens, const ParaxialOptions& 
 double ParaxialSystem::efl_mm() const { return 1.0 / power_per_mm(); }
 double ParaxialSystem::front_focal_length_mm() const { return n_object_ / power_per_mm(); }
 double ParaxialSystem::rear_focal_length_mm() const { return n_image_ / power_per_mm(); }
-double ParaxialSystem::z_front_focal_mm() const { return n_object_ * matrix_.a11 / matrix_.a12; }
-double ParaxialSystem::z_rear_focal_mm() const { return z_last_mm_ - n_image_ * matrix_.a22 / matrix_.a12; }
-double ParaxialSystem::bfl_mm() const { return z_rear_focal_mm() - z_last_mm_; }
-double ParaxialSystem::ffl_mm() const { return z_front_focal_mm(); }
-double ParaxialSystem::z_front_principal_mm() const { return z_front_focal_mm() + front_focal_length_mm(); }
-double ParaxialSystem::z_rear_principal_mm() const { return z_rear_focal_mm() - rear_focal_length_mm(); }
-double ParaxialSystem::z_front_nodal_mm() const { return z_front_focal_mm() + rear_focal_length_mm(); }
-double ParaxialSystem::z_rear_nodal_mm() const { return z_rear_focal_mm() - front_focal_length_mm(); }
+double ParaxialSystem::z_front_focal_mm() const { return z_front_focal_mm_; }
+double ParaxialSystem::z_rear_focal_mm() const { return z_rear_focal_mm_; }
+double ParaxialSystem::bfl_mm() const { return z_rear_focal_mm_ - z_last_mm_; }
+double ParaxialSystem::ffl_mm() const { return z_front_focal_mm_; }
+double ParaxialSystem::z_front_principal_mm() const { return z_front_principal_mm_; }
+double ParaxialSystem::z_rear_principal_mm() const { return z_rear_principal_mm_; }
+double ParaxialSystem::z_front_nodal_mm() const { return z_front_nodal_mm_; }
+double ParaxialSystem::z_rear_nodal_mm() const { return z_rear_nodal_mm_; }
 double ParaxialSystem::z_last_surface_mm() const { return z_last_mm_; }
 double ParaxialSystem::z_image_mm() const { return z_last_mm_ + image_distance_mm_; }
 
@@ -408,19 +423,23 @@ std::string SystemMatrix::to_string() const {
 std::string ParaxialRayTable::to_string() const {
   std::ostringstream os;
   os << "  surf" << padded("y (mm)", 14) << padded("u", 14) << padded("i", 14) << padded("n'", 10) << '\n';
-  os << "   obj" << field(object_height_mm, 6, 14) << field(object_slope, 6, 14) << padded("", 14) << '\n';
+  os << "   obj" << (std::isinf(object_distance_mm) ? padded("at infinity", 14) : field(object_height_mm, 6, 14))
+     << field(object_slope, 6, 14) << '\n';
   for (const ParaxialRayRow& row : rows) {
     os << padded(std::to_string(row.surface), 6) << field(row.y_mm, 6, 14) << field(row.u_after, 6, 14)
        << field(row.i, 6, 14) << field(row.n_after, 6, 10) << '\n';
   }
-  os << "   img" << field(image_height_mm, 6, 14) << field(rows.empty() ? object_slope : rows.back().u_after, 6, 14)
-     << '\n';
+  os << "   img" << field(image_height_mm, 6, 14)
+     << field(rows.empty() ? object_slope : rows.back().u_after, 6, 14) << '\n';
   return os.str();
 }
 
 std::string ParaxialSystem::to_string() const {
-  constexpr std::size_t kLabel = 40;
+  constexpr std::size_t kLabel = 36;
   std::ostringstream os;
+  auto line = [&](const std::string& name, const std::string& value, const std::string& note = {}) {
+    os << label("  " + name, kLabel) << value << (note.empty() ? "" : "  (" + note + ")") << '\n';
+  };
   os << "Paraxial (first-order) data at " << number(wavelength_nm_, 4) << " nm, object "
      << (std::isinf(object_distance_mm_) ? std::string("at infinity")
                                          : number(object_distance_mm_, 4) + " mm in front of surface 1")
@@ -428,55 +447,52 @@ std::string ParaxialSystem::to_string() const {
   os << "  z: mm from the vertex of surface 1, +z toward the image; last surface at z = " << number(z_last_mm_, 4)
      << " mm\n\n";
 
-  os << label("  System matrix (n u, y)", kLabel) << matrix_.to_string() << '\n';
-  os << label("  Power", kLabel) << number(power_per_mm(), 8) << " 1/mm\n";
-  os << label("  Effective focal length (EFL = 1/P)", kLabel) << number(efl_mm(), 4) << " mm\n";
-  os << label("  Front focal length (f = n/P)", kLabel) << number(front_focal_length_mm(), 4) << " mm  (n = "
-     << number(n_object_, 6) << ")\n";
-  os << label("  Rear focal length (f' = n'/P)", kLabel) << number(rear_focal_length_mm(), 4) << " mm  (n' = "
-     << number(n_image_, 6) << ")\n";
-  os << label("  Back focal length (BFL)", kLabel) << number(bfl_mm(), 4) << " mm  (last surface to F')\n";
-  os << label("  Front focal distance (FFL)", kLabel) << number(ffl_mm(), 4) << " mm  (surface 1 to F)\n\n";
-
-  os << label("  Point", 26) << padded("z (mm)", 14) << padded("from surf 1", 14) << padded("from last surf", 16)
-     << '\n';
-  auto point_row = [&](const std::string& name, double z) {
-    os << label("  " + name, 26) << field(z, 4, 14) << field(z, 4, 14) << field(z - z_last_mm_, 4, 16) << '\n';
-  };
-  point_row("Front focal point F", z_front_focal_mm());
-  point_row("Rear focal point F'", z_rear_focal_mm());
-  point_row("Front principal point P", z_front_principal_mm());
-  point_row("Rear principal point P'", z_rear_principal_mm());
-  point_row("Front nodal point N", z_front_nodal_mm());
-  point_row("Rear nodal point N'", z_rear_nodal_mm());
-  point_row("Entrance pupil", entrance_pupil_.z_mm);
-  point_row("Exit pupil", exit_pupil_.z_mm);
-  point_row("Paraxial image", z_image_mm());
+  line("System matrix (n u, y)", matrix_.to_string());
+  line("Power", number(power_per_mm(), 8) + " 1/mm");
+  line("Effective focal length EFL", number(efl_mm(), 4) + " mm", "1/P");
+  line("Front focal length f", number(front_focal_length_mm(), 4) + " mm", "n/P, n = " + number(n_object_, 6));
+  line("Rear focal length f'", number(rear_focal_length_mm(), 4) + " mm", "n'/P, n' = " + number(n_image_, 6));
+  line("Back focal length BFL", number(bfl_mm(), 4) + " mm", "last surface to F'");
+  line("Front focal distance FFL", number(ffl_mm(), 4) + " mm", "surface 1 to F");
   os << '\n';
 
-  os << label("  Aperture stop", kLabel) << "surface " << stop_surface_
-     << (stop_flagged_ ? " (flagged)" : " (found: limits the axial beam)") << '\n';
-  os << label("  Entrance pupil diameter (EPD)", kLabel) << number(entrance_pupil_.diameter_mm, 4)
-     << " mm  (magnification " << number(entrance_pupil_.magnification, 5) << " of the stop)\n";
-  os << label("  Exit pupil diameter", kLabel) << number(exit_pupil_.diameter_mm, 4) << " mm  (magnification "
-     << number(exit_pupil_.magnification, 5) << " of the stop)\n";
-  os << label("  F-number (EFL/EPD)", kLabel) << number(f_number(), 4) << '\n';
-  os << label("  Working F-number (1/(2 n'|u'|))", kLabel) << number(working_f_number(), 4) << '\n';
-  os << label("  Image-space NA (n'|u'|)", kLabel) << number(image_space_na(), 6) << '\n';
-  if (const auto h = lagrange_invariant()) {
-    os << label("  Lagrange invariant H", kLabel) << number(*h, 6) << " mm\n";
-  }
-  os << label("  Image distance", kLabel) << number(image_distance_mm_, 4) << " mm  (last surface to paraxial image)\n";
-  os << label("  Image plane", kLabel) << number(image_plane_distance_mm_, 4) << " mm  (last surface to image plane)\n";
-  os << label("  Magnification", kLabel) << number(magnification_, 6)
-     << (std::isinf(object_distance_mm_) ? "  (object at infinity)" : "") << '\n';
+  os << label("  Point", 28) << padded("z = from surf 1", 16) << padded("from last surf", 16) << "  (mm)\n";
+  auto point = [&](const std::string& name, double z) {
+    os << label("  " + name, 28) << field(z, 4, 16) << field(z - z_last_mm_, 4, 16) << '\n';
+  };
+  point("Front focal point F", z_front_focal_mm());
+  point("Rear focal point F'", z_rear_focal_mm());
+  point("Front principal point P", z_front_principal_mm());
+  point("Rear principal point P'", z_rear_principal_mm());
+  point("Front nodal point N", z_front_nodal_mm());
+  point("Rear nodal point N'", z_rear_nodal_mm());
+  point("Entrance pupil", entrance_pupil_.z_mm);
+  point("Exit pupil", exit_pupil_.z_mm);
+  point("Paraxial image", z_image_mm());
+  point("Image plane", z_last_mm_ + image_plane_distance_mm_);
+  os << '\n';
+
+  line("Aperture stop", "surface " + std::to_string(stop_surface_) +
+                            (stop_semi_diameter_mm_ ? ", semi-diameter " + number(*stop_semi_diameter_mm_, 4) + " mm"
+                                                    : std::string()),
+       stop_flagged_ ? "flagged" : "found: limits the axial beam");
+  line("Entrance pupil diameter EPD", number(entrance_pupil_.diameter_mm, 4) + " mm",
+       "magnification " + number(entrance_pupil_.magnification, 5) + " of the stop");
+  line("Exit pupil diameter", number(exit_pupil_.diameter_mm, 4) + " mm",
+       "magnification " + number(exit_pupil_.magnification, 5) + " of the stop");
+  line("F-number", number(f_number(), 4), "EFL/EPD");
+  line("Working F-number", number(working_f_number(), 4), "1/(2 n'|u'|), this object distance");
+  line("Image-space NA", number(image_space_na(), 6), "n'|u'|");
+  line("Image distance", number(image_distance_mm_, 4) + " mm", "last surface to paraxial image");
+  line("Image plane distance", number(image_plane_distance_mm_, 4) + " mm", "last surface to image plane");
+  line("Magnification", number(magnification_, 6), std::isinf(object_distance_mm_) ? "object at infinity" : "");
   if (chief_) {
-    os << label("  Image height (chief ray)", kLabel) << number(chief_->image_height_mm, 4)
-       << " mm  (at the image plane)\n";
+    line("Maximum field", field_description_);
+    line("Chief-ray image height", number(chief_->image_height_mm, 4) + " mm", "at the image plane");
+    line("Lagrange invariant H", number(*lagrange_invariant(), 6) + " mm", "n (u_chief y - u y_chief)");
   }
 
-  os << "\nMarginal ray (axial object point to the edge of the entrance pupil; u after the surface, "
-        "i = u + y c)\n"
+  os << "\nMarginal ray (axial object point to the edge of the entrance pupil; u after the surface, i = u + y c)\n"
      << marginal_.to_string();
   if (chief_) {
     os << "\nChief ray (maximum field, through the centre of the entrance pupil)\n" << chief_->to_string();

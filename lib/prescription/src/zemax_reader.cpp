@@ -1,1 +1,893 @@
-// in progress
+// Reader for Zemax OpticStudio sequential lens files (.zmx). OpticStudio writes one keyword per
+// line: system data first, then one block per surface ("SURF n" followed by indented surface
+// keywords). Lengths are in the lens unit of the UNIT line, wavelengths in micrometres.
+// The keyword table (read, ignored, refused) is in docs/lens-formats-foreign.md, section "Zemax".
+#include "lensmith/prescription/zemax_reader.h"
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "lensmith/core/errors.h"
+#include "lensmith/core/text_file.h"
+#include "lensmith/core/units.h"
+
+namespace lensmith {
+namespace {
+
+// Limits that keep hostile input from asking for unbounded work or memory. OpticStudio itself
+// stays far below them (24 wavelength slots, a few hundred surfaces and fields).
+constexpr int kMaxSurfaceNumber = 10000;
+constexpr int kMaxWavelengthSlot = 1000;
+constexpr int kMaxFieldCount = 1000;
+constexpr std::size_t kMaxUnknownKeywordWarnings = 50;
+constexpr std::size_t kMaxShownKeywordLength = 32;
+
+// OpticStudio writes nd 1.5 and Vd 40 on the GLAS line of every catalogue glass: they are its
+// model-glass defaults, not data about that glass, so they never stand in for a missing glass.
+constexpr double kPlaceholderNd = 1.5;
+constexpr double kPlaceholderVd = 40.0;
+
+// Indices and Vd on a GLAS line outside these bounds are not optical glass.
+constexpr double kMaxPlausibleIndex = 5.0;
+
+// Keywords that change nothing lensmith models: drawing, coating, tolerancing, optimisation,
+// ray-aiming and bookkeeping data (MIRR only sets how a mirror substrate is drawn; GLAS MIRROR is
+// what makes a mirror). Sorted for binary search.
+constexpr auto kIgnoredKeywords = std::to_array<std::string_view>({
+    "BLNK", "COAT", "COFN", "CONF", "DMFS", "EDGE", "EFFL", "FIMP", "FLAP", "FWGN", "FWGT", "GFAC", "GLRS",
+    "GSTD", "HIDE", "HYPR", "ISNA", "LANG", "MAZH", "MEMA", "MIRR", "MNCA", "MNCG", "MNEA", "MNEG", "MOFF",
+    "MXCA", "MXCG", "NSCD", "OEMA", "OMMA", "OPDX", "PFIL", "PICB", "PKUP", "PMAG", "POLS", "POPS", "PPAR",
+    "PUPD", "PUSH", "PZUP", "RAIM", "RGLA", "ROPD", "SDMA", "SLAB", "TCED", "TCMM", "TOL", "TOLE", "TOTR",
+    "TRAC", "VANN", "VCON", "VCXN", "VCYN", "VDSZ", "VDXN", "VDYN", "VERS", "VPAR", "WAVN", "WWGN", "WWGT",
+    "ZVAN", "ZVCX", "ZVCY", "ZVDX", "ZVDY",
+});
+// Surface apertures and obscurations lensmith cannot represent (lensmith has one circular clear
+// aperture per surface): always an error.
+constexpr auto kRefusedApertureKeywords = std::to_array<std::string_view>({
+    "ELAP", "ELOB", "OBSC", "OBSQ", "SPID", "SQAP", "SQOB", "UDAD", "USAP", "USOB",
+});
+// Decentres, tilts and extra surface data: an error unless every value is zero.
+constexpr auto kZeroOnlyKeywords = std::to_array<std::string_view>({
+    "DECX", "DECY", "OBDC", "TILT", "TILX", "TILY", "TILZ", "XDAT", "YDAT",
+});
+static_assert(std::ranges::is_sorted(kIgnoredKeywords) && std::ranges::is_sorted(kRefusedApertureKeywords) &&
+              std::ranges::is_sorted(kZeroOnlyKeywords));
+
+template <std::size_t N>
+bool contains(const std::array<std::string_view, N>& sorted, std::string_view key) {
+  return std::binary_search(sorted.begin(), sorted.end(), key);
+}
+
+bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && is_blank(s.front())) s.remove_prefix(1);
+  while (!s.empty() && is_blank(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+// Trims blanks and line breaks (a note often ends with "NOTE 4" line breaks).
+std::string_view trim_lines(std::string_view s) {
+  while (!s.empty() && (is_blank(s.front()) || s.front() == '\n')) s.remove_prefix(1);
+  while (!s.empty() && (is_blank(s.back()) || s.back() == '\n')) s.remove_suffix(1);
+  return s;
+}
+
+std::string to_upper(std::string_view s) {
+  std::string out(s);
+  for (char& c : out) {
+    if (c >= 'a' && c <= 'z') c = static_cast<char>(c - 'a' + 'A');
+  }
+  return out;
+}
+
+// A display form of user text for messages: bounded in length, so a megabyte "keyword" from a
+// garbage file does not become a megabyte error message.
+std::string shown(std::string_view s, std::size_t max_length = kMaxShownKeywordLength) {
+  if (s.size() <= max_length) return std::string(s);
+  return std::string(s.substr(0, max_length)) + "...";
+}
+
+std::string format_number(double v) {
+  char buffer[32];
+  auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, v);
+  if (ec != std::errc()) return "?";
+  return std::string(buffer, end);
+}
+
+// Parses a whole token as a finite decimal number. Rejects what OpticStudio and C runtimes write
+// for overflow or invalid values ("1.#INF", "-1.#IND", "nan", "inf") and anything out of range.
+std::optional<double> parse_finite(std::string_view s) {
+  if (s.size() >= 2 && s.front() == '+' && s[1] != '-' && s[1] != '+') s.remove_prefix(1);
+  if (s.empty()) return std::nullopt;
+  double v = 0.0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v, std::chars_format::general);
+  if (ec != std::errc() || end != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+std::optional<long long> parse_integer(std::string_view s) {
+  if (s.size() >= 2 && s.front() == '+' && s[1] != '-') s.remove_prefix(1);
+  long long v = 0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || end != s.data() + s.size()) return std::nullopt;
+  return v;
+}
+
+struct Token {
+  std::string_view text;
+  int column = 0;  // 1-based byte column in the line
+};
+
+// One line split into its keyword and arguments (views into the decoded text).
+struct ZmxLine {
+  int number = 0;
+  Token keyword;
+  std::vector<Token> args;
+  std::string_view rest;  // everything after the keyword and the blanks that follow it
+  int end_column = 1;     // column just past the last character, for "missing argument" errors
+};
+
+ZmxLine split_line(std::string_view line, int number) {
+  ZmxLine out;
+  out.number = number;
+  out.end_column = static_cast<int>(line.size()) + 1;
+  std::size_t i = 0;
+  bool first = true;
+  while (i < line.size()) {
+    while (i < line.size() && is_blank(line[i])) ++i;
+    if (i >= line.size()) break;
+    const std::size_t start = i;
+    while (i < line.size() && !is_blank(line[i])) ++i;
+    Token t{line.substr(start, i - start), static_cast<int>(start) + 1};
+    if (first) {
+      out.keyword = t;
+      std::size_t r = i;
+      while (r < line.size() && is_blank(line[r])) ++r;
+      out.rest = line.substr(r);
+      first = false;
+    } else {
+      out.args.push_back(t);
+    }
+  }
+  return out;
+}
+
+struct GlassRef {
+  std::string name;
+  int line = 0;
+  int column = 0;
+  std::optional<double> nd;
+  std::optional<double> vd;
+  double dpgf = 0.0;
+};
+
+struct ParmRecord {
+  long long index = 0;
+  double value = 0.0;
+  int line = 0;
+  int column = 0;
+};
+
+// One SURF block as written, in lens units; converted to millimetres when the prescription is built.
+struct ZmxSurface {
+  int number = 0;
+  int line = 0;
+  std::string type = "STANDARD";
+  int type_line = 0;
+  double curvature = 0.0;  // 1 / lens unit
+  int curv_line = 0;
+  std::optional<double> disz;  // lens units; empty with disz_infinite for INFINITY
+  bool disz_infinite = false;
+  int disz_line = 0;
+  int disz_column = 0;
+  std::optional<GlassRef> glass;
+  std::optional<double> diam;      // semi-diameter, lens units
+  std::optional<double> clap_max;  // circular aperture radius, lens units
+  bool stop = false;
+  int stop_line = 0;
+  double conic = 0.0;
+  std::vector<ParmRecord> parms;
+  std::string comment;
+};
+
+struct ApertureLine {
+  ApertureSpec::Kind kind = ApertureSpec::Kind::FloatByStop;
+  double value = 0.0;  // EPD in lens units, or F/#
+  int line = 0;
+};
+
+struct FieldTypeLine {
+  long long type = 0;
+  long long field_count = 0;
+  long long wavelength_count = 0;
+  int line = 0;
+};
+
+struct Located {
+  double value = 0.0;
+  int line = 0;
+  int column = 0;
+};
+
+struct UnknownKeyword {
+  int first_line = 0;
+  int count = 0;
+};
+
+class ZemaxParser {
+ public:
+  ZemaxParser(const std::string& file_name, const GlassCatalog& catalogue)
+      : file_(file_name), catalogue_(catalogue) {}
+
+  LensReadResult parse(std::string_view bytes) {
+    const std::string text = decode_text(bytes, file_);
+    int line_number = 0;
+    std::size_t pos = 0;
+    while (pos <= text.size()) {
+      std::size_t end = text.find('\n', pos);
+      if (end == std::string::npos) end = text.size();
+      std::string_view line(text.data() + pos, end - pos);
+      ++line_number;
+      if (line.find('\0') != std::string_view::npos) {
+        fail(line_number, static_cast<int>(line.find('\0')) + 1,
+             "NUL byte in the text: not a .zmx text file (UTF-16 without a byte-order mark?)");
+      }
+      handle(split_line(line, line_number));
+      if (end == text.size()) break;
+      pos = end + 1;
+    }
+    last_line_ = line_number;
+    return build();
+  }
+
+ private:
+  // ---- errors and argument access --------------------------------------------------------------
+
+  [[noreturn]] void fail(int line, int column, const std::string& message) const {
+    throw LensFileError(SourceLocation{file_, line, column}, message);
+  }
+  [[noreturn]] void fail_at(const ZmxLine& l, const Token& t, const std::string& message) const {
+    fail(l.number, t.column, std::string(l.keyword.text) + ": " + message);
+  }
+  void warn(int line, const std::string& message) {
+    diagnostics_.push_back(Diagnostic{Diagnostic::Severity::Warning, SourceLocation{file_, line, 0}, message});
+  }
+  void note(int line, const std::string& message) {
+    diagnostics_.push_back(Diagnostic{Diagnostic::Severity::Note, SourceLocation{file_, line, 0}, message});
+  }
+
+  const Token& required_arg(const ZmxLine& l, std::size_t i, const std::string& what) const {
+    if (i >= l.args.size()) {
+      fail(l.number, l.end_column, std::string(l.keyword.text) + ": missing " + what);
+    }
+    return l.args[i];
+  }
+  double number(const ZmxLine& l, std::size_t i, const std::string& what) const {
+    const Token& t = required_arg(l, i, what);
+    auto v = parse_finite(t.text);
+    if (!v) fail_at(l, t, "expected a finite number for " + what + ", got \"" + shown(t.text) + "\"");
+    return *v;
+  }
+  std::optional<double> optional_number(const ZmxLine& l, std::size_t i, const std::string& what) const {
+    if (i >= l.args.size()) return std::nullopt;
+    return number(l, i, what);
+  }
+  long long integer(const ZmxLine& l, std::size_t i, const std::string& what, long long min, long long max) const {
+    const Token& t = required_arg(l, i, what);
+    auto v = parse_integer(t.text);
+    if (!v) fail_at(l, t, "expected an integer for " + what + ", got \"" + shown(t.text) + "\"");
+    if (*v < min || *v > max) {
+      fail_at(l, t, what + " = " + std::to_string(*v) + ": must be in [" + std::to_string(min) + ", " +
+                        std::to_string(max) + "]");
+    }
+    return *v;
+  }
+  std::vector<Located> all_numbers(const ZmxLine& l, const std::string& what) const {
+    std::vector<Located> out;
+    out.reserve(l.args.size());
+    for (std::size_t i = 0; i < l.args.size(); ++i) out.push_back({number(l, i, what), l.number, l.args[i].column});
+    return out;
+  }
+  ZmxSurface& current_surface(const ZmxLine& l) {
+    if (surfaces_.empty()) {
+      fail(l.number, l.keyword.column, std::string(l.keyword.text) + ": surface data before the first SURF line");
+    }
+    return surfaces_.back();
+  }
+
+  // ---- one line --------------------------------------------------------------------------------
+
+  void handle(const ZmxLine& l) {
+    const std::string_view k = l.keyword.text;
+    if (k.empty()) return;
+    if (k == "SURF") return handle_surf(l);
+    if (k == "TYPE") return handle_type(l);
+    if (k == "CURV") {
+      ZmxSurface& s = current_surface(l);
+      s.curvature = number(l, 0, "the curvature (1/lens unit)");
+      s.curv_line = l.number;
+      return;
+    }
+    if (k == "DISZ") return handle_disz(l);
+    if (k == "GLAS") return handle_glas(l);
+    if (k == "DIAM") {
+      ZmxSurface& s = current_surface(l);
+      const double sd = number(l, 0, "the semi-diameter");
+      if (sd < 0.0) fail_at(l, l.args[0], "semi-diameter = " + format_number(sd) + ": must be >= 0");
+      s.diam = sd;
+      return;
+    }
+    if (k == "CLAP") return handle_clap(l);
+    if (k == "STOP") {
+      ZmxSurface& s = current_surface(l);
+      if (stop_line_ != 0) {
+        fail(l.number, l.keyword.column,
+             "STOP: a second aperture stop (the first is on line " + std::to_string(stop_line_) + ")");
+      }
+      s.stop = true;
+      s.stop_line = l.number;
+      stop_line_ = l.number;
+      return;
+    }
+    if (k == "CONI") {
+      current_surface(l).conic = number(l, 0, "the conic constant");
+      return;
+    }
+    if (k == "PARM") {
+      ZmxSurface& s = current_surface(l);
+      ParmRecord p;
+      p.index = integer(l, 0, "the parameter number", 0, 1000);
+      p.value = number(l, 1, "the parameter value");
+      p.line = l.number;
+      p.column = l.args[1].column;
+      s.parms.push_back(p);
+      return;
+    }
+    if (k == "COMM") {
+      current_surface(l).comment = std::string(trim(l.rest));
+      return;
+    }
+    if (k == "UNIT") return handle_unit(l);
+    if (k == "NAME") {
+      std::string_view name = trim(l.rest);
+      if (name.size() >= 2 && name.front() == '"' && name.back() == '"') name = name.substr(1, name.size() - 2);
+      name_ = std::string(name);
+      return;
+    }
+    if (k == "NOTE") return handle_note(l);
+    if (k == "MODE") {
+      const Token& t = required_arg(l, 0, "the mode");
+      if (t.text != "SEQ") fail_at(l, t, "mode \"" + shown(t.text) + "\" is not supported: only sequential (SEQ) files are read");
+      return;
+    }
+    if (k == "GCAT") return handle_gcat(l);
+    if (k == "ENPD") {
+      aperture_ = ApertureLine{ApertureSpec::Kind::EntrancePupilDiameter, number(l, 0, "the entrance-pupil diameter"), l.number};
+      return;
+    }
+    if (k == "FNUM") {
+      const double f = number(l, 0, "the F-number");
+      if (l.args.size() > 1 && number(l, 1, "the F-number type") != 0.0) {
+        fail_at(l, l.args[1], "paraxial working F/# apertures are not supported (use image-space F/#, ENPD or FLOA)");
+      }
+      aperture_ = ApertureLine{ApertureSpec::Kind::ImageSpaceFNumber, f, l.number};
+      return;
+    }
+    if (k == "FLOA") {
+      aperture_ = ApertureLine{ApertureSpec::Kind::FloatByStop, 0.0, l.number};
+      return;
+    }
+    if (k == "OBNA") {
+      fail(l.number, l.keyword.column,
+           "OBNA: object-space NA and object cone angle apertures are not supported (use ENPD, FNUM or FLOA)");
+    }
+    if (k == "FTYP") return handle_ftyp(l);
+    if (k == "XFLN" || k == "XFLD") {
+      x_fields_ = all_numbers(l, "a field value");
+      return;
+    }
+    if (k == "YFLN" || k == "YFLD") {
+      y_fields_ = all_numbers(l, "a field value");
+      y_field_line_ = l.number;
+      return;
+    }
+    if (k == "WAVM") {
+      const long long slot = integer(l, 0, "the wavelength number", 1, kMaxWavelengthSlot);
+      const double um = number(l, 1, "the wavelength (micrometres)");
+      wavm_[static_cast<int>(slot)] = Located{um, l.number, l.args[1].column};
+      return;
+    }
+    if (k == "WAVL") {
+      for (const Located& w : all_numbers(l, "a wavelength (micrometres)")) {
+        if (wavl_.size() >= static_cast<std::size_t>(kMaxWavelengthSlot)) {
+          fail(l.number, w.column, "WAVL: more than " + std::to_string(kMaxWavelengthSlot) + " wavelengths");
+        }
+        wavl_.push_back(w);
+      }
+      return;
+    }
+    if (k == "PWAV") {
+      primary_ = Located{static_cast<double>(integer(l, 0, "the primary wavelength number", 1, kMaxWavelengthSlot)),
+                         l.number, l.args[0].column};
+      return;
+    }
+    if (k == "ENVD") return handle_envd(l);
+    if (k == "MNUM") {
+      if (!l.args.empty()) {
+        auto n = parse_integer(l.args[0].text);
+        if (n && *n > 1) {
+          warn(l.number, "the file has " + std::to_string(*n) +
+                             " configurations; the surface data as stored (the active configuration) is read");
+        }
+      }
+      return;
+    }
+    if (k == "SCBD") {
+      // SCBD carries a tilt/decentre before or after the surface; its first field is a flag.
+      for (std::size_t i = 1; i < l.args.size(); ++i) {
+        if (number(l, i, "a decentre or tilt value") != 0.0) {
+          fail_at(l, l.args[i], "surface decentres and tilts are not supported (rotationally symmetric systems only)");
+        }
+      }
+      return;
+    }
+    if (contains(kRefusedApertureKeywords, k)) {
+      fail(l.number, l.keyword.column,
+           std::string(k) + ": non-circular apertures, obscurations and user apertures are not supported");
+    }
+    if (contains(kZeroOnlyKeywords, k)) {
+      for (std::size_t i = 0; i < l.args.size(); ++i) {
+        auto v = parse_finite(l.args[i].text);
+        if (v && *v != 0.0) {
+          fail_at(l, l.args[i], "decentres, tilts and extra surface data are not supported (value " + shown(l.args[i].text) + ")");
+        }
+      }
+      return;
+    }
+    if (contains(kIgnoredKeywords, k)) return;
+    record_unknown(l);
+  }
+
+  void handle_surf(const ZmxLine& l) {
+    const long long n = integer(l, 0, "the surface number", 0, kMaxSurfaceNumber);
+    if (n != static_cast<long long>(surfaces_.size())) {
+      fail_at(l, l.args[0], "surface " + std::to_string(n) + " out of order: expected SURF " +
+                                std::to_string(surfaces_.size()) + " (surfaces are numbered 0, 1, 2, ... in order)");
+    }
+    ZmxSurface s;
+    s.number = static_cast<int>(n);
+    s.line = l.number;
+    surfaces_.push_back(std::move(s));
+  }
+
+  void handle_type(const ZmxLine& l) {
+    ZmxSurface& s = current_surface(l);
+    const Token& t = required_arg(l, 0, "the surface type");
+    if (t.text != "STANDARD" && t.text != "EVENASPH") {
+      std::string why = "only STANDARD and EVENASPH surfaces are read";
+      if (t.text == "COORDBRK") why = "coordinate breaks (tilts and decentres) are not supported; " + why;
+      fail_at(l, t, "surface type " + shown(t.text) + " on SURF " + std::to_string(s.number) + " is not supported: " + why);
+    }
+    s.type = std::string(t.text);
+    s.type_line = l.number;
+  }
+
+  void handle_disz(const ZmxLine& l) {
+    ZmxSurface& s = current_surface(l);
+    const Token& t = required_arg(l, 0, "the thickness");
+    s.disz_line = l.number;
+    s.disz_column = t.column;
+    if (to_upper(t.text) == "INFINITY") {
+      s.disz.reset();
+      s.disz_infinite = true;
+      return;
+    }
+    s.disz = number(l, 0, "the thickness");
+    s.disz_infinite = false;
+  }
+
+  void handle_glas(const ZmxLine& l) {
+    ZmxSurface& s = current_surface(l);
+    const Token& t = required_arg(l, 0, "the glass name");
+    if (to_upper(t.text) == "MIRROR") {
+      fail_at(l, t, "mirrors are not supported (SURF " + std::to_string(s.number) + "; lensmith models refracting systems)");
+    }
+    GlassRef g;
+    g.name = std::string(t.text);
+    g.line = l.number;
+    g.column = t.column;
+    // GLAS NAME solve pickup nd Vd dPgF ...: the nd/Vd fields are optional and are read leniently
+    // because OpticStudio also writes them for catalogue glasses, where they mean nothing.
+    if (l.args.size() > 3) g.nd = parse_finite(l.args[3].text);
+    if (l.args.size() > 4) g.vd = parse_finite(l.args[4].text);
+    if (l.args.size() > 5) g.dpgf = parse_finite(l.args[5].text).value_or(0.0);
+    s.glass = std::move(g);
+  }
+
+  void handle_clap(const ZmxLine& l) {
+    ZmxSurface& s = current_surface(l);
+    const double min_radius = number(l, 0, "the minimum radius");
+    const double max_radius = number(l, 1, "the maximum radius");
+    if (min_radius != 0.0) {
+      fail_at(l, l.args[0], "annular apertures (minimum radius " + format_number(min_radius) + ") are not supported");
+    }
+    if (max_radius <= 0.0) fail_at(l, l.args[1], "maximum radius = " + format_number(max_radius) + ": must be > 0");
+    s.clap_max = max_radius;
+  }
+
+  void handle_unit(const ZmxLine& l) {
+    const Token& t = required_arg(l, 0, "the lens unit");
+    const std::string u = to_upper(t.text);
+    if (u == "MM") {
+      mm_per_unit_ = 1.0;
+    } else if (u == "CM") {
+      mm_per_unit_ = mm_from_cm(1.0);
+    } else if (u == "IN" || u == "INCH" || u == "INCHES") {
+      mm_per_unit_ = mm_from_inch(1.0);
+    } else if (u == "METER" || u == "METERS" || u == "M") {
+      mm_per_unit_ = mm_from_m(1.0);
+    } else {
+      fail_at(l, t, "unknown lens unit \"" + shown(t.text) + "\" (expected MM, CM, IN or METER)");
+    }
+  }
+
+  void handle_note(const ZmxLine& l) {
+    // "NOTE 0 text" continues the note (OpticStudio splits long lines mid-word, so pieces join
+    // without a separator); "NOTE <other>" ends a line of the note.
+    std::string_view rest = l.rest;
+    std::size_t digits = 0;
+    while (digits < rest.size() && rest[digits] >= '0' && rest[digits] <= '9') ++digits;
+    const std::string_view kind = rest.substr(0, digits);
+    std::string_view text = rest.substr(digits);
+    if (!text.empty() && text.front() == ' ') text.remove_prefix(1);
+    while (!text.empty() && is_blank(text.back())) text.remove_suffix(1);
+    if (kind == "0") {
+      notes_ += text;
+    } else {
+      notes_ += '\n';
+    }
+  }
+
+  void handle_gcat(const ZmxLine& l) {
+    // Vendor catalogue names may carry a date suffix ("SUMITA_AUG2011"); other catalogues
+    // (MISC, INFRARED, user catalogues) are not in lensmith and are skipped.
+    for (const Token& t : l.args) {
+      const std::string token = to_upper(t.text);
+      for (const std::string& vendor : catalogue_.vendors()) {
+        if (token == vendor || (token.size() > vendor.size() && token.compare(0, vendor.size(), vendor) == 0 &&
+                                token[vendor.size()] == '_')) {
+          if (std::find(vendor_order_.begin(), vendor_order_.end(), vendor) == vendor_order_.end()) {
+            vendor_order_.push_back(vendor);
+          }
+        }
+      }
+    }
+  }
+
+  void handle_ftyp(const ZmxLine& l) {
+    // FTYP type telecentric field-count wavelength-count ... afocal ...
+    const long long type = integer(l, 0, "the field type", 0, 1000);
+    if (type == 3) fail_at(l, l.args[0], "real image height fields (type 3) are not supported; use paraxial image height (2)");
+    if (type == 4) fail_at(l, l.args[0], "theodolite angle fields (type 4) are not supported");
+    if (type > 4) fail_at(l, l.args[0], "field type " + std::to_string(type) + " is not supported");
+    if (l.args.size() > 1 && integer(l, 1, "the telecentric flag", 0, 1000) != 0) {
+      fail_at(l, l.args[1], "object-space telecentric systems are not supported");
+    }
+    FieldTypeLine f;
+    f.type = type;
+    f.field_count = l.args.size() > 2 ? integer(l, 2, "the number of fields", 0, kMaxFieldCount) : -1;
+    f.wavelength_count = l.args.size() > 3 ? integer(l, 3, "the number of wavelengths", 0, kMaxWavelengthSlot) : -1;
+    if (l.args.size() > 6 && integer(l, 6, "the afocal image space flag", 0, 1000) != 0) {
+      fail_at(l, l.args[6], "afocal image space is not supported");
+    }
+    f.line = l.number;
+    field_type_ = f;
+  }
+
+  void handle_envd(const ZmxLine& l) {
+    // Catalogue indices are relative to air at 20 C and 1 atm; another environment would shift them.
+    const double temperature_c = number(l, 0, "the temperature (C)");
+    const double pressure_atm = l.args.size() > 1 ? number(l, 1, "the pressure (atm)") : 1.0;
+    if (temperature_c != 20.0 || pressure_atm != 1.0) {
+      warn(l.number, "environment " + format_number(temperature_c) + " C, " + format_number(pressure_atm) +
+                         " atm ignored: indices are computed at 20 C and 1 atm");
+    }
+  }
+
+  void record_unknown(const ZmxLine& l) {
+    const std::string key = shown(l.keyword.text);
+    auto it = unknown_.find(key);
+    if (it != unknown_.end()) {
+      ++it->second.count;
+      return;
+    }
+    if (unknown_.size() >= kMaxUnknownKeywordWarnings) {
+      ++unknown_overflow_;
+      return;
+    }
+    unknown_.emplace(key, UnknownKeyword{l.number, 1});
+  }
+
+  // ---- building the prescription ----------------------------------------------------------------
+
+  double mm(double lens_units) const { return lens_units * mm_per_unit_; }
+
+  MaterialSpec material_for(const GlassRef& g) {
+    const std::string upper = to_upper(g.name);
+    if (upper == "___BLANK") {
+      // A model glass: nd and Vd are the glass (Vd 0 = no dispersion, as in OpticStudio).
+      if (!g.nd || *g.nd < 1.0 || *g.nd > kMaxPlausibleIndex) {
+        fail(g.line, g.column, "GLAS ___BLANK: a model glass needs an nd between 1 and 5 (GLAS ___BLANK solve pickup nd Vd ...)");
+      }
+      if (g.vd && *g.vd < 0.0) fail(g.line, g.column, "GLAS ___BLANK: Vd = " + format_number(*g.vd) + ": must be >= 0");
+      if (g.dpgf != 0.0) note(g.line, "model glass dPgF = " + format_number(g.dpgf) + " ignored");
+      return MaterialSpec::model(*g.nd, g.vd && *g.vd > 0.0 ? g.vd : std::nullopt);
+    }
+    if (upper == "AIR") return MaterialSpec::air();
+    if (const Glass* found = catalogue_.find(g.name, {}, vendor_order_)) {
+      return MaterialSpec::catalog(found->name(), found->vendor());
+    }
+    const bool placeholder = g.nd && g.vd && *g.nd == kPlaceholderNd && *g.vd == kPlaceholderVd;
+    const bool usable_nd = g.nd && *g.nd >= 1.0 && *g.nd <= kMaxPlausibleIndex && !placeholder;
+    if (usable_nd && (!g.vd || *g.vd >= 0.0)) {
+      const std::optional<double> vd = g.vd && *g.vd > 0.0 ? g.vd : std::nullopt;
+      warn(g.line, "glass \"" + g.name + "\" is in no catalogue; using a model glass nd=" + format_number(*g.nd) +
+                       (vd ? " Vd=" + format_number(*vd) : std::string(" without dispersion")) + " from its GLAS line");
+      return MaterialSpec::model(*g.nd, vd);
+    }
+    std::string names;
+    for (const std::string& n : catalogue_.closest_names(g.name)) names += (names.empty() ? "" : ", ") + n;
+    std::string why = placeholder ? "its GLAS line carries only OpticStudio's placeholder nd 1.5 / Vd 40"
+                                  : "its GLAS line gives no usable nd/Vd to fall back on";
+    fail(g.line, g.column, "GLAS: unknown glass \"" + shown(g.name, 64) + "\": in no catalogue and " + why +
+                               "; closest catalogue names: " + (names.empty() ? "(none)" : names));
+  }
+
+  // The line a PrescriptionError is about, from the "surface N: ..." form of its message.
+  int line_for_prescription_message(const std::string& message) const {
+    constexpr std::string_view kSurface = "surface ";
+    if (message.rfind(kSurface, 0) == 0) {
+      auto end = message.find_first_not_of("0123456789", kSurface.size());
+      auto n = parse_integer(std::string_view(message).substr(kSurface.size(), end - kSurface.size()));
+      if (n && *n >= 1 && *n < static_cast<long long>(surfaces_.size())) return surfaces_[static_cast<std::size_t>(*n)].line;
+    }
+    if (message.rfind("aperture", 0) == 0 && aperture_) return aperture_->line;
+    if (message.rfind("field", 0) == 0 && field_type_) return field_type_->line;
+    if (message.rfind("object", 0) == 0) return surfaces_.front().disz_line;
+    return 0;
+  }
+
+  LensReadResult build() {
+    if (surfaces_.empty()) {
+      fail(last_line_, 0, "no SURF lines: not a Zemax sequential lens file, or the file is truncated");
+    }
+    if (surfaces_.size() < 3) {
+      fail(surfaces_.back().line, 0,
+           "a lens needs an object surface (SURF 0), at least one lens surface and an image surface; found " +
+               std::to_string(surfaces_.size()) + " SURF blocks");
+    }
+    for (const ZmxSurface& s : surfaces_) {
+      // OpticStudio writes DISZ for every surface, the image included: a missing one means a
+      // truncated or hand-damaged file, never a default of zero.
+      if (!s.disz && !s.disz_infinite) {
+        fail(s.line, 0, "SURF " + std::to_string(s.number) + " has no DISZ (thickness) line; is the file truncated?");
+      }
+    }
+    LensReadResult result;
+    Prescription& p = result.prescription;
+    p.name = name_;
+    p.notes = std::string(trim_lines(notes_));
+
+    const ZmxSurface& object = surfaces_.front();
+    if (object.stop) fail(object.stop_line, 0, "STOP on the object surface (SURF 0)");
+    if (object.disz_infinite) {
+      p.object_distance_mm = kInfinity;
+    } else {
+      if (*object.disz <= 0.0) {
+        fail(object.disz_line, object.disz_column,
+             "DISZ: object distance = " + format_number(*object.disz) + ": must be > 0 or INFINITY (virtual objects are not supported)");
+      }
+      p.object_distance_mm = mm(*object.disz);
+    }
+    if (object.glass) p.object_material = material_for(*object.glass);
+
+    const ZmxSurface& image = surfaces_.back();
+    if (image.stop) fail(image.stop_line, 0, "STOP on the image surface (SURF " + std::to_string(image.number) + ")");
+    if (image.curvature != 0.0) {
+      warn(image.curv_line, "the image surface is curved (CURV " + format_number(image.curvature) +
+                                "); lensmith models a plane image surface");
+    }
+
+    for (std::size_t k = 1; k + 1 < surfaces_.size(); ++k) p.surfaces.push_back(make_surface(surfaces_[k]));
+
+    set_aperture(p);
+    set_field(p);
+    set_wavelengths(p);
+
+    try {
+      p.resolve_materials(catalogue_);
+    } catch (const GlassError& e) {
+      throw LensFileError(SourceLocation{file_, line_for_prescription_message(e.what()), 0}, e.what());
+    }
+    try {
+      p.validate();
+    } catch (const PrescriptionError& e) {
+      throw LensFileError(SourceLocation{file_, line_for_prescription_message(e.what()), 0}, e.what());
+    }
+    for (const auto& [keyword, u] : unknown_) {
+      warn(u.first_line, "unknown keyword " + keyword + " ignored" +
+                             (u.count > 1 ? " (" + std::to_string(u.count) + " lines)" : std::string()));
+    }
+    if (unknown_overflow_ > 0) {
+      warn(0, std::to_string(unknown_overflow_) + " more lines with unknown keywords ignored");
+    }
+    result.diagnostics = std::move(diagnostics_);
+    return result;
+  }
+
+  Surface make_surface(const ZmxSurface& z) {
+    Surface s;
+    s.curvature_per_mm = z.curvature / mm_per_unit_;
+    if (z.disz_infinite) {
+      fail(z.disz_line, z.disz_column, "DISZ INFINITY on lens surface SURF " + std::to_string(z.number) +
+                                           " (afocal systems are not supported)");
+    }
+    s.thickness_mm = mm(*z.disz);
+    if (z.glass) s.material = material_for(*z.glass);
+    if (z.clap_max) {
+      s.semi_diameter_mm = mm(*z.clap_max);
+    } else if (z.diam && *z.diam > 0.0) {
+      s.semi_diameter_mm = mm(*z.diam);  // DIAM 0 means "not computed": no limit
+    }
+    s.is_stop = z.stop;
+    s.conic = z.conic;
+    for (const ParmRecord& parm : z.parms) {
+      if (parm.value == 0.0) continue;
+      if (z.type != "EVENASPH") {
+        fail(parm.line, parm.column, "PARM " + std::to_string(parm.index) + " = " + format_number(parm.value) +
+                                         " on a STANDARD surface (SURF " + std::to_string(z.number) +
+                                         "): surface parameters need TYPE EVENASPH");
+      }
+      if (parm.index < 1 || parm.index > static_cast<long long>(s.even_asphere.size())) {
+        fail(parm.line, parm.column, "PARM " + std::to_string(parm.index) +
+                                         " is not an even-asphere coefficient (PARM 1..8 hold the r^2..r^16 terms)");
+      }
+      // PARM j is the r^(2j) coefficient, in lens-unit^(1 - 2j).
+      const auto j = static_cast<int>(parm.index);
+      s.even_asphere[static_cast<std::size_t>(j - 1)] = parm.value * std::pow(mm_per_unit_, 1 - 2 * j);
+    }
+    s.comment = z.comment;
+    return s;
+  }
+
+  void set_aperture(Prescription& p) {
+    if (!aperture_) {
+      warn(0, "no aperture keyword (ENPD, FNUM or FLOA); the stop's semi-diameter sets the aperture");
+      p.aperture = ApertureSpec{ApertureSpec::Kind::FloatByStop, 0.0};
+      return;
+    }
+    double value = aperture_->value;
+    if (aperture_->kind == ApertureSpec::Kind::EntrancePupilDiameter) value = mm(value);
+    if (aperture_->kind != ApertureSpec::Kind::FloatByStop && !(value > 0.0)) {
+      fail(aperture_->line, 0, "aperture value = " + format_number(aperture_->value) + ": must be > 0");
+    }
+    p.aperture = ApertureSpec{aperture_->kind, value};
+  }
+
+  void set_field(Prescription& p) {
+    if (y_fields_.empty() && x_fields_.empty()) return;
+    const long long type = field_type_ ? field_type_->type : 0;
+    std::size_t count = std::max(x_fields_.size(), y_fields_.size());
+    if (field_type_ && field_type_->field_count >= 0) {
+      count = static_cast<std::size_t>(field_type_->field_count);
+      if (count > y_fields_.size() || (!x_fields_.empty() && count > x_fields_.size())) {
+        fail(field_type_->line, 0, "FTYP declares " + std::to_string(count) + " fields but XFLN/YFLN list fewer values");
+      }
+    }
+    if (count == 0) return;
+    FieldSpec field;
+    field.kind = type == 0 ? FieldSpec::Kind::AngleDeg
+                           : (type == 1 ? FieldSpec::Kind::ObjectHeightMm : FieldSpec::Kind::ImageHeightMm);
+    bool folded = false;
+    for (std::size_t i = 0; i < count; ++i) {
+      const double y = i < y_fields_.size() ? y_fields_[i].value : 0.0;
+      const double x = i < x_fields_.size() ? x_fields_[i].value : 0.0;
+      double radial = y;
+      if (x != 0.0) {
+        folded = true;
+        // A rotationally symmetric lens sees only the distance of a field point from the axis; for
+        // angles that is the angle whose tangent is the length of (tan x, tan y).
+        radial = type == 0 ? deg_from_rad(std::atan(std::hypot(std::tan(rad_from_deg(x)), std::tan(rad_from_deg(y)))))
+                           : std::hypot(x, y);
+      }
+      field.values.push_back(type == 0 ? radial : mm(radial));
+    }
+    if (folded) {
+      note(y_field_line_, "fields with an x component were folded into radial fields (the lens is rotationally symmetric)");
+    }
+    p.field = std::move(field);
+  }
+
+  void set_wavelengths(Prescription& p) {
+    std::vector<Located> micrometres;
+    if (!wavm_.empty()) {
+      long long count = field_type_ && field_type_->wavelength_count >= 0 ? field_type_->wavelength_count
+                                                                         : static_cast<long long>(wavm_.size());
+      for (int slot = 1; slot <= count; ++slot) {
+        auto it = wavm_.find(slot);
+        if (it == wavm_.end()) {
+          fail(field_type_ ? field_type_->line : 0, 0,
+               "wavelength " + std::to_string(slot) + " is in use but has no WAVM line");
+        }
+        micrometres.push_back(it->second);
+      }
+    } else if (!wavl_.empty()) {
+      micrometres = wavl_;
+      if (field_type_ && field_type_->wavelength_count >= 0) {
+        if (static_cast<std::size_t>(field_type_->wavelength_count) > wavl_.size()) {
+          fail(field_type_->line, 0, "FTYP declares " + std::to_string(field_type_->wavelength_count) +
+                                         " wavelengths but WAVL lists " + std::to_string(wavl_.size()));
+        }
+        micrometres.resize(static_cast<std::size_t>(field_type_->wavelength_count));
+      }
+    }
+    if (micrometres.empty()) {
+      note(0, "no wavelengths in the file; using F, d, C with d primary");
+      return;
+    }
+    p.wavelengths_nm.clear();
+    for (const Located& w : micrometres) {
+      if (!(w.value > 0.0)) fail(w.line, w.column, "wavelength = " + format_number(w.value) + " um: must be > 0");
+      p.wavelengths_nm.push_back(nm_from_um(w.value));
+    }
+    p.primary_wavelength_index = 0;
+    if (primary_) {
+      const auto index = static_cast<std::size_t>(primary_->value);
+      if (index > p.wavelengths_nm.size()) {
+        fail(primary_->line, primary_->column, "PWAV " + std::to_string(index) + ": only " +
+                                                   std::to_string(p.wavelengths_nm.size()) + " wavelengths are in use");
+      }
+      p.primary_wavelength_index = index - 1;
+    }
+  }
+
+  const std::string& file_;
+  const GlassCatalog& catalogue_;
+  Diagnostics diagnostics_;
+  int last_line_ = 0;
+
+  std::vector<ZmxSurface> surfaces_;
+  int stop_line_ = 0;
+  double mm_per_unit_ = 1.0;
+  std::string name_;
+  std::string notes_;
+  std::vector<std::string> vendor_order_;
+  std::optional<ApertureLine> aperture_;
+  std::optional<FieldTypeLine> field_type_;
+  std::vector<Located> x_fields_;
+  std::vector<Located> y_fields_;
+  int y_field_line_ = 0;
+  std::map<int, Located> wavm_;
+  std::vector<Located> wavl_;
+  std::optional<Located> primary_;
+  std::map<std::string, UnknownKeyword> unknown_;
+  std::size_t unknown_overflow_ = 0;
+};
+
+}  // namespace
+
+LensReadResult read_zemax(std::string_view bytes, const std::string& file_name, const GlassCatalog& catalogue) {
+  ZemaxParser parser(file_name, catalogue);
+  return parser.parse(bytes);
+}
+
+}  // namespace lensmith

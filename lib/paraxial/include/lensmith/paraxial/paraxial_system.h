@@ -32,6 +32,7 @@ struct ParaxialRayRow {
 };
 
 struct ParaxialRayTable {
+  double object_distance_mm = kInfinity;  // object plane to surface 1 (+inf = object at infinity)
   double object_slope = 0.0;     // slope in object space
   double object_height_mm = 0.0; // height at the object plane (0 for an object at infinity)
   double y1_mm = 0.0;            // height at surface 1
@@ -130,6 +131,14 @@ class ParaxialSystem {
   std::vector<double> curvatures_;   // paraxial curvature per surface
   std::vector<double> thicknesses_;  // per surface
   std::vector<double> indices_;      // index after each surface at wavelength_nm_
+  double z_front_focal_mm_ = 0.0;     // cardinal points, from the kernel shared with the spectral table
+  double z_rear_focal_mm_ = 0.0;
+  double z_front_principal_mm_ = 0.0;
+  double z_rear_principal_mm_ = 0.0;
+  double z_front_nodal_mm_ = 0.0;
+  double z_rear_nodal_mm_ = 0.0;
+  std::optional<double> stop_semi_diameter_mm_;  // the stop's clear semi-diameter, when given
+  std::string field_description_;    // the maximum field as the prescription states it, for to_string()
 };
 
 }  // namespace lensmith

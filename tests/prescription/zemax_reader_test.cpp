@@ -1,0 +1,534 @@
+// Zemax .zmx reader: one test per rule. The Sasian triplet is checked against its published table
+// (ray-optics docs, SasianTriplet.rst; ../shared/lens-data/REFERENCE-VALUES.md section 2) and
+// Smith's Cooke triplet against Modern Optical Engineering, 4th ed., ch. 6 (section 1 there).
+#include "lensmith/prescription/zemax_reader.h"
+
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "lensmith/core/errors.h"
+#include "lensmith/core/text_file.h"
+
+using Catch::Matchers::Contains;
+using Catch::Matchers::WithinAbs;
+using Catch::Matchers::WithinRel;
+using namespace lensmith;
+
+namespace {
+
+// The test files print 16 significant digits of 1/R; R comes back to a few units in the 15th digit.
+constexpr double kPrintedDigits = 1e-13;
+// Converting inches to millimetres multiplies by 25.4 and powers of it: a few ulps per step.
+constexpr double kUnitConversion = 1e-12;
+
+std::string data_file(const std::string& name) { return std::string(LENSMITH_TEST_DATA_DIR) + "/zemax/" + name; }
+
+LensReadResult read_data(const std::string& name) {
+  const std::string path = data_file(name);
+  return read_zemax(read_file_bytes(path), path);
+}
+
+// A small valid lens in OpticStudio's layout: a stop, an N-BK7 singlet, the image. `system_extra`
+// lines go at the end of the system block, `lens_extra` lines into SURF 2 (the singlet's front).
+std::string mini_zmx(const std::string& system_extra = "", const std::string& lens_extra = "",
+                     const std::string& object_disz = "INFINITY") {
+  return "VERS 190513 80 123457 L123457\n"
+         "MODE SEQ\n"
+         "NAME MINI\n"
+         "UNIT MM X W X CM MR CPMM\n"
+         "ENPD 10\n"
+         "GCAT SCHOTT\n"
+         "FTYP 0 0 2 1 0 0 0\n"
+         "XFLN 0 0 0 0\n"
+         "YFLN 0 5 0 0\n"
+         "WAVM 1 0.5875618 1\n"
+         "WAVM 2 0.55 1\n"
+         "PWAV 1\n" +
+         system_extra +
+         "SURF 0\n"
+         "  TYPE STANDARD\n"
+         "  CURV 0.0 0 0 0 0 \"\"\n"
+         "  DISZ " + object_disz + "\n"
+         "SURF 1\n"
+         "  STOP\n"
+         "  TYPE STANDARD\n"
+         "  CURV 0.0 0 0 0 0 \"\"\n"
+         "  DISZ 2\n"
+         "  DIAM 5 0 0 0 1 \"\"\n"
+         "SURF 2\n"
+         "  TYPE STANDARD\n"
+         "  CURV 0.02 0 0 0 0 \"\"\n"
+         "  DISZ 5\n"
+         "  GLAS N-BK7 0 0 1.5 40 0 0 0 0 0 0\n"
+         "  DIAM 8 1 0 0 1 \"\"\n" +
+         lens_extra +
+         "SURF 3\n"
+         "  TYPE STANDARD\n"
+         "  CURV -0.005 0 0 0 0 \"\"\n"
+         "  DISZ 90\n"
+         "  DIAM 8 1 0 0 1 \"\"\n"
+         "SURF 4\n"
+         "  TYPE STANDARD\n"
+         "  CURV 0.0 0 0 0 0 \"\"\n"
+         "  DISZ 0\n";
+}
+
+// 1-based line of the first occurrence of `needle` in `text`.
+int line_of(const std::string& text, const std::string& needle) {
+  const auto pos = text.find(needle);
+  if (pos == std::string::npos) throw std::logic_error("test text lacks " + needle);
+  int line = 1;
+  for (std::size_t i = 0; i < pos; ++i) line += text[i] == '\n' ? 1 : 0;
+  return line;
+}
+
+LensFileError zemax_error(const std::string& text) {
+  try {
+    read_zemax(text, "t.zmx");
+  } catch (const LensFileError& e) {
+    return e;
+  }
+  FAIL("expected a LensFileError");
+  throw std::logic_error("unreachable");
+}
+
+bool has_diagnostic(const Diagnostics& d, Diagnostic::Severity severity, int line, const std::string& text) {
+  for (const Diagnostic& x : d) {
+    if (x.severity == severity && x.where.line == line && x.message.find(text) != std::string::npos) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+TEST_CASE("Zemax: the Sasian triplet reads surface by surface as published", "[prescription][zemax]") {
+  const LensReadResult r = read_data("sasian_triplet.zmx");
+  const Prescription& p = r.prescription;
+  CHECK(r.diagnostics.empty());
+  CHECK(p.name == "SASIAN TRIPLET");
+  CHECK_THAT(p.notes, Contains("SasianTriplet.rst"));
+  struct Row {
+    double radius_mm, thickness_mm;
+    const char* glass;
+    double semi_diameter_mm;
+  };
+  // ray-optics docs, SasianTriplet.rst (REFERENCE-VALUES.md section 2).
+  const Row published[] = {{23.713, 4.831, "N-LAK9", 10.009},    {7331.288, 5.86, "", 8.9482},
+                           {-24.456, 0.975, "N-SF5", 4.7919},    {21.896, 4.822, "", 4.7761},
+                           {86.759, 3.127, "N-LAK9", 8.0217},    {-20.4942, 41.2365, "", 8.3321}};
+  REQUIRE(p.surfaces.size() == 6);
+  for (std::size_t i = 0; i < 6; ++i) {
+    INFO("surface " << i + 1);
+    const Surface& s = p.surfaces[i];
+    CHECK_THAT(s.radius_mm(), WithinRel(published[i].radius_mm, kPrintedDigits));
+    CHECK(s.thickness_mm == published[i].thickness_mm);
+    CHECK(*s.semi_diameter_mm == published[i].semi_diameter_mm);
+    if (std::string(published[i].glass).empty()) {
+      CHECK(s.material.kind == MaterialSpec::Kind::Air);
+    } else {
+      CHECK(s.material == MaterialSpec::catalog(published[i].glass, "SCHOTT"));
+      CHECK(s.medium.name() == published[i].glass);
+    }
+    CHECK(s.is_stop == (i == 2));
+  }
+  CHECK(std::isinf(p.object_distance_mm));
+  CHECK_FALSE(p.image_at_paraxial_focus);
+  CHECK(p.aperture == ApertureSpec{ApertureSpec::Kind::EntrancePupilDiameter, 12.5});
+  REQUIRE(p.field);
+  CHECK(p.field->kind == FieldSpec::Kind::AngleDeg);
+  CHECK(p.field->values == std::vector<double>{0.0, 14.0, 20.0});
+  REQUIRE(p.wavelengths_nm.size() == 3);
+  CHECK_THAT(p.wavelengths_nm[0], WithinRel(kWavelengthF_nm, 1e-15));
+  CHECK_THAT(p.primary_wavelength_nm(), WithinRel(kWavelengthD_nm, 1e-15));
+  CHECK_THAT(p.wavelengths_nm[2], WithinRel(kWavelengthC_nm, 1e-15));
+}
+
+TEST_CASE("Zemax: a UTF-16LE file with a byte-order mark reads exactly like its UTF-8 copy", "[prescription][zemax]") {
+  const LensReadResult utf8 = read_data("sasian_triplet.zmx");
+  const LensReadResult utf16 = read_data("sasian_triplet_utf16.zmx");
+  CHECK(utf16.prescription == utf8.prescription);
+  CHECK(utf16.diagnostics.size() == utf8.diagnostics.size());
+}
+
+TEST_CASE("Zemax: a UTF-8 byte-order mark is skipped", "[prescription][zemax]") {
+  const std::string plain = mini_zmx();
+  CHECK(read_zemax("\xEF\xBB\xBF" + plain, "t.zmx").prescription == read_zemax(plain, "t.zmx").prescription);
+}
+
+TEST_CASE("Zemax: GLAS ___BLANK is a model glass from the nd and Vd on its line, without a warning",
+          "[prescription][zemax]") {
+  // Smith's Cooke triplet with SK4 (nd 1.61272, dn 0.010450) and SF2 (nd 1.64769, dn 0.019151).
+  const LensReadResult r = read_data("smith_cooke_triplet.zmx");
+  CHECK(r.diagnostics.empty());
+  const Prescription& p = r.prescription;
+  REQUIRE(p.surfaces.size() == 7);
+  const MaterialSpec& sk4 = p.surfaces[0].material;
+  CHECK(sk4.kind == MaterialSpec::Kind::Model);
+  CHECK(sk4.nd == 1.61272);
+  REQUIRE(sk4.vd);
+  CHECK_THAT(*sk4.vd, WithinRel(0.61272 / 0.010450, 1e-15));
+  CHECK_THAT(p.surfaces[0].medium.principal_dispersion(), WithinRel(0.010450, 1e-9));
+  CHECK_THAT(p.surfaces[2].medium.principal_dispersion(), WithinRel(0.019151, 1e-9));
+  CHECK(p.surfaces[4].is_stop);
+  CHECK(p.surfaces[4].is_plane());
+  CHECK(p.surfaces[6].thickness_mm == 77.405);  // Smith's BFL: the last DISZ is the image distance
+}
+
+TEST_CASE("Zemax: GLAS ___BLANK with Vd 0 is an index without dispersion", "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("N-BK7 0 0 1.5 40"), 16, "___BLANK 1 0 1.7 0");
+  const Prescription p = read_zemax(text, "t.zmx").prescription;
+  CHECK(p.surfaces[1].material == MaterialSpec::model(1.7, std::nullopt));
+}
+
+TEST_CASE("Zemax: EVENASPH PARM 1..8 are the r^2..r^16 coefficients, CONI the conic", "[prescription][zemax]") {
+  const Prescription p = read_data("even_asphere_singlet.zmx").prescription;
+  REQUIRE(p.surfaces.size() == 3);
+  const Surface& s = p.surfaces[1];
+  CHECK(s.conic == -0.62);
+  CHECK(s.even_asphere[0] == 2.0e-5);
+  CHECK(s.even_asphere[1] == -1.25e-6);
+  CHECK(s.even_asphere[2] == 3.4e-10);
+  CHECK(s.even_asphere[3] == -2.2e-13);
+  CHECK(s.even_asphere[4] == 0.0);
+  CHECK(s.comment == "aspheric front");
+  CHECK(p.surfaces[0].comment == "stop in front");
+  CHECK_FALSE(p.surfaces[2].has_asphere());
+}
+
+TEST_CASE("Zemax: UNIT IN converts lengths, curvatures and aspheric coefficients to millimetres",
+          "[prescription][zemax]") {
+  const Prescription mm = read_data("even_asphere_singlet.zmx").prescription;
+  const Prescription inch = read_data("even_asphere_singlet_inch.zmx").prescription;
+  REQUIRE(inch.surfaces.size() == mm.surfaces.size());
+  for (std::size_t i = 0; i < mm.surfaces.size(); ++i) {
+    INFO("surface " << i + 1);
+    const Surface& a = inch.surfaces[i];
+    const Surface& b = mm.surfaces[i];
+    CHECK_THAT(a.curvature_per_mm, WithinRel(b.curvature_per_mm, kUnitConversion));
+    CHECK_THAT(a.thickness_mm, WithinRel(b.thickness_mm, kUnitConversion));
+    CHECK_THAT(*a.semi_diameter_mm, WithinRel(*b.semi_diameter_mm, kUnitConversion));
+    for (std::size_t j = 0; j < a.even_asphere.size(); ++j) {
+      INFO("r^" << 2 * (j + 1) << " term");
+      CHECK_THAT(a.even_asphere[j], WithinRel(b.even_asphere[j], kUnitConversion));
+    }
+  }
+  CHECK_THAT(inch.aperture.value, WithinRel(20.0, kUnitConversion));
+  CHECK(inch.field == mm.field);  // angles do not scale
+}
+
+TEST_CASE("Zemax: an unknown UNIT is an error naming it", "[prescription][zemax]") {
+  const std::string text = mini_zmx("UNIT FURLONG\n");
+  const LensFileError e = zemax_error(text);
+  CHECK(e.where().line == line_of(text, "UNIT FURLONG"));
+  CHECK_THAT(e.what(), Contains("FURLONG"));
+}
+
+TEST_CASE("Zemax: TYPE COORDBRK is an error naming the type and its line", "[prescription][zemax]") {
+  const std::string path = data_file("coordbrk.zmx");
+  try {
+    read_zemax(read_file_bytes(path), path);
+    FAIL("expected a LensFileError");
+  } catch (const LensFileError& e) {
+    CHECK(e.where().file == path);
+    CHECK(e.where().line == 16);
+    CHECK_THAT(e.what(), Contains("COORDBRK"));
+  }
+}
+
+TEST_CASE("Zemax: a surface type other than STANDARD and EVENASPH is refused", "[prescription][zemax]") {
+  for (const char* type : {"TOROIDAL", "BICONICX", "PARAXIAL", "GRID_SAG", "XOSPHERE"}) {
+    std::string text = mini_zmx();
+    text.replace(text.find("  TYPE STANDARD\n  CURV 0.02"), 15, std::string("  TYPE ") + type);
+    const LensFileError e = zemax_error(text);
+    CHECK(e.where().line == line_of(text, std::string("TYPE ") + type));
+    CHECK_THAT(e.what(), Contains(type));
+  }
+}
+
+TEST_CASE("Zemax: a glass in no catalogue falls back to the nd/Vd on its GLAS line, with a warning",
+          "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("N-BK7 0 0 1.5 40"), 16, "MYGLASS 0 0 1.62 36.3");
+  const LensReadResult r = read_zemax(text, "t.zmx");
+  CHECK(r.prescription.surfaces[1].material == MaterialSpec::model(1.62, 36.3));
+  CHECK(has_diagnostic(r.diagnostics, Diagnostic::Severity::Warning, line_of(text, "MYGLASS"), "MYGLASS"));
+}
+
+TEST_CASE("Zemax: a glass in no catalogue and without nd on its line is an error listing close names",
+          "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("N-BK7 0 0 1.5 40 0 0 0 0 0 0"), 28, "NBK7");  // newer OpticStudio writes the name only
+  const LensFileError e = zemax_error(text);
+  CHECK(e.where().line == line_of(text, "GLAS NBK7"));
+  CHECK_THAT(e.what(), Contains("NBK7") && Contains("closest catalogue names") && Contains("N-BK7"));
+}
+
+TEST_CASE("Zemax: OpticStudio's placeholder nd 1.5 / Vd 40 never stands in for an unknown glass",
+          "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("N-BK7 0 0 1.5 40"), 16, "SILICA 0 0 1.5 40");
+  const LensFileError e = zemax_error(text);
+  CHECK(e.where().line == line_of(text, "GLAS SILICA"));
+  CHECK_THAT(e.what(), Contains("SILICA") && Contains("placeholder"));
+}
+
+TEST_CASE("Zemax: GCAT sets the vendor searched first", "[prescription][zemax]") {
+  // BAF10 is in both the HOYA and the HIKARI catalogue.
+  std::string text = mini_zmx();
+  text.replace(text.find("GCAT SCHOTT"), 11, "GCAT HIKARI_2019 MISC");
+  text.replace(text.find("N-BK7 0 0 1.5 40"), 16, "BAF10 0 0 1.5 40");
+  const Prescription p = read_zemax(text, "t.zmx").prescription;
+  CHECK(p.surfaces[1].material == MaterialSpec::catalog("BAF10", "HIKARI"));
+}
+
+TEST_CASE("Zemax: GLAS MIRROR is an error (mirrors are not supported)", "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("N-BK7 0 0 1.5 40"), 16, "MIRROR 0 0 1.5 40");
+  const LensFileError e = zemax_error(text);
+  CHECK(e.where().line == line_of(text, "GLAS MIRROR"));
+  CHECK_THAT(e.what(), Contains("mirror"));
+}
+
+TEST_CASE("Zemax: MIRR (the mirror substrate drawn) alone does not make a mirror", "[prescription][zemax]") {
+  const LensReadResult r = read_zemax(mini_zmx("", "  MIRR 2 0\n"), "t.zmx");
+  CHECK(r.diagnostics.empty());
+}
+
+TEST_CASE("Zemax: a surface without GLAS is air, and GLAS on SURF 0 is the object medium", "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("  DISZ INFINITY\n"), 16, "  DISZ 100\n  GLAS ___BLANK 1 0 1.333 55.8\n");
+  const Prescription p = read_zemax(text, "t.zmx").prescription;
+  CHECK(p.surfaces[0].material.kind == MaterialSpec::Kind::Air);
+  CHECK(p.surfaces[2].material.kind == MaterialSpec::Kind::Air);
+  CHECK(p.object_material == MaterialSpec::model(1.333, 55.8));
+}
+
+TEST_CASE("Zemax: DISZ on SURF 0 is the object distance, INFINITY an object at infinity", "[prescription][zemax]") {
+  CHECK(std::isinf(read_zemax(mini_zmx(), "t.zmx").prescription.object_distance_mm));
+  CHECK(read_zemax(mini_zmx("", "", "250"), "t.zmx").prescription.object_distance_mm == 250.0);
+}
+
+TEST_CASE("Zemax: a negative object distance is an error", "[prescription][zemax]") {
+  const std::string text = mini_zmx("", "", "-50");
+  const LensFileError e = zemax_error(text);
+  CHECK(e.where().line == line_of(text, "DISZ -50"));
+}
+
+TEST_CASE("Zemax: PWAV picks the primary wavelength, counting from 1", "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("FTYP 0 0 2 1"), 12, "FTYP 0 0 2 2");
+  text.replace(text.find("PWAV 1"), 6, "PWAV 2");
+  const Prescription p = read_zemax(text, "t.zmx").prescription;
+  REQUIRE(p.wavelengths_nm.size() == 2);
+  CHECK(p.primary_wavelength_index == 1);
+  CHECK_THAT(p.primary_wavelength_nm(), WithinRel(550.0, 1e-15));
+}
+
+TEST_CASE("Zemax: PWAV beyond the wavelengths in use is an error", "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("PWAV 1"), 6, "PWAV 2");  // FTYP says one wavelength is in use
+  const LensFileError e = zemax_error(text);
+  CHECK(e.where().line == line_of(text, "PWAV 2"));
+}
+
+TEST_CASE("Zemax: old-style WAVL lists the wavelengths in micrometres", "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("WAVM 1 0.5875618 1\nWAVM 2 0.55 1\n"), 33, "WAVL 0.4861327 0.5875618 0.6562725\nWWGT 1 1 1\n");
+  text.replace(text.find("FTYP 0 0 2 1"), 12, "FTYP 0 0 2 3");
+  text.replace(text.find("PWAV 1"), 6, "PWAV 2");
+  const Prescription p = read_zemax(text, "t.zmx").prescription;
+  REQUIRE(p.wavelengths_nm.size() == 3);
+  CHECK_THAT(p.primary_wavelength_nm(), WithinRel(kWavelengthD_nm, 1e-15));
+}
+
+TEST_CASE("Zemax: FTYP 1 gives an object-height field, converted with the lens unit", "[prescription][zemax]") {
+  std::string text = mini_zmx("", "", "400");
+  text.replace(text.find("FTYP 0"), 6, "FTYP 1");
+  text.replace(text.find("UNIT MM"), 7, "UNIT CM");
+  const Prescription p = read_zemax(text, "t.zmx").prescription;
+  REQUIRE(p.field);
+  CHECK(p.field->kind == FieldSpec::Kind::ObjectHeightMm);
+  CHECK(p.field->values == std::vector<double>{0.0, 50.0});
+  CHECK(p.object_distance_mm == 4000.0);
+}
+
+TEST_CASE("Zemax: FTYP 2 gives a paraxial image-height field", "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("FTYP 0"), 6, "FTYP 2");
+  const Prescription p = read_zemax(text, "t.zmx").prescription;
+  CHECK(p.field->kind == FieldSpec::Kind::ImageHeightMm);
+}
+
+TEST_CASE("Zemax: real image height fields (FTYP 3) are refused", "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("FTYP 0"), 6, "FTYP 3");
+  const LensFileError e = zemax_error(text);
+  CHECK(e.where().line == line_of(text, "FTYP 3"));
+  CHECK_THAT(e.what(), Contains("real image height"));
+}
+
+TEST_CASE("Zemax: an object-space telecentric system is refused", "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("FTYP 0 0"), 8, "FTYP 0 1");
+  CHECK_THAT(zemax_error(text).what(), Contains("telecentric"));
+}
+
+TEST_CASE("Zemax: XFLN components fold into radial fields with a note", "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("FTYP 0"), 6, "FTYP 2");
+  text.replace(text.find("XFLN 0 0"), 8, "XFLN 0 3");
+  text.replace(text.find("YFLN 0 5"), 8, "YFLN 0 4");
+  const LensReadResult r = read_zemax(text, "t.zmx");
+  CHECK(r.prescription.field->values == std::vector<double>{0.0, 5.0});
+  CHECK(has_diagnostic(r.diagnostics, Diagnostic::Severity::Note, line_of(text, "YFLN"), "radial"));
+}
+
+TEST_CASE("Zemax: x and y field angles fold into the angle whose tangent is their tangents' length",
+          "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("XFLN 0 0"), 8, "XFLN 0 10");
+  text.replace(text.find("YFLN 0 5"), 8, "YFLN 0 10");
+  const Prescription p = read_zemax(text, "t.zmx").prescription;
+  const double expected = deg_from_rad(std::atan(std::sqrt(2.0) * std::tan(rad_from_deg(10.0))));
+  CHECK_THAT(p.field->values[1], WithinRel(expected, 1e-14));
+}
+
+TEST_CASE("Zemax: ENPD is the entrance-pupil diameter, FNUM an image-space F/#, FLOA floats by the stop",
+          "[prescription][zemax]") {
+  CHECK(read_zemax(mini_zmx(), "t.zmx").prescription.aperture ==
+        ApertureSpec{ApertureSpec::Kind::EntrancePupilDiameter, 10.0});
+  std::string fnum = mini_zmx();
+  fnum.replace(fnum.find("ENPD 10"), 7, "FNUM 4.5 0");
+  CHECK(read_zemax(fnum, "t.zmx").prescription.aperture == ApertureSpec{ApertureSpec::Kind::ImageSpaceFNumber, 4.5});
+  std::string floa = mini_zmx();
+  floa.replace(floa.find("ENPD 10"), 7, "FLOA");
+  CHECK(read_zemax(floa, "t.zmx").prescription.aperture.kind == ApertureSpec::Kind::FloatByStop);
+}
+
+TEST_CASE("Zemax: paraxial working F/# and object-space NA apertures are refused", "[prescription][zemax]") {
+  std::string working = mini_zmx();
+  working.replace(working.find("ENPD 10"), 7, "FNUM 4.5 1");
+  CHECK(zemax_error(working).where().line == line_of(working, "FNUM"));
+  std::string na = mini_zmx();
+  na.replace(na.find("ENPD 10"), 7, "OBNA 1.5E-1 0");
+  CHECK_THAT(zemax_error(na).what(), Contains("NA"));
+}
+
+TEST_CASE("Zemax: CLAP's maximum radius is the semi-diameter, over DIAM", "[prescription][zemax]") {
+  const Prescription p = read_zemax(mini_zmx("", "  CLAP 0 6.5 0\n"), "t.zmx").prescription;
+  CHECK(*p.surfaces[1].semi_diameter_mm == 6.5);
+  CHECK(*p.surfaces[2].semi_diameter_mm == 8.0);
+}
+
+TEST_CASE("Zemax: DIAM 0 leaves a surface unlimited", "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("  DIAM 8 1 0 0 1 \"\"\nSURF 3"), 19, "  DIAM 0 0 0 0 1 \"\"");
+  CHECK_FALSE(read_zemax(text, "t.zmx").prescription.surfaces[1].semi_diameter_mm);
+}
+
+TEST_CASE("Zemax: obscurations and non-circular apertures are refused", "[prescription][zemax]") {
+  for (const char* line : {"  OBSC 0 2.5 0\n", "  SQAP 3 3 0\n", "  ELAP 3 2 0\n", "  CLAP 1 6 0\n"}) {
+    const std::string text = mini_zmx("", line);
+    INFO(line);
+    CHECK(zemax_error(text).where().line == line_of(text, line));
+  }
+}
+
+TEST_CASE("Zemax: decentres and tilts are refused unless zero", "[prescription][zemax]") {
+  const std::string tilted = mini_zmx("", "  SCBD 1 0 0 0.0 0.0 90 0 0\n");
+  CHECK(zemax_error(tilted).where().line == line_of(tilted, "SCBD"));
+  CHECK_NOTHROW(read_zemax(mini_zmx("", "  SCBD 1 0 0 0 0 0 0 0\n"), "t.zmx"));
+  const std::string decentred = mini_zmx("", "  OBDC 0.000000000000E+00 1.906000000000E+02\n");
+  CHECK(zemax_error(decentred).where().line == line_of(decentred, "OBDC"));
+}
+
+TEST_CASE("Zemax: PARM with a non-zero value on a STANDARD surface is an error", "[prescription][zemax]") {
+  const std::string text = mini_zmx("", "  PARM 2 1.0E-6\n");
+  const LensFileError e = zemax_error(text);
+  CHECK(e.where().line == line_of(text, "PARM 2"));
+  CHECK_THAT(e.what(), Contains("EVENASPH"));
+  CHECK_NOTHROW(read_zemax(mini_zmx("", "  PARM 2 0\n"), "t.zmx"));
+}
+
+TEST_CASE("Zemax: MODE NSC is refused", "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("MODE SEQ"), 8, "MODE NSC");
+  CHECK(zemax_error(text).where().line == 2);
+}
+
+TEST_CASE("Zemax: an unknown keyword is a warning naming it and its line, and the file still reads",
+          "[prescription][zemax]") {
+  const std::string text = mini_zmx("FROB 1 2 3\nFROB 4\n");
+  const LensReadResult r = read_zemax(text, "t.zmx");
+  REQUIRE(r.diagnostics.size() == 1);
+  CHECK(has_diagnostic(r.diagnostics, Diagnostic::Severity::Warning, line_of(text, "FROB"), "FROB"));
+}
+
+TEST_CASE("Zemax: a curved image surface is a warning", "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  const auto image = text.find("SURF 4");
+  text.replace(text.find("CURV 0.0", image), 8, "CURV -0.01");
+  const LensReadResult r = read_zemax(text, "t.zmx");
+  CHECK(has_diagnostic(r.diagnostics, Diagnostic::Severity::Warning, line_of(text, "CURV -0.01"), "curved"));
+}
+
+TEST_CASE("Zemax: NOTE lines join into the notes; NOTE 0 pieces continue the same line", "[prescription][zemax]") {
+  const std::string text = mini_zmx("NOTE 0 first half of a long li\nNOTE 0 ne\nNOTE 4\nNOTE 0 second line\nNOTE 4\n");
+  CHECK(read_zemax(text, "t.zmx").prescription.notes == "first half of a long line\nsecond line");
+}
+
+TEST_CASE("Zemax: numbers such as 1.#INF, nan and 1e999 are errors naming their line", "[prescription][zemax]") {
+  for (const char* bad : {"1.#INF", "nan", "inf", "1e999", "0x1p3", "4.2E"}) {
+    std::string text = mini_zmx();
+    text.replace(text.find("CURV 0.02"), 9, std::string("CURV ") + bad);
+    INFO(bad);
+    const LensFileError e = zemax_error(text);
+    CHECK(e.where().line == line_of(text, std::string("CURV ") + bad));
+    CHECK(e.where().column == 8);
+  }
+}
+
+TEST_CASE("Zemax: DISZ INFINITY on a lens surface is an error", "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("DISZ 90"), 7, "DISZ INFINITY");
+  CHECK(zemax_error(text).where().line == line_of(text, "DISZ INFINITY\n  DIAM 8"));
+}
+
+TEST_CASE("Zemax: a second STOP is an error", "[prescription][zemax]") {
+  const std::string text = mini_zmx("", "  STOP\n");
+  CHECK(zemax_error(text).where().line == line_of(text, "  STOP\nSURF 3"));
+}
+
+TEST_CASE("Zemax: SURF blocks out of order are an error, and huge surface numbers are refused",
+          "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("SURF 3"), 6, "SURF 7");
+  CHECK(zemax_error(text).where().line == line_of(text, "SURF 7"));
+  CHECK_THAT(zemax_error("SURF 0\nSURF 99999999999\n").what(), Contains("surface number"));
+}
+
+TEST_CASE("Zemax: a truncated file is an error", "[prescription][zemax]") {
+  const std::string path = data_file("truncated.zmx");
+  try {
+    read_zemax(read_file_bytes(path), path);
+    FAIL("expected a LensFileError");
+  } catch (const LensFileError& e) {
+    CHECK_THAT(e.what(), Contains("truncated"));
+    CHECK(e.where().line > 0);
+  }
+}
+
+TEST_CASE("Zemax: binary garbage and empty files are errors, not crashes", "[prescription][zemax]") {
+  const std::string garbage("\x89PNG\r\n\x1a\n\0\0\0\rIHDR", 16);
+  CHECK_THROWS_AS(read_zemax(garbage, "g.zmx"), LensFileError);
+  CHECK_THROWS_AS(read_zemax("", "e.zmx"), LensFileError);
+  CHECK_THROWS_AS(read_zemax("\xFF\xFE", "bom-only.zmx"), LensFileError);
+  CHECK_THROWS_AS(read_zemax(std::string(100000, 'A'), "long.zmx"), LensFileError);
+}
+
+TEST_CASE("Zemax: a file needs an object, a lens surface and an image surface", "[prescription][zemax]") {
+  CHECK_THAT(zemax_error("SURF 0\n  DISZ INFINITY\nSURF 1\n  DISZ 0\n").what(), Contains("at least one lens surface"));
+}
