@@ -9,10 +9,13 @@
 #include "lensmith/core/errors.h"
 #include "lensmith/glass/glass_catalog.h"
 #include "lensmith/paraxial/paraxial_system.h"
+#include "reference_lenses.h"
 
 using Catch::Matchers::WithinAbs;
 using Catch::Matchers::WithinRel;
 using namespace lensmith;
+using lensmith::testing::make_surface;
+using lensmith::testing::sasian_triplet;
 
 namespace {
 
@@ -21,34 +24,6 @@ constexpr double kSameKernel = 1e-12;
 // Linear interpolation over 6.35 nm steps of a smooth dispersion curve: the error is h^2/8 times
 // the curvature of EFL(lambda), about 1e-7 relative for these glasses; allow 100 times that.
 constexpr double kInterpolation = 1e-5;
-
-Surface make_surface(double radius_mm, double thickness_mm, const MaterialSpec& material,
-                     std::optional<double> semi_diameter_mm = {}) {
-  Surface s;
-  s.curvature_per_mm = std::isinf(radius_mm) ? 0.0 : 1.0 / radius_mm;
-  s.thickness_mm = thickness_mm;
-  s.material = material;
-  s.medium = material.resolve(GlassCatalog::builtin());
-  s.semi_diameter_mm = semi_diameter_mm;
-  return s;
-}
-
-// Sasian triplet (ray-optics docs, SasianTriplet.rst), Schott N-LAK9 and N-SF5.
-Prescription sasian_triplet() {
-  const MaterialSpec lak9 = MaterialSpec::catalog("N-LAK9", "SCHOTT");
-  const MaterialSpec sf5 = MaterialSpec::catalog("N-SF5", "SCHOTT");
-  const MaterialSpec air = MaterialSpec::air();
-  Prescription p;
-  p.surfaces = {
-      make_surface(23.713, 4.831, lak9, 10.009),  make_surface(7331.288, 5.86, air, 8.9482),
-      make_surface(-24.456, 0.975, sf5, 4.7919),  make_surface(21.896, 4.822, air, 4.7761),
-      make_surface(86.759, 3.127, lak9, 8.0217),  make_surface(-20.4942, 41.2365, air, 8.3321),
-  };
-  p.surfaces[2].is_stop = true;
-  p.aperture = ApertureSpec{ApertureSpec::Kind::EntrancePupilDiameter, 12.5};
-  p.field = FieldSpec{FieldSpec::Kind::AngleDeg, {20.0}};
-  return p;
-}
 
 // Biconvex singlet in air, first surface as stop.
 Prescription singlet(const MaterialSpec& glass) {

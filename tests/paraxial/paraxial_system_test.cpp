@@ -10,10 +10,14 @@
 
 #include "lensmith/core/errors.h"
 #include "lensmith/glass/glass_catalog.h"
+#include "reference_lenses.h"
 
 using Catch::Matchers::WithinAbs;
 using Catch::Matchers::WithinRel;
 using namespace lensmith;
+using lensmith::testing::make_surface;
+using lensmith::testing::sasian_triplet;
+using lensmith::testing::smith_cooke_triplet;
 
 namespace {
 
@@ -31,62 +35,6 @@ constexpr double kSmithImageRounding = 1e-4;
 constexpr double kSmithSlopeRounding = 2e-6;
 // Smith prints EFL and BFL with 3 decimals.
 constexpr double kSmithThreeDecimals = 5e-4;
-
-Surface make_surface(double radius_mm, double thickness_mm, const MaterialSpec& material,
-                     std::optional<double> semi_diameter_mm = {}) {
-  Surface s;
-  s.curvature_per_mm = std::isinf(radius_mm) ? 0.0 : 1.0 / radius_mm;
-  s.thickness_mm = thickness_mm;
-  s.material = material;
-  s.medium = material.resolve(GlassCatalog::builtin());
-  s.semi_diameter_mm = semi_diameter_mm;
-  return s;
-}
-
-// Model glass from Smith's n_d and delta n = n_F - n_C (Vd = (n_d - 1) / delta n).
-MaterialSpec smith_glass(double nd, double delta_n) { return MaterialSpec::model(nd, (nd - 1.0) / delta_n); }
-
-// W. J. Smith, Modern Optical Engineering, 4th ed., ch. 6 (REFERENCE-VALUES.md section 1).
-Prescription smith_cooke_triplet() {
-  const MaterialSpec sk4 = smith_glass(1.61272, 0.010450);
-  const MaterialSpec sf2 = smith_glass(1.64769, 0.019151);
-  const MaterialSpec air = MaterialSpec::air();
-  Prescription p;
-  p.name = "Smith Cooke triplet";
-  p.source = "W. J. Smith, Modern Optical Engineering, 4th ed., ch. 6";
-  p.surfaces = {
-      make_surface(37.40, 5.90, sk4, 14.7),     make_surface(-341.48, 12.93, air, 14.7),
-      make_surface(-42.65, 2.50, sf2, 10.8),    make_surface(36.40, 2.00, air, 10.8),
-      make_surface(kInfinity, 9.85, air, 10.3), make_surface(204.52, 5.90, sk4, 11.6),
-      make_surface(-37.05, 77.405, air, 11.6),
-  };
-  p.surfaces[4].is_stop = true;
-  p.image_at_paraxial_focus = true;
-  p.aperture = ApertureSpec{ApertureSpec::Kind::EntrancePupilDiameter, 29.2};
-  p.field = FieldSpec{FieldSpec::Kind::AngleDeg, {deg_from_rad(std::atan(0.21))}};
-  return p;
-}
-
-// Sasian triplet, ray-optics docs/source/examples/SasianTriplet (REFERENCE-VALUES.md section 2).
-Prescription sasian_triplet() {
-  const MaterialSpec lak9 = MaterialSpec::catalog("N-LAK9", "SCHOTT");
-  const MaterialSpec sf5 = MaterialSpec::catalog("N-SF5", "SCHOTT");
-  const MaterialSpec air = MaterialSpec::air();
-  Prescription p;
-  p.name = "Sasian triplet";
-  p.source = "ray-optics documentation, SasianTriplet.rst";
-  p.surfaces = {
-      make_surface(23.713, 4.831, lak9, 10.009),  make_surface(7331.288, 5.86, air, 8.9482),
-      make_surface(-24.456, 0.975, sf5, 4.7919),  make_surface(21.896, 4.822, air, 4.7761),
-      make_surface(86.759, 3.127, lak9, 8.0217),  make_surface(-20.4942, 41.2365, air, 8.3321),
-  };
-  p.surfaces[2].is_stop = true;
-  p.aperture = ApertureSpec{ApertureSpec::Kind::EntrancePupilDiameter, 12.5};
-  p.field = FieldSpec{FieldSpec::Kind::AngleDeg, {0.0, 14.0, 20.0}};
-  p.wavelengths_nm = {486.1327, 587.5618, 656.2725};
-  p.primary_wavelength_index = 1;
-  return p;
-}
 
 // A lens in air with the first surface as stop, EPD 10 mm, object at infinity.
 Prescription lens_in_air(std::vector<Surface> surfaces) {

@@ -199,8 +199,9 @@ TEST_CASE("lentil: a zoom thickness list is an error naming the element", "[pres
 }
 
 TEST_CASE("lentil: a glass in no catalogue without an ior is an error listing close names", "[prescription][lentil]") {
-  const LensFileError e = lentil_error(tiny_database(glass_element("NBK7", "null", "null")), "0100");
-  CHECK_THAT(e.what(), Contains("NBK7") && Contains("N-BK7"));
+  const LensFileError e = lentil_error(tiny_database(glass_element("NBK8", "null", "null")), "0100");
+  CHECK_THAT(e.what(), Contains("NBK8") && Contains("closest catalogue names") && Contains("N-BK7"));
+  CHECK(e.where().line == 6);
 }
 
 TEST_CASE("lentil: a catalogue glass with a null ior is used as is", "[prescription][lentil]") {

@@ -162,12 +162,14 @@ TEST_CASE("pbrt: a row without exactly 4 columns is an error naming its line", "
 }
 
 TEST_CASE("pbrt: a value that is not a finite number is an error naming line and column", "[prescription][pbrt]") {
-  for (const char* bad : {"abc", "nan", "1.#INF", "inf", "1e999", "5,0"}) {
+  for (const char* bad : {"abc", "nan", "inf", "1e999", "5,0", "0x1p3"}) {
     INFO(bad);
     const LensFileError e = pbrt_error(std::string("50 5 1.6 20\n0 ") + bad + " 0 16\n-80 0 1 20\n");
     CHECK(e.where().line == 2);
     CHECK(e.where().column == 3);
   }
+  // '#' starts a comment anywhere in a pbrt file, so "1.#INF" leaves a row of two numbers.
+  CHECK(pbrt_error("50 5 1.6 20\n0 1.#INF 0 16\n-80 0 1 20\n").where().line == 2);
 }
 
 TEST_CASE("pbrt: two stop rows are an error naming the second", "[prescription][pbrt]") {

@@ -215,6 +215,14 @@ class LentilEntryReader {
     const double housing = finite_number(e, "housing-radius");
     if (!(housing > 0.0)) e.fail("housing-radius", "housing-radius = " + format_number(housing) + ": must be > 0");
     s.semi_diameter_mm = housing;
+    // Some entries give a housing wider than the sphere itself (0015: radius 0.8146, housing 0.82).
+    // No ray can pass beyond |R|, so lentil's own tracer loses nothing when the aperture stops there.
+    if (s.curvature_per_mm != 0.0 && housing > 1.0 / std::abs(s.curvature_per_mm)) {
+      const double limit = 1.0 / std::abs(s.curvature_per_mm);
+      warn(e, "housing-radius", "housing-radius " + format_number(housing) + " exceeds |radius| " +
+                                    format_number(limit) + "; the clear semi-diameter is limited to |radius|");
+      s.semi_diameter_mm = limit;
+    }
 
     const std::optional<double> ior = number_or_null(e, "ior");
     const std::optional<double> abbe = number_or_null(e, "abbe");
