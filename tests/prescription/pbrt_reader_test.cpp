@@ -52,8 +52,9 @@ TEST_CASE("pbrt: every unscaled file read with the Auto rule is its scaled count
     double factor;
     const char* scaled;
   };
-  for (const Pair& pair : {Pair{"dgauss.dat", 0.5, "dgauss.50mm.dat"}, Pair{"telephoto.dat", 2.5, "telephoto.250mm.dat"},
-                           Pair{"fisheye.dat", 0.1, "fisheye.10mm.dat"}, Pair{"wide.dat", 0.22, "wide.22mm.dat"}}) {
+  for (const Pair& pair :
+       {Pair{"dgauss.dat", 0.5, "dgauss.50mm.dat"}, Pair{"telephoto.dat", 2.5, "telephoto.250mm.dat"},
+        Pair{"fisheye.dat", 0.1, "fisheye.10mm.dat"}, Pair{"wide.dat", 0.22, "wide.22mm.dat"}}) {
     INFO(pair.unscaled << " x " << pair.factor << " vs " << pair.scaled);
     const Prescription a = read_data(pair.unscaled).prescription.scaled(pair.factor);
     const Prescription b = read_data(pair.scaled).prescription;
@@ -94,9 +95,9 @@ TEST_CASE("pbrt: the unscaled file's second column is the separation from the pr
           "[prescription][pbrt]") {
   const Prescription p = read_data("dgauss.dat").prescription;
   REQUIRE(p.surfaces.size() == 11);
-  CHECK(p.surfaces[0].thickness_mm == 7.52);   // row 2's column
-  CHECK(p.surfaces[9].thickness_mm == 6.44);   // row 11's column
-  CHECK(p.surfaces[10].thickness_mm == 0.0);   // unknown: the image goes to the paraxial focus
+  CHECK(p.surfaces[0].thickness_mm == 7.52);  // row 2's column
+  CHECK(p.surfaces[9].thickness_mm == 6.44);  // row 11's column
+  CHECK(p.surfaces[10].thickness_mm == 0.0);  // unknown: the image goes to the paraxial focus
 }
 
 TEST_CASE("pbrt: the image is at the paraxial focus, the aperture floats by the stop, the object is at infinity",
@@ -195,10 +196,22 @@ TEST_CASE("pbrt: a negative thickness or a non-positive diameter is an error", "
 TEST_CASE("pbrt: empty files, comment-only files and binary data are errors", "[prescription][pbrt]") {
   CHECK_THROWS_AS(read_pbrt("", "e.dat"), LensFileError);
   CHECK_THROWS_AS(read_pbrt("# only a comment\n\n", "c.dat"), LensFileError);
-  CHECK_THROWS_AS(read_pbrt(std::string("\x7f" "ELF\0\0\0", 7), "b.dat"), LensFileError);
+  CHECK_THROWS_AS(read_pbrt(std::string("\x7f"
+                                        "ELF\0\0\0",
+                                        7),
+                            "b.dat"),
+                  LensFileError);
 }
 
 TEST_CASE("pbrt: comments after the numbers and CRLF line ends are fine", "[prescription][pbrt]") {
   const Prescription p = read_pbrt("50 5 1.6 20 # front\r\n0 3 0 16\r\n-80 0 1 20\r\n", "t.dat").prescription;
   CHECK(p.surfaces.size() == 3);
+}
+
+TEST_CASE("pbrt: a file without header comments is named after the file", "[prescription][pbrt]") {
+  CHECK(read_pbrt("50 5 1.6 20\n0 3 0 16\n-80 0 1 20\n", "lenses/tessar.dat").prescription.name == "tessar");
+}
+
+TEST_CASE("pbrt: a UTF-8 byte-order mark is skipped", "[prescription][pbrt]") {
+  CHECK(read_pbrt("\xEF\xBB\xBF" + kSmallLens, "t.dat").prescription == read_pbrt(kSmallLens, "t.dat").prescription);
 }

@@ -32,6 +32,7 @@ LensReadResult read_data(const std::string& name) {
 
 // A small valid lens in OpticStudio's layout: a stop, an N-BK7 singlet, the image. `system_extra`
 // lines go at the end of the system block, `lens_extra` lines into SURF 2 (the singlet's front).
+// clang-format off
 std::string mini_zmx(const std::string& system_extra = "", const std::string& lens_extra = "",
                      const std::string& object_disz = "INFINITY") {
   return "VERS 190513 80 123457 L123457\n"
@@ -74,6 +75,7 @@ std::string mini_zmx(const std::string& system_extra = "", const std::string& le
          "  CURV 0.0 0 0 0 0 \"\"\n"
          "  DISZ 0\n";
 }
+// clang-format on
 
 // 1-based line of the first occurrence of `needle` in `text`.
 int line_of(const std::string& text, const std::string& needle) {
@@ -115,9 +117,9 @@ TEST_CASE("Zemax: the Sasian triplet reads surface by surface as published", "[p
     double semi_diameter_mm;
   };
   // ray-optics docs, SasianTriplet.rst (REFERENCE-VALUES.md section 2).
-  const Row published[] = {{23.713, 4.831, "N-LAK9", 10.009},    {7331.288, 5.86, "", 8.9482},
-                           {-24.456, 0.975, "N-SF5", 4.7919},    {21.896, 4.822, "", 4.7761},
-                           {86.759, 3.127, "N-LAK9", 8.0217},    {-20.4942, 41.2365, "", 8.3321}};
+  const Row published[] = {{23.713, 4.831, "N-LAK9", 10.009}, {7331.288, 5.86, "", 8.9482},
+                           {-24.456, 0.975, "N-SF5", 4.7919}, {21.896, 4.822, "", 4.7761},
+                           {86.759, 3.127, "N-LAK9", 8.0217}, {-20.4942, 41.2365, "", 8.3321}};
   REQUIRE(p.surfaces.size() == 6);
   for (std::size_t i = 0; i < 6; ++i) {
     INFO("surface " << i + 1);
@@ -336,7 +338,8 @@ TEST_CASE("Zemax: PWAV beyond the wavelengths in use is an error", "[prescriptio
 
 TEST_CASE("Zemax: old-style WAVL lists the wavelengths in micrometres", "[prescription][zemax]") {
   std::string text = mini_zmx();
-  text.replace(text.find("WAVM 1 0.5875618 1\nWAVM 2 0.55 1\n"), 33, "WAVL 0.4861327 0.5875618 0.6562725\nWWGT 1 1 1\n");
+  text.replace(text.find("WAVM 1 0.5875618 1\nWAVM 2 0.55 1\n"), 33,
+               "WAVL 0.4861327 0.5875618 0.6562725\nWWGT 1 1 1\n");
   text.replace(text.find("FTYP 0 0 2 1"), 12, "FTYP 0 0 2 3");
   text.replace(text.find("PWAV 1"), 6, "PWAV 2");
   const Prescription p = read_zemax(text, "t.zmx").prescription;
@@ -531,4 +534,25 @@ TEST_CASE("Zemax: binary garbage and empty files are errors, not crashes", "[pre
 
 TEST_CASE("Zemax: a file needs an object, a lens surface and an image surface", "[prescription][zemax]") {
   CHECK_THAT(zemax_error("SURF 0\n  DISZ INFINITY\nSURF 1\n  DISZ 0\n").what(), Contains("at least one lens surface"));
+}
+
+TEST_CASE("Zemax: a wavelength used twice is an error naming its WAVM line", "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("FTYP 0 0 2 1"), 12, "FTYP 0 0 2 2");
+  text.replace(text.find("WAVM 2 0.55 1"), 13, "WAVM 2 0.5875618 1");
+  const LensFileError e = zemax_error(text);
+  CHECK(e.where().line == line_of(text, "WAVM 2"));
+  CHECK_THAT(e.what(), Contains("twice"));
+}
+
+TEST_CASE("Zemax: a blank NAME gives the lens the file's name", "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("NAME MINI"), 9, "NAME ");
+  CHECK(read_zemax(text, "lenses/US8427765.zmx").prescription.name == "US8427765");
+}
+
+TEST_CASE("Zemax: extra surface data (XDAT) is refused unless its value is zero", "[prescription][zemax]") {
+  CHECK_NOTHROW(read_zemax(mini_zmx("", "  XDAT 1 0 0 0\n"), "t.zmx"));
+  const std::string text = mini_zmx("", "  XDAT 3 2.5E-3 0 0\n");
+  CHECK(zemax_error(text).where().column == 10);
 }

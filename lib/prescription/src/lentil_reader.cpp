@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include "lensmith/core/errors.h"
@@ -31,8 +32,8 @@ constexpr std::size_t kMaxElements = 10000;
 constexpr std::size_t kMaxListedIds = 50;
 constexpr std::size_t kAsphericTerms = 4;  // a4, a6, a8, a10
 
-const std::vector<std::string> kElementKeys = {"radius", "thickness", "material", "ior", "abbe",
-                                               "housing-radius", "lens-geometry", "aspherical-equation"};
+const std::vector<std::string> kElementKeys = {"radius", "thickness",      "material",      "ior",
+                                               "abbe",   "housing-radius", "lens-geometry", "aspherical-equation"};
 
 std::string to_lower(std::string_view s) {
   std::string out(s);
@@ -94,8 +95,8 @@ std::string year_text(double year) {
 
 const json& entries_object(const LocatedJson& doc) {
   if (!doc.root().is_object()) {
-    throw LensFileError(doc.where(""), "expected a JSON object of lens entries keyed by id, got " +
-                                           json_type_phrase(doc.root()));
+    throw LensFileError(doc.where(""),
+                        "expected a JSON object of lens entries keyed by id, got " + json_type_phrase(doc.root()));
   }
   return doc.root();
 }
@@ -124,7 +125,7 @@ bool entry_supported(const json& entry) {
 class LentilEntryReader {
  public:
   LentilEntryReader(const LocatedJson& doc, const std::string& id, const GlassCatalog& catalogue)
-      : doc_(doc), id_(id), catalogue_(catalogue), entry_(doc, entry_pointer(id), id) {}
+      : doc_(doc), catalogue_(catalogue), entry_(doc, entry_pointer(id), id) {}
 
   LensReadResult read() {
     LensReadResult result;
@@ -219,8 +220,9 @@ class LentilEntryReader {
     // No ray can pass beyond |R|, so lentil's own tracer loses nothing when the aperture stops there.
     if (s.curvature_per_mm != 0.0 && housing > 1.0 / std::abs(s.curvature_per_mm)) {
       const double limit = 1.0 / std::abs(s.curvature_per_mm);
-      warn(e, "housing-radius", "housing-radius " + format_number(housing) + " exceeds |radius| " +
-                                    format_number(limit) + "; the clear semi-diameter is limited to |radius|");
+      warn(e, "housing-radius",
+           "housing-radius " + format_number(housing) + " exceeds |radius| " + format_number(limit) +
+               "; the clear semi-diameter is limited to |radius|");
       s.semi_diameter_mm = limit;
     }
 
@@ -273,9 +275,9 @@ class LentilEntryReader {
         }
         return MaterialSpec::catalog(glass->name(), glass->vendor());
       }
-      note(e, "material", "catalogue glass " + glass->vendor() + " " + glass->name() + " has nd " +
-                              format_number(catalogue_nd) + ", the entry's ior is " + format_number(*ior) +
-                              "; using a model glass from ior and abbe");
+      note(e, "material",
+           "catalogue glass " + glass->vendor() + " " + glass->name() + " has nd " + format_number(catalogue_nd) +
+               ", the entry's ior is " + format_number(*ior) + "; using a model glass from ior and abbe");
       return MaterialSpec::model(*ior, vd);
     }
     if (ior) {
@@ -288,17 +290,22 @@ class LentilEntryReader {
                            (names.empty() ? "(none)" : names));
   }
 
-  const Glass* find_normalized(const std::string& name) const {
-    const std::string key = normalized_glass_name(name);
-    if (key.empty()) return nullptr;
-    for (const std::string& vendor : catalogue_.vendors()) {
-      for (const Glass& g : catalogue_.glasses()) {
-        if (normalized_glass_name(g.vendor()) == normalized_glass_name(vendor) && normalized_glass_name(g.name()) == key) {
-          return &g;
+  // The catalogue glass whose name matches once dashes, blanks and case are ignored, first in the
+  // catalogue's vendor order. The index is built once per entry, so the cost stays linear in the
+  // number of elements.
+  const Glass* find_normalized(const std::string& name) {
+    if (!normalized_index_built_) {
+      for (const std::string& vendor : catalogue_.vendors()) {
+        for (const Glass& g : catalogue_.glasses()) {
+          if (normalized_glass_name(g.vendor()) == normalized_glass_name(vendor)) {
+            normalized_index_.emplace(normalized_glass_name(g.name()), &g);  // keeps the first vendor's glass
+          }
         }
       }
+      normalized_index_built_ = true;
     }
-    return nullptr;
+    auto it = normalized_index_.find(normalized_glass_name(name));
+    return it == normalized_index_.end() ? nullptr : it->second;
   }
 
   void read_asphere(JsonObjectReader& e, const std::string& geometry, Surface& s) {
@@ -348,12 +355,13 @@ class LentilEntryReader {
   }
 
   const LocatedJson& doc_;
-  std::string id_;
   const GlassCatalog& catalogue_;
   JsonObjectReader entry_;
   std::vector<std::string> element_pointers_;
   std::string stop_path_;
   Diagnostics diagnostics_;
+  std::unordered_map<std::string, const Glass*> normalized_index_;
+  bool normalized_index_built_ = false;
 };
 
 }  // namespace
@@ -391,7 +399,8 @@ LensReadResult read_lentil(std::string_view text, const std::string& file_name, 
       ids += (ids.empty() ? "" : ", ") + it.key();
     }
     if (root.size() > kMaxListedIds) ids += ", ... (" + std::to_string(root.size()) + " in all)";
-    throw LensFileError(doc.where(""), "no lentil entry \"" + id + "\"; available ids: " + (ids.empty() ? "(none)" : ids));
+    throw LensFileError(doc.where(""),
+                        "no lentil entry \"" + id + "\"; available ids: " + (ids.empty() ? "(none)" : ids));
   }
   LentilEntryReader reader(doc, id, catalogue);
   return reader.read();

@@ -117,6 +117,8 @@ class PbrtParser {
   explicit PbrtParser(const std::string& file_name) : file_(file_name) {}
 
   LensReadResult parse(std::string_view text, PbrtConvention convention) {
+    // A UTF-8 byte-order mark (editors on Windows add one) is not part of the first line.
+    if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
     int line_number = 0;
     std::size_t pos = 0;
     while (pos <= text.size()) {
@@ -175,7 +177,8 @@ class PbrtParser {
       ++count;
     }
     if (count != kColumns) {
-      fail(number, 0, "expected 4 columns (radius, thickness, index, aperture diameter), found " + std::to_string(count));
+      fail(number, 0,
+           "expected 4 columns (radius, thickness, index, aperture diameter), found " + std::to_string(count));
     }
     if (rows_.size() >= kMaxRows) fail(number, 0, "more than " + std::to_string(kMaxRows) + " lens rows");
     rows_.push_back(row);
@@ -197,8 +200,9 @@ class PbrtParser {
 
     if (convention == PbrtConvention::SeparationFromPrevious && rows_.front().value[1] != 0.0) {
       const Row& r = rows_.front();
-      fail(r.line, r.column[1], "first row's separation = " + format_number(r.value[1]) +
-                                    ": must be 0 in the separation-from-previous convention (there is no previous vertex)");
+      fail(r.line, r.column[1],
+           "first row's separation = " + format_number(r.value[1]) +
+               ": must be 0 in the separation-from-previous convention (there is no previous vertex)");
     }
 
     std::optional<std::size_t> stop_row;
@@ -211,8 +215,8 @@ class PbrtParser {
       s.is_stop = radius == 0.0;
       if (s.is_stop) {
         if (stop_row) {
-          fail(r.line, r.column[0], "a second aperture stop (radius 0); the first is on line " +
-                                        std::to_string(rows_[*stop_row].line));
+          fail(r.line, r.column[0],
+               "a second aperture stop (radius 0); the first is on line " + std::to_string(rows_[*stop_row].line));
         }
         stop_row = k;
       } else {
@@ -243,11 +247,13 @@ class PbrtParser {
       } else if (index > 1.0 && index <= kMaxPlausibleIndex) {
         s.material = MaterialSpec::model(index, std::nullopt);
       } else {
-        fail(r.line, r.column[2], "index = " + format_number(index) +
-                                      ": must be 1 (air), a glass index in (1, 5], or 0 on the stop row");
+        fail(r.line, r.column[2],
+             "index = " + format_number(index) + ": must be 1 (air), a glass index in (1, 5], or 0 on the stop row");
       }
 
-      if (!(diameter > 0.0)) fail(r.line, r.column[3], "aperture diameter = " + format_number(diameter) + ": must be > 0");
+      if (!(diameter > 0.0)) {
+        fail(r.line, r.column[3], "aperture diameter = " + format_number(diameter) + ": must be > 0");
+      }
       s.semi_diameter_mm = diameter / 2.0;
       p.surfaces.push_back(std::move(s));
     }
@@ -277,6 +283,8 @@ class PbrtParser {
     if (header_.empty()) {
       const std::size_t slash = file_.find_last_of("/\\");
       p.name = slash == std::string::npos ? file_ : file_.substr(slash + 1);
+      const std::size_t dot = p.name.find_last_of('.');
+      if (dot != std::string::npos && dot > 0) p.name.resize(dot);
       return;
     }
     p.name = header_.front();
@@ -290,9 +298,9 @@ class PbrtParser {
       field.kind = FieldSpec::Kind::AngleDeg;
       field.values = {0.0, *half_deg};
       p.field = field;
-      diagnostics.push_back(Diagnostic{Diagnostic::Severity::Note, SourceLocation{file_, name_line_, 0},
-                                       "half field angle " + format_number(*half_deg) + " deg taken from the header \"" +
-                                           p.name + "\""});
+      diagnostics.push_back(
+          Diagnostic{Diagnostic::Severity::Note, SourceLocation{file_, name_line_, 0},
+                     "half field angle " + format_number(*half_deg) + " deg taken from the header \"" + p.name + "\""});
     }
   }
 

@@ -8,7 +8,6 @@
 #include <array>
 #include <charconv>
 #include <cmath>
-#include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
@@ -41,6 +40,7 @@ constexpr double kMaxPlausibleIndex = 5.0;
 // Keywords that change nothing lensmith models: drawing, coating, tolerancing, optimisation,
 // ray-aiming and bookkeeping data (MIRR only sets how a mirror substrate is drawn; GLAS MIRROR is
 // what makes a mirror). Sorted for binary search.
+// clang-format off
 constexpr auto kIgnoredKeywords = std::to_array<std::string_view>({
     "BLNK", "COAT", "COFN", "CONF", "DMFS", "EDGE", "EFFL", "FIMP", "FLAP", "FWGN", "FWGT", "GFAC", "GLRS",
     "GSTD", "HIDE", "HYPR", "ISNA", "LANG", "MAZH", "MEMA", "MIRR", "MNCA", "MNCG", "MNEA", "MNEG", "MOFF",
@@ -58,6 +58,7 @@ constexpr auto kRefusedApertureKeywords = std::to_array<std::string_view>({
 constexpr auto kZeroOnlyKeywords = std::to_array<std::string_view>({
     "DECX", "DECY", "OBDC", "TILT", "TILX", "TILY", "TILZ", "XDAT", "YDAT",
 });
+// clang-format on
 static_assert(std::ranges::is_sorted(kIgnoredKeywords) && std::ranges::is_sorted(kRefusedApertureKeywords) &&
               std::ranges::is_sorted(kZeroOnlyKeywords));
 
@@ -182,7 +183,6 @@ struct ZmxSurface {
   int number = 0;
   int line = 0;
   std::string type = "STANDARD";
-  int type_line = 0;
   double curvature = 0.0;  // 1 / lens unit
   int curv_line = 0;
   std::optional<double> disz;  // lens units; empty with disz_infinite for INFINITY
@@ -225,8 +225,7 @@ struct UnknownKeyword {
 
 class ZemaxParser {
  public:
-  ZemaxParser(const std::string& file_name, const GlassCatalog& catalogue)
-      : file_(file_name), catalogue_(catalogue) {}
+  ZemaxParser(const std::string& file_name, const GlassCatalog& catalogue) : file_(file_name), catalogue_(catalogue) {}
 
   LensReadResult parse(std::string_view bytes) {
     const std::string text = decode_text(bytes, file_);
@@ -277,17 +276,14 @@ class ZemaxParser {
     if (!v) fail_at(l, t, "expected a finite number for " + what + ", got \"" + shown(t.text) + "\"");
     return *v;
   }
-  std::optional<double> optional_number(const ZmxLine& l, std::size_t i, const std::string& what) const {
-    if (i >= l.args.size()) return std::nullopt;
-    return number(l, i, what);
-  }
   long long integer(const ZmxLine& l, std::size_t i, const std::string& what, long long min, long long max) const {
     const Token& t = required_arg(l, i, what);
     auto v = parse_integer(t.text);
     if (!v) fail_at(l, t, "expected an integer for " + what + ", got \"" + shown(t.text) + "\"");
     if (*v < min || *v > max) {
-      fail_at(l, t, what + " = " + std::to_string(*v) + ": must be in [" + std::to_string(min) + ", " +
-                        std::to_string(max) + "]");
+      fail_at(l, t,
+              what + " = " + std::to_string(*v) + ": must be in [" + std::to_string(min) + ", " + std::to_string(max) +
+                  "]");
     }
     return *v;
   }
@@ -366,12 +362,15 @@ class ZemaxParser {
     if (k == "NOTE") return handle_note(l);
     if (k == "MODE") {
       const Token& t = required_arg(l, 0, "the mode");
-      if (t.text != "SEQ") fail_at(l, t, "mode \"" + shown(t.text) + "\" is not supported: only sequential (SEQ) files are read");
+      if (t.text != "SEQ") {
+        fail_at(l, t, "mode \"" + shown(t.text) + "\" is not supported: only sequential (SEQ) files are read");
+      }
       return;
     }
     if (k == "GCAT") return handle_gcat(l);
     if (k == "ENPD") {
-      aperture_ = ApertureLine{ApertureSpec::Kind::EntrancePupilDiameter, number(l, 0, "the entrance-pupil diameter"), l.number};
+      aperture_ = ApertureLine{ApertureSpec::Kind::EntrancePupilDiameter, number(l, 0, "the entrance-pupil diameter"),
+                               l.number};
       return;
     }
     if (k == "FNUM") {
@@ -393,11 +392,12 @@ class ZemaxParser {
     if (k == "FTYP") return handle_ftyp(l);
     if (k == "XFLN" || k == "XFLD") {
       x_fields_ = all_numbers(l, "a field value");
+      field_line_ = l.number;
       return;
     }
     if (k == "YFLN" || k == "YFLD") {
       y_fields_ = all_numbers(l, "a field value");
-      y_field_line_ = l.number;
+      field_line_ = l.number;
       return;
     }
     if (k == "WAVM") {
@@ -445,10 +445,18 @@ class ZemaxParser {
            std::string(k) + ": non-circular apertures, obscurations and user apertures are not supported");
     }
     if (contains(kZeroOnlyKeywords, k)) {
-      for (std::size_t i = 0; i < l.args.size(); ++i) {
+      // XDAT/YDAT are "index value ...": only the value matters. The others are values throughout.
+      std::size_t first = 0;
+      std::size_t last = l.args.size();
+      if (k == "XDAT" || k == "YDAT") {
+        first = 1;
+        last = std::min<std::size_t>(2, last);
+      }
+      for (std::size_t i = first; i < last; ++i) {
         auto v = parse_finite(l.args[i].text);
         if (v && *v != 0.0) {
-          fail_at(l, l.args[i], "decentres, tilts and extra surface data are not supported (value " + shown(l.args[i].text) + ")");
+          fail_at(l, l.args[i],
+                  "decentres, tilts and extra surface data are not supported (value " + shown(l.args[i].text) + ")");
         }
       }
       return;
@@ -460,8 +468,9 @@ class ZemaxParser {
   void handle_surf(const ZmxLine& l) {
     const long long n = integer(l, 0, "the surface number", 0, kMaxSurfaceNumber);
     if (n != static_cast<long long>(surfaces_.size())) {
-      fail_at(l, l.args[0], "surface " + std::to_string(n) + " out of order: expected SURF " +
-                                std::to_string(surfaces_.size()) + " (surfaces are numbered 0, 1, 2, ... in order)");
+      fail_at(l, l.args[0],
+              "surface " + std::to_string(n) + " out of order: expected SURF " + std::to_string(surfaces_.size()) +
+                  " (surfaces are numbered 0, 1, 2, ... in order)");
     }
     ZmxSurface s;
     s.number = static_cast<int>(n);
@@ -475,10 +484,10 @@ class ZemaxParser {
     if (t.text != "STANDARD" && t.text != "EVENASPH") {
       std::string why = "only STANDARD and EVENASPH surfaces are read";
       if (t.text == "COORDBRK") why = "coordinate breaks (tilts and decentres) are not supported; " + why;
-      fail_at(l, t, "surface type " + shown(t.text) + " on SURF " + std::to_string(s.number) + " is not supported: " + why);
+      fail_at(l, t,
+              "surface type " + shown(t.text) + " on SURF " + std::to_string(s.number) + " is not supported: " + why);
     }
     s.type = std::string(t.text);
-    s.type_line = l.number;
   }
 
   void handle_disz(const ZmxLine& l) {
@@ -499,7 +508,8 @@ class ZemaxParser {
     ZmxSurface& s = current_surface(l);
     const Token& t = required_arg(l, 0, "the glass name");
     if (to_upper(t.text) == "MIRROR") {
-      fail_at(l, t, "mirrors are not supported (SURF " + std::to_string(s.number) + "; lensmith models refracting systems)");
+      fail_at(l, t,
+              "mirrors are not supported (SURF " + std::to_string(s.number) + "; lensmith models refracting systems)");
     }
     GlassRef g;
     g.name = std::string(t.text);
@@ -576,7 +586,9 @@ class ZemaxParser {
   void handle_ftyp(const ZmxLine& l) {
     // FTYP type telecentric field-count wavelength-count ... afocal ...
     const long long type = integer(l, 0, "the field type", 0, 1000);
-    if (type == 3) fail_at(l, l.args[0], "real image height fields (type 3) are not supported; use paraxial image height (2)");
+    if (type == 3) {
+      fail_at(l, l.args[0], "real image height fields (type 3) are not supported; use paraxial image height (2)");
+    }
     if (type == 4) fail_at(l, l.args[0], "theodolite angle fields (type 4) are not supported");
     if (type > 4) fail_at(l, l.args[0], "field type " + std::to_string(type) + " is not supported");
     if (l.args.size() > 1 && integer(l, 1, "the telecentric flag", 0, 1000) != 0) {
@@ -626,7 +638,8 @@ class ZemaxParser {
     if (upper == "___BLANK") {
       // A model glass: nd and Vd are the glass (Vd 0 = no dispersion, as in OpticStudio).
       if (!g.nd || *g.nd < 1.0 || *g.nd > kMaxPlausibleIndex) {
-        fail(g.line, g.column, "GLAS ___BLANK: a model glass needs an nd between 1 and 5 (GLAS ___BLANK solve pickup nd Vd ...)");
+        fail(g.line, g.column,
+             "GLAS ___BLANK: a model glass needs an nd between 1 and 5 (GLAS ___BLANK solve pickup nd Vd ...)");
       }
       if (g.vd && *g.vd < 0.0) fail(g.line, g.column, "GLAS ___BLANK: Vd = " + format_number(*g.vd) + ": must be >= 0");
       if (g.dpgf != 0.0) note(g.line, "model glass dPgF = " + format_number(g.dpgf) + " ignored");
@@ -648,8 +661,9 @@ class ZemaxParser {
     for (const std::string& n : catalogue_.closest_names(g.name)) names += (names.empty() ? "" : ", ") + n;
     std::string why = placeholder ? "its GLAS line carries only OpticStudio's placeholder nd 1.5 / Vd 40"
                                   : "its GLAS line gives no usable nd/Vd to fall back on";
-    fail(g.line, g.column, "GLAS: unknown glass \"" + shown(g.name, 64) + "\": in no catalogue and " + why +
-                               "; closest catalogue names: " + (names.empty() ? "(none)" : names));
+    fail(g.line, g.column,
+         "GLAS: unknown glass \"" + shown(g.name, 64) + "\": in no catalogue and " + why +
+             "; closest catalogue names: " + (names.empty() ? "(none)" : names));
   }
 
   // The line a PrescriptionError is about, from the "surface N: ..." form of its message.
@@ -658,8 +672,19 @@ class ZemaxParser {
     if (message.rfind(kSurface, 0) == 0) {
       auto end = message.find_first_not_of("0123456789", kSurface.size());
       auto n = parse_integer(std::string_view(message).substr(kSurface.size(), end - kSurface.size()));
-      if (n && *n >= 1 && *n < static_cast<long long>(surfaces_.size())) return surfaces_[static_cast<std::size_t>(*n)].line;
+      if (n && *n >= 1 && *n < static_cast<long long>(surfaces_.size())) {
+        return surfaces_[static_cast<std::size_t>(*n)].line;
+      }
     }
+    constexpr std::string_view kWavelength = "wavelengths_nm[";
+    if (message.rfind(kWavelength, 0) == 0) {
+      auto end = message.find(']', kWavelength.size());
+      auto i = parse_integer(std::string_view(message).substr(kWavelength.size(), end - kWavelength.size()));
+      if (i && *i >= 0 && *i < static_cast<long long>(wavelength_sources_.size())) {
+        return wavelength_sources_[static_cast<std::size_t>(*i)].line;
+      }
+    }
+    if (message.rfind("primary", 0) == 0 && primary_) return primary_->line;
     if (message.rfind("aperture", 0) == 0 && aperture_) return aperture_->line;
     if (message.rfind("field", 0) == 0 && field_type_) return field_type_->line;
     if (message.rfind("object", 0) == 0) return surfaces_.front().disz_line;
@@ -684,7 +709,7 @@ class ZemaxParser {
     }
     LensReadResult result;
     Prescription& p = result.prescription;
-    p.name = name_;
+    p.name = name_.empty() ? file_stem() : name_;  // OpticStudio often leaves NAME blank
     p.notes = std::string(trim_lines(notes_));
 
     const ZmxSurface& object = surfaces_.front();
@@ -694,7 +719,8 @@ class ZemaxParser {
     } else {
       if (*object.disz <= 0.0) {
         fail(object.disz_line, object.disz_column,
-             "DISZ: object distance = " + format_number(*object.disz) + ": must be > 0 or INFINITY (virtual objects are not supported)");
+             "DISZ: object distance = " + format_number(*object.disz) +
+                 ": must be > 0 or INFINITY (virtual objects are not supported)");
       }
       p.object_distance_mm = mm(*object.disz);
     }
@@ -734,12 +760,20 @@ class ZemaxParser {
     return result;
   }
 
+  std::string file_stem() const {
+    const std::size_t slash = file_.find_last_of("/\\");
+    std::string stem = slash == std::string::npos ? file_ : file_.substr(slash + 1);
+    const std::size_t dot = stem.find_last_of('.');
+    if (dot != std::string::npos && dot > 0) stem.resize(dot);
+    return stem;
+  }
+
   Surface make_surface(const ZmxSurface& z) {
     Surface s;
     s.curvature_per_mm = z.curvature / mm_per_unit_;
     if (z.disz_infinite) {
-      fail(z.disz_line, z.disz_column, "DISZ INFINITY on lens surface SURF " + std::to_string(z.number) +
-                                           " (afocal systems are not supported)");
+      fail(z.disz_line, z.disz_column,
+           "DISZ INFINITY on lens surface SURF " + std::to_string(z.number) + " (afocal systems are not supported)");
     }
     s.thickness_mm = mm(*z.disz);
     if (z.glass) s.material = material_for(*z.glass);
@@ -753,13 +787,15 @@ class ZemaxParser {
     for (const ParmRecord& parm : z.parms) {
       if (parm.value == 0.0) continue;
       if (z.type != "EVENASPH") {
-        fail(parm.line, parm.column, "PARM " + std::to_string(parm.index) + " = " + format_number(parm.value) +
-                                         " on a STANDARD surface (SURF " + std::to_string(z.number) +
-                                         "): surface parameters need TYPE EVENASPH");
+        fail(parm.line, parm.column,
+             "PARM " + std::to_string(parm.index) + " = " + format_number(parm.value) +
+                 " on a STANDARD surface (SURF " + std::to_string(z.number) +
+                 "): surface parameters need TYPE EVENASPH");
       }
       if (parm.index < 1 || parm.index > static_cast<long long>(s.even_asphere.size())) {
-        fail(parm.line, parm.column, "PARM " + std::to_string(parm.index) +
-                                         " is not an even-asphere coefficient (PARM 1..8 hold the r^2..r^16 terms)");
+        fail(parm.line, parm.column,
+             "PARM " + std::to_string(parm.index) +
+                 " is not an even-asphere coefficient (PARM 1..8 hold the r^2..r^16 terms)");
       }
       // PARM j is the r^(2j) coefficient, in lens-unit^(1 - 2j).
       const auto j = static_cast<int>(parm.index);
@@ -790,10 +826,14 @@ class ZemaxParser {
     if (field_type_ && field_type_->field_count >= 0) {
       count = static_cast<std::size_t>(field_type_->field_count);
       if (count > y_fields_.size() || (!x_fields_.empty() && count > x_fields_.size())) {
-        fail(field_type_->line, 0, "FTYP declares " + std::to_string(count) + " fields but XFLN/YFLN list fewer values");
+        fail(field_type_->line, 0,
+             "FTYP declares " + std::to_string(count) + " fields but XFLN/YFLN list fewer values");
       }
     }
     if (count == 0) return;
+    if (count > static_cast<std::size_t>(kMaxFieldCount)) {
+      fail(field_line_, 0, "more than " + std::to_string(kMaxFieldCount) + " field points");
+    }
     FieldSpec field;
     field.kind = type == 0 ? FieldSpec::Kind::AngleDeg
                            : (type == 1 ? FieldSpec::Kind::ObjectHeightMm : FieldSpec::Kind::ImageHeightMm);
@@ -812,7 +852,8 @@ class ZemaxParser {
       field.values.push_back(type == 0 ? radial : mm(radial));
     }
     if (folded) {
-      note(y_field_line_, "fields with an x component were folded into radial fields (the lens is rotationally symmetric)");
+      note(field_line_,
+           "fields with an x component were folded into radial fields (the lens is rotationally symmetric)");
     }
     p.field = std::move(field);
   }
@@ -821,7 +862,7 @@ class ZemaxParser {
     std::vector<Located> micrometres;
     if (!wavm_.empty()) {
       long long count = field_type_ && field_type_->wavelength_count >= 0 ? field_type_->wavelength_count
-                                                                         : static_cast<long long>(wavm_.size());
+                                                                          : static_cast<long long>(wavm_.size());
       for (int slot = 1; slot <= count; ++slot) {
         auto it = wavm_.find(slot);
         if (it == wavm_.end()) {
@@ -834,8 +875,9 @@ class ZemaxParser {
       micrometres = wavl_;
       if (field_type_ && field_type_->wavelength_count >= 0) {
         if (static_cast<std::size_t>(field_type_->wavelength_count) > wavl_.size()) {
-          fail(field_type_->line, 0, "FTYP declares " + std::to_string(field_type_->wavelength_count) +
-                                         " wavelengths but WAVL lists " + std::to_string(wavl_.size()));
+          fail(field_type_->line, 0,
+               "FTYP declares " + std::to_string(field_type_->wavelength_count) + " wavelengths but WAVL lists " +
+                   std::to_string(wavl_.size()));
         }
         micrometres.resize(static_cast<std::size_t>(field_type_->wavelength_count));
       }
@@ -845,6 +887,7 @@ class ZemaxParser {
       return;
     }
     p.wavelengths_nm.clear();
+    wavelength_sources_ = micrometres;
     for (const Located& w : micrometres) {
       if (!(w.value > 0.0)) fail(w.line, w.column, "wavelength = " + format_number(w.value) + " um: must be > 0");
       p.wavelengths_nm.push_back(nm_from_um(w.value));
@@ -853,8 +896,9 @@ class ZemaxParser {
     if (primary_) {
       const auto index = static_cast<std::size_t>(primary_->value);
       if (index > p.wavelengths_nm.size()) {
-        fail(primary_->line, primary_->column, "PWAV " + std::to_string(index) + ": only " +
-                                                   std::to_string(p.wavelengths_nm.size()) + " wavelengths are in use");
+        fail(primary_->line, primary_->column,
+             "PWAV " + std::to_string(index) + ": only " + std::to_string(p.wavelengths_nm.size()) +
+                 " wavelengths are in use");
       }
       p.primary_wavelength_index = index - 1;
     }
@@ -875,10 +919,11 @@ class ZemaxParser {
   std::optional<FieldTypeLine> field_type_;
   std::vector<Located> x_fields_;
   std::vector<Located> y_fields_;
-  int y_field_line_ = 0;
+  int field_line_ = 0;  // the last XFLN/YFLN line
   std::map<int, Located> wavm_;
   std::vector<Located> wavl_;
   std::optional<Located> primary_;
+  std::vector<Located> wavelength_sources_;  // the wavelengths in use, where the file gives them
   std::map<std::string, UnknownKeyword> unknown_;
   std::size_t unknown_overflow_ = 0;
 };

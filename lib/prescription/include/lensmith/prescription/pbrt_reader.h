@@ -1,6 +1,6 @@
 // Reader for pbrt RealisticCamera lens files (.dat): rows of radius, thickness, index, aperture
 // diameter (mm); radius 0 marks the aperture stop. Two column conventions exist (see
-// docs/lens-format.md, section "pbrt"); both are read.
+// docs/lens-formats-foreign.md, section "pbrt"); both are read.
 #pragma once
 
 #include <string>

@@ -1,5 +1,5 @@
 // Reader for Zemax OpticStudio sequential lens files (.zmx), UTF-8 or UTF-16LE with BOM.
-// Supported keywords and what is ignored or refused: docs/lens-format.md, section "Zemax".
+// Supported keywords and what is ignored or refused: docs/lens-formats-foreign.md, section "Zemax".
 #pragma once
 
 #include <string>
