@@ -74,6 +74,10 @@ def main():
         with open(out) as f:
             lens = json.load(f)
         lens["name"] = name
+        if "#" in source:  # a lentil entry: say where the numbers came from
+            entry = source.rsplit("#", 1)[1]
+            via = "lentil lens database entry " + entry + " (github.com/zpelgrims/lentil, MIT)"
+            lens["source"] = (lens["source"] + "; via the " + via) if lens.get("source") else via
         lens["notes"] = (note + " " + lens.get("notes", "")).strip() if note else lens.get("notes", "")
         if half_field_deg is not None and "field" not in lens:
             lens["field"] = {"angle_deg": [0.0, half_field_deg * 0.7, half_field_deg]}
