@@ -890,7 +890,7 @@ class ZemaxParser {
     wavelength_sources_ = micrometres;
     for (const Located& w : micrometres) {
       if (!(w.value > 0.0)) fail(w.line, w.column, "wavelength = " + format_number(w.value) + " um: must be > 0");
-      p.wavelengths_nm.push_back(nm_from_um(w.value));
+      p.wavelengths_nm.push_back(nm_from_um_rounded(w.value));
     }
     p.primary_wavelength_index = 0;
     if (primary_) {

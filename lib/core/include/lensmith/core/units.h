@@ -15,6 +15,13 @@ constexpr double mm_from_cm(double centimetres) { return centimetres * 10.0; }
 constexpr double mm_from_inch(double inches) { return inches * 25.4; }
 constexpr double um_from_nm(double nanometres) { return nanometres / 1000.0; }
 constexpr double nm_from_um(double micrometres) { return micrometres * 1000.0; }
+// A wavelength read in micrometres (as Zemax writes it) in nanometres, rounded to 1e-6 nm so that
+// "0.5875618" becomes exactly the double nearest 587.5618 rather than 587.5618000000001.
+inline double nm_from_um_rounded(double micrometres) {
+  // Outside any optical range (or NaN) there is nothing to round; avoid an overflowing cast.
+  if (!(micrometres > -1.0e6 && micrometres < 1.0e6)) return nm_from_um(micrometres);
+  return static_cast<double>(static_cast<long long>(micrometres * 1.0e9 + (micrometres >= 0 ? 0.5 : -0.5))) / 1.0e6;
+}
 constexpr double um_from_mm(double millimetres) { return millimetres * 1000.0; }
 constexpr double mm_from_nm(double nanometres) { return nanometres / 1.0e6; }
 constexpr double rad_from_deg(double degrees) { return degrees * (kPi / 180.0); }
