@@ -1,0 +1,81 @@
+// Making rays the way lens designers specify them: a field point and normalised pupil coordinates
+// (px, py) in the unit disc, either on the paraxial entrance pupil (Zemax without ray aiming) or
+// aimed by iteration so the real ray crosses the stop at (px, py) times the stop radius.
+#pragma once
+
+#include <optional>
+#include <ostream>
+#include <string>
+
+#include "lensmith/paraxial/paraxial_system.h"
+#include "lensmith/trace/sequential_tracer.h"
+
+namespace lensmith {
+
+// A field point. Angles follow conventions.h: a positive y angle gives a chief ray with positive
+// object-space slope (the image lands at negative y, as in Zemax).
+struct FieldPoint {
+  enum class Kind {
+    AngleDeg,        // x_angle_deg, y_angle_deg: direction (tan x, tan y, 1) normalised; object at infinity
+    ObjectHeightMm,  // x, y object height at the prescription's (finite) object plane
+    ObjectPoint,     // an explicit object point in the global frame (mm), any z before surface 1
+  };
+  Kind kind = Kind::AngleDeg;
+  double x = 0.0;
+  double y = 0.0;
+  Eigen::Vector3d point_mm{0.0, 0.0, 0.0};  // ObjectPoint only
+
+  static FieldPoint angle_deg(double y_deg, double x_deg = 0.0) { return {Kind::AngleDeg, x_deg, y_deg, {}}; }
+  static FieldPoint object_height_mm(double y_mm, double x_mm = 0.0) { return {Kind::ObjectHeightMm, x_mm, y_mm, {}}; }
+  static FieldPoint object_point_mm(const Eigen::Vector3d& p) { return {Kind::ObjectPoint, 0.0, 0.0, p}; }
+  std::string to_string() const;
+};
+
+struct PupilCoordinate {
+  double px = 0.0;  // normalised, x
+  double py = 0.0;  // normalised, y (the tangential direction for a y field)
+};
+
+enum class RayAiming {
+  ParaxialEntrancePupil,  // aim at (px, py) * EP radius on the paraxial entrance-pupil plane
+  RealStop,               // iterate until the real ray crosses the stop surface at (px, py) * stop radius
+};
+
+struct AimOptions {
+  RayAiming aiming = RayAiming::ParaxialEntrancePupil;
+  double tolerance_mm = 1e-10;  // RealStop: accepted miss on the stop surface
+  int max_iterations = 50;      // RealStop: Newton iterations (>= 1)
+  void validate() const;        // throws OptionsError
+};
+
+// The result of making a ray: the ray in object space, starting a little before surface 1 (or at
+// the object point), or a status saying why it could not be aimed.
+struct AimedRay {
+  RayStatus status = RayStatus::Ok;  // NotConverged when real aiming failed
+  int surface = 0;                   // where an aiming trace died, 0 when ok
+  Ray ray;
+  bool ok() const { return status == RayStatus::Ok; }
+};
+
+class RayAimer {
+ public:
+  // Uses the paraxial system at the primary wavelength for the pupil and the stop (stop radius =
+  // stop semi-diameter, or the paraxial marginal height at the stop when none is given).
+  RayAimer(const SequentialTracer& tracer, const AimOptions& options = {});
+
+  AimedRay make_ray(const FieldPoint& field, const PupilCoordinate& pupil, double wavelength_nm) const;
+  // The field point at the prescription's maximum field scaled by `relative` (0 = on axis, 1 = full),
+  // along +y.
+  FieldPoint field_at(double relative) const;
+
+  const ParaxialSystem& paraxial() const { return paraxial_; }
+  const SequentialTracer& tracer() const { return tracer_; }
+
+ private:
+  const SequentialTracer& tracer_;
+  AimOptions options_;
+  ParaxialSystem paraxial_;
+  double stop_radius_mm_ = 0.0;
+};
+
+}  // namespace lensmith
