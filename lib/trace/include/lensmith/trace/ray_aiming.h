@@ -3,6 +3,7 @@
 // aimed by iteration so the real ray crosses the stop at (px, py) times the stop radius.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -13,11 +14,13 @@
 namespace lensmith {
 
 // A field point. Angles follow conventions.h: a positive y angle gives a chief ray with positive
-// object-space slope (the image lands at negative y, as in Zemax).
+// object-space slope (a positive lens images it at positive y, as ParaxialSystem's chief-ray table shows).
 struct FieldPoint {
   enum class Kind {
     AngleDeg,        // x_angle_deg, y_angle_deg: direction (tan x, tan y, 1) normalised; object at infinity
-    ObjectHeightMm,  // x, y object height at the prescription's (finite) object plane
+                     // (for a finite object: the object-plane point on the chief ray at that angle)
+    ObjectHeightMm,  // x, y object height at the prescription's (finite) object plane; the object point is
+                     // at (-x, -y) so that the chief ray rises like a positive angle's (docs/paraxial.md)
     ObjectPoint,     // an explicit object point in the global frame (mm), any z before surface 1
   };
   Kind kind = Kind::AngleDeg;
@@ -25,8 +28,14 @@ struct FieldPoint {
   double y = 0.0;
   Eigen::Vector3d point_mm{0.0, 0.0, 0.0};  // ObjectPoint only
 
-  static FieldPoint angle_deg(double y_deg, double x_deg = 0.0) { return {Kind::AngleDeg, x_deg, y_deg, {}}; }
-  static FieldPoint object_height_mm(double y_mm, double x_mm = 0.0) { return {Kind::ObjectHeightMm, x_mm, y_mm, {}}; }
+  // point_mm is zeroed explicitly: `{}` here would call Eigen's default constructor, which leaves the vector
+  // uninitialised, instead of the member initialiser above.
+  static FieldPoint angle_deg(double y_deg, double x_deg = 0.0) {
+    return {Kind::AngleDeg, x_deg, y_deg, Eigen::Vector3d::Zero()};
+  }
+  static FieldPoint object_height_mm(double y_mm, double x_mm = 0.0) {
+    return {Kind::ObjectHeightMm, x_mm, y_mm, Eigen::Vector3d::Zero()};
+  }
   static FieldPoint object_point_mm(const Eigen::Vector3d& p) { return {Kind::ObjectPoint, 0.0, 0.0, p}; }
   std::string to_string() const;
 };
@@ -59,8 +68,9 @@ struct AimedRay {
 
 class RayAimer {
  public:
-  // Uses the paraxial system at the primary wavelength for the pupil and the stop (stop radius =
-  // stop semi-diameter, or the paraxial marginal height at the stop when none is given).
+  // Uses the paraxial system at the primary wavelength for the pupil and the stop. The stop radius
+  // that pupil coordinate 1 means is the paraxial marginal-ray height at the stop: the beam the
+  // aperture specification defines (equal to the stop's semi-diameter when the aperture floats by it).
   RayAimer(const SequentialTracer& tracer, const AimOptions& options = {});
 
   AimedRay make_ray(const FieldPoint& field, const PupilCoordinate& pupil, double wavelength_nm) const;
@@ -76,6 +86,10 @@ class RayAimer {
   AimOptions options_;
   ParaxialSystem paraxial_;
   double stop_radius_mm_ = 0.0;
+  // Implementation-defined members (ray_aiming.cpp).
+  double front_z_mm_ = 0.0;      // front-most z of surface 1 within its clear aperture (<= 0)
+  double beam_radius_mm_ = 0.0;  // radius used to place the start wavefront of an angle field before surface 1
+  std::shared_ptr<const SequentialTracer> to_stop_;  // surfaces 1..stop, apertures not clipped (RealStop)
 };
 
 }  // namespace lensmith

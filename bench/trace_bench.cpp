@@ -1,0 +1,137 @@
+// Exact ray tracing speed: single-ray forward traces through every shipped lens (ns per ray and per surface)
+// and the OpenMP batch path (rays per second on 1 thread and on all of them). The reference point is the
+// 160-200 ns per surface per ray (float) of a published polynomial-optics renderer's exact tracer. Figures:
+// docs/performance.md.
+#include <benchmark/benchmark.h>
+#include <omp.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "lensmith/prescription/lens_library.h"
+#include "lensmith/trace/ray_aiming.h"
+#include "lensmith/trace/sequential_tracer.h"
+
+namespace {
+
+using namespace lensmith;
+
+// Rays over 70 % of the field and the whole pupil (a golden-angle spiral), at the primary wavelength, kept
+// only when they reach the image: every timed ray crosses every surface, so time / surfaces is the cost of
+// one surface crossing.
+std::vector<Ray> sample_rays(const SequentialTracer& tracer, std::size_t count) {
+  const RayAimer aimer(tracer);
+  const Prescription& lens = tracer.lens();
+  std::vector<Ray> rays;
+  rays.reserve(count);
+  constexpr double kGoldenAngle = 2.39996322972865332;
+  const std::size_t candidates = 4 * count;
+  for (std::size_t i = 0; rays.size() < count && i < candidates; ++i) {
+    const double relative_field = 0.7 * static_cast<double>(i % 8) / 7.0;
+    const FieldPoint field = lens.field ? aimer.field_at(relative_field) : FieldPoint::angle_deg(10.0 * relative_field);
+    const double radius = std::sqrt((static_cast<double>(i) + 0.5) / static_cast<double>(candidates));
+    const double angle = kGoldenAngle * static_cast<double>(i);
+    const Ray ray =
+        aimer.make_ray(field, {radius * std::cos(angle), radius * std::sin(angle)}, lens.primary_wavelength_nm()).ray;
+    if (tracer.trace_forward(ray).ok()) rays.push_back(ray);
+  }
+  // Repeat the survivors if fewer than `count` got through (a heavily vignetted lens).
+  for (std::size_t i = 0; rays.size() < count; ++i) rays.push_back(rays[i]);
+  return rays;
+}
+
+void BM_TraceForward(benchmark::State& state, const std::string& id) {
+  const Prescription lens = LensLibrary::load(id).prescription;
+  const SequentialTracer tracer(lens);
+  const std::vector<Ray> rays = sample_rays(tracer, 4096);
+  std::size_t next = 0;
+  for (auto _ : state) {
+    const TraceResult r = tracer.trace_forward(rays[next]);
+    benchmark::DoNotOptimize(r.ray.position_mm.data());
+    next = (next + 1) & 4095;
+  }
+  const auto surfaces = static_cast<double>(lens.surfaces.size());
+  const auto iterations = static_cast<double>(state.iterations());
+  state.counters["surfaces"] = surfaces;
+  // Seconds per surface crossing (shown with an SI prefix: "28n" = 28 ns).
+  state.counters["time_per_surface"] =
+      benchmark::Counter(iterations * surfaces, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+// trace_batch on 65536 rays with `state.range(0)` OpenMP threads (0 = all). Refilling the batch from the
+// inputs is not timed.
+void BM_TraceBatch(benchmark::State& state, const std::string& id) {
+  const Prescription lens = LensLibrary::load(id).prescription;
+  const SequentialTracer tracer(lens);
+  constexpr std::size_t kRays = 65536;
+  const std::vector<Ray> rays = sample_rays(tracer, kRays);
+  RayBatch batch;
+  batch.resize(kRays);
+  const int threads = state.range(0) == 0 ? omp_get_num_procs() : static_cast<int>(state.range(0));
+  omp_set_num_threads(threads);
+  for (auto _ : state) {
+    state.PauseTiming();
+    for (std::size_t i = 0; i < kRays; ++i) batch.set(i, rays[i]);
+    state.ResumeTiming();
+    tracer.trace_batch(batch, TraceDirection::Forward);
+    benchmark::DoNotOptimize(batch.x_mm.data());
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(kRays));
+  state.counters["threads"] = threads;
+  state.counters["surfaces"] = static_cast<double>(lens.surfaces.size());
+  state.counters["time_per_surface"] = benchmark::Counter(
+      static_cast<double>(state.iterations()) * static_cast<double>(kRays) * static_cast<double>(lens.surfaces.size()),
+      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+// RayAimer::make_ray for Smith's triplet over the field and pupil, paraxial or real-stop aiming.
+void BM_AimRay(benchmark::State& state, RayAiming aiming) {
+  const Prescription lens = LensLibrary::load("smith-cooke-triplet").prescription;
+  const SequentialTracer tracer(lens);
+  AimOptions options;
+  options.aiming = aiming;
+  const RayAimer aimer(tracer, options);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const double relative_field = static_cast<double>(i % 8) / 7.0;
+    const double py = -0.9 + 1.8 * static_cast<double>(i % 11) / 10.0;
+    const AimedRay ray = aimer.make_ray(aimer.field_at(relative_field), {0.3, py}, lens.primary_wavelength_nm());
+    benchmark::DoNotOptimize(ray.ray.position_mm.data());
+    ++i;
+  }
+}
+
+// Median of 5 repetitions, as docs/performance.md reports.
+const int kRegistered = [] {
+  for (const ShippedLens& lens : LensLibrary::list()) {
+    benchmark::RegisterBenchmark(("BM_TraceForward/" + lens.id).c_str(), BM_TraceForward, lens.id)
+        ->Unit(benchmark::kNanosecond)
+        ->Repetitions(5)
+        ->ReportAggregatesOnly(true);
+  }
+  for (const char* id : {"smith-cooke-triplet", "angenieux-double-gauss-1953", "aspherical-fisheye"}) {
+    benchmark::RegisterBenchmark((std::string("BM_TraceBatch/") + id).c_str(), BM_TraceBatch, std::string(id))
+        ->Arg(1)
+        ->Arg(0)
+        ->ArgName("threads")
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime()
+        ->Repetitions(5)
+        ->ReportAggregatesOnly(true);
+  }
+  benchmark::RegisterBenchmark("BM_AimRay/smith-cooke-triplet/paraxial_pupil", BM_AimRay,
+                               RayAiming::ParaxialEntrancePupil)
+      ->Unit(benchmark::kNanosecond)
+      ->Repetitions(5)
+      ->ReportAggregatesOnly(true);
+  benchmark::RegisterBenchmark("BM_AimRay/smith-cooke-triplet/real_stop", BM_AimRay, RayAiming::RealStop)
+      ->Unit(benchmark::kMicrosecond)
+      ->Repetitions(5)
+      ->ReportAggregatesOnly(true);
+  return 0;
+}();
+
+}  // namespace
+
+BENCHMARK_MAIN();
