@@ -2,11 +2,21 @@
 // one library call and prints the result. main.cpp turns exceptions into exit codes.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "lensmith/core/diagnostic.h"
 #include "lensmith/prescription/prescription.h"
+
+namespace lensmith {
+struct AnalysisOptions;
+namespace plot {
+class Canvas;
+struct PlotOptions;
+}  // namespace plot
+}  // namespace lensmith
 
 namespace lensmith::cli {
 
@@ -43,6 +53,75 @@ struct ConvertOptions {
   std::optional<double> scale_to_efl_mm;  // scale the lens so its EFL (primary wavelength) becomes this
 };
 int run_convert(const ConvertOptions& options, const GlobalOptions& global);
+
+// Options every real-ray analysis command shares (spot, fan, analyze); docs/cli.md.
+struct RealRayCommandOptions {
+  std::string lens;
+  std::vector<double> relative_fields{0.0, 0.7, 1.0};  // --fields: fractions of the maximum field, 0..1
+  std::vector<double> wavelengths_nm;                   // --wavelength: default the lens's
+  std::optional<double> field_angle_deg;                // --field-angle: what relative field 1 means, deg
+  std::string image = "prescribed";                     // --image prescribed|paraxial
+  std::string aim = "paraxial";                         // --aim paraxial|real
+  std::string png;                                      // --png FILE: write a picture
+  bool json = false;
+};
+
+// Helpers the real-ray commands share (real_ray_command.cpp).
+// The library options for `options`; throws OptionsError for an unknown --image or --aim word.
+AnalysisOptions make_analysis_options(const RealRayCommandOptions& options);
+// Plot options with the default font; warns once on stderr (unless quiet) when there is none.
+plot::PlotOptions make_plot_options(const GlobalOptions& global);
+struct SeidelCommandOptions {
+  std::string lens;
+  std::optional<double> wavelength_nm;      // default: the lens's primary wavelength
+  std::optional<double> object_distance_m;  // metres from the object to surface 1; default: the lens's
+  std::optional<double> field_angle_deg;    // maximum field; default: the lens's
+  std::optional<double> epd_mm;             // entrance-pupil diameter; default: the lens's aperture
+  std::optional<double> f_number;           // image-space F/#, instead of --epd
+  std::string png;                          // --png FILE: the Seidel diagram
+  bool json = false;
+};
+int run_seidel(const SeidelCommandOptions& options, const GlobalOptions& global);
+
+// Writes `canvas` to `png` atomically; throws IoError when `png` is the lens file itself.
+void write_picture(const plot::Canvas& canvas, const std::string& png, const std::string& lens, const GlobalOptions& global);
+
+struct TraceCommandOptions {
+  std::string lens;
+  std::optional<double> field_angle_deg;   // --field-angle: object-space angle along y, deg
+  std::optional<double> object_height_mm;  // --object-height: finite objects, mm along y
+  std::optional<double> relative_field;    // --field: fraction of the lens's maximum field
+  std::string pupil = "0,0";               // --pupil PX,PY in the unit disc
+  std::optional<double> wavelength_nm;
+  std::string image = "prescribed";
+  std::string aim = "paraxial";
+  bool json = false;
+};
+int run_trace(const TraceCommandOptions& options, const GlobalOptions& global);
+// "" when `text` is a valid --pupil value (PX,PY in the unit disc), else what is wrong with it.
+std::string check_pupil_text(const std::string& text);
+
+struct SpotCommandOptions {
+  RealRayCommandOptions common;
+  int rings = 6;                  // --rings: hexapolar rings
+  std::optional<int> random_rays; // --random N: uniform random pupil points instead
+  std::uint64_t seed = 1;         // --seed
+};
+int run_spot(const SpotCommandOptions& options, const GlobalOptions& global);
+
+struct FanCommandOptions {
+  RealRayCommandOptions common;
+  int samples = 41;  // --samples: pupil points per fan, odd
+};
+int run_fan(const FanCommandOptions& options, const GlobalOptions& global);
+
+struct AnalyzeCommandOptions {
+  RealRayCommandOptions common;
+  std::string what;              // --what distortion|field-curves|focal-shift|illumination|pupil
+  std::optional<int> samples;    // --samples: field samples (wavelength samples for focal-shift)
+  std::optional<int> grid;       // --grid: pupil grid cells across (illumination, pupil)
+};
+int run_analyze(const AnalyzeCommandOptions& options, const GlobalOptions& global);
 
 // Prints the reader's warnings to stderr unless quiet.
 void print_diagnostics(const Diagnostics& diagnostics, const GlobalOptions& global);

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "json_output.h"
 #include "lensmith/core/units.h"
 #include "lensmith/paraxial/paraxial_spectral_table.h"
 #include "lensmith/paraxial/paraxial_system.h"
@@ -14,10 +15,7 @@ namespace lensmith::cli {
 
 namespace {
 
-using ojson = nlohmann::ordered_json;
 
-// JSON has no infinity: an infinite distance is written as null.
-ojson finite_or_null(double v) { return std::isfinite(v) ? ojson(v) : ojson(nullptr); }
 
 ojson ray_table_json(const ParaxialRayTable& t) {
   ojson rows = ojson::array();
@@ -32,7 +30,7 @@ ojson info_json(const Prescription& lens, const ParaxialSystem& p) {
   ojson o;
   o["name"] = lens.name;
   o["wavelength_nm"] = p.wavelength_nm();
-  o["object_distance_mm"] = finite_or_null(p.object_distance_mm());
+  o["object_distance_mm"] = number_or_null(p.object_distance_mm());
   o["efl_mm"] = p.efl_mm();
   o["bfl_mm"] = p.bfl_mm();
   o["ffl_mm"] = p.ffl_mm();
@@ -54,8 +52,8 @@ ojson info_json(const Prescription& lens, const ParaxialSystem& p) {
   o["image_space_na"] = p.image_space_na();
   auto h = p.lagrange_invariant();
   o["lagrange_invariant"] = h ? ojson(*h) : ojson(nullptr);
-  o["image_distance_mm"] = finite_or_null(p.image_distance_mm());
-  o["z_image_mm"] = finite_or_null(p.z_image_mm());
+  o["image_distance_mm"] = number_or_null(p.image_distance_mm());
+  o["z_image_mm"] = number_or_null(p.z_image_mm());
   o["magnification"] = p.magnification();
   o["image_plane_distance_mm"] = p.image_plane_distance_mm();
   const auto& m = p.system_matrix();
@@ -72,7 +70,7 @@ ojson spectral_json(const ParaxialSpectralTable& table) {
                     {"z_front_principal_mm", s.z_front_principal_mm}, {"z_rear_principal_mm", s.z_rear_principal_mm},
                     {"entrance_pupil", {{"z_mm", s.z_entrance_pupil_mm}, {"diameter_mm", s.entrance_pupil_diameter_mm}}},
                     {"exit_pupil", {{"z_mm", s.z_exit_pupil_mm}, {"diameter_mm", s.exit_pupil_diameter_mm}}},
-                    {"image_distance_mm", finite_or_null(s.image_distance_mm)}, {"magnification", s.magnification},
+                    {"image_distance_mm", number_or_null(s.image_distance_mm)}, {"magnification", s.magnification},
                     {"extrapolated", s.extrapolated}});
   }
   return rows;

@@ -55,6 +55,100 @@ int main(int argc, char** argv) {
   convert_cmd->add_option("--scale-to-efl", convert.scale_to_efl_mm, "Scale every length so the EFL becomes this, mm (> 0)")
       ->check(CLI::PositiveNumber);
 
+  // Real-ray analyses (docs/cli.md, docs/analysis.md).
+  const std::string lens_help = "Lens file (.json, .zmx, .dat, lentil.json#ID) or shipped lens name (see `lensmith lenses`)";
+  const CLI::Validator pupil_check(
+      [](std::string& text) { return check_pupil_text(text); }, "PX,PY", "pupil in the unit disc");
+  const CLI::IsMember image_words({"prescribed", "paraxial"});
+  const CLI::IsMember aim_words({"paraxial", "real"});
+  const std::string aim_help =
+      "Ray aiming: paraxial (at the paraxial entrance pupil, Zemax's \"ray aiming off\"; default) or real (iterate onto the real stop)";
+
+  TraceCommandOptions trace;
+  CLI::App* trace_cmd = app.add_subcommand("trace", "Trace one real ray and print it at every surface and at the image plane");
+  trace_cmd->add_option("lens", trace.lens, lens_help)->required();
+  CLI::Option* trace_angle = trace_cmd->add_option("--field-angle", trace.field_angle_deg,
+                                                   "Object-space field angle along y, degrees (default 0; -90 < DEG < 90)")
+                                 ->check(CLI::Range(-89.999999, 89.999999));
+  CLI::Option* trace_height = trace_cmd->add_option("--object-height", trace.object_height_mm,
+                                                    "Object height along y for a finite object, mm (instead of --field-angle)");
+  CLI::Option* trace_relative = trace_cmd->add_option("--field", trace.relative_field,
+                                                      "Field as a fraction of the lens's maximum field, 0 to 1 (instead of --field-angle)")
+                                    ->check(CLI::Range(0.0, 1.0));
+  trace_angle->excludes(trace_height)->excludes(trace_relative);
+  trace_height->excludes(trace_relative);
+  trace_cmd->add_option("--pupil", trace.pupil, "Normalised pupil coordinate PX,PY in the unit disc (default 0,0: the chief ray)")
+      ->check(pupil_check);
+  trace_cmd->add_option("-w,--wavelength", trace.wavelength_nm, "Wavelength, nm (default: the lens's primary; 100-20000)")
+      ->check(CLI::Range(100.0, 20000.0));
+  trace_cmd->add_option("--image", trace.image, "Image plane: prescribed (the lens's last thickness) or paraxial (paraxial focus)")
+      ->check(image_words);
+  trace_cmd->add_option("--aim", trace.aim, aim_help)->check(aim_words);
+  trace_cmd->add_flag("--json", trace.json, "Print one JSON object (schema: docs/cli.md)");
+
+  // Options of spot, fan and analyze.
+  auto add_real_ray_options = [&](CLI::App* cmd, RealRayCommandOptions& o) {
+    cmd->add_option("lens", o.lens, lens_help)->required();
+    cmd->add_option("--fields", o.relative_fields, "Fields as fractions of the maximum field, comma separated, each 0 to 1 (default 0,0.7,1)")
+        ->delimiter(',')
+        ->check(CLI::Range(0.0, 1.0));
+    cmd->add_option("--field-angle", o.field_angle_deg,
+                    "The object-space half field angle that field 1 means, degrees (0 < DEG < 90; default: the lens's field)")
+        ->check(CLI::Range(1e-9, 89.999999));
+    cmd->add_option("-w,--wavelength", o.wavelengths_nm, "Wavelengths, nm, repeated or comma separated (default: the lens's; 100-20000)")
+        ->delimiter(',')
+        ->check(CLI::Range(100.0, 20000.0));
+    cmd->add_option("--image", o.image, "Image plane: prescribed (the lens's last thickness) or paraxial (paraxial focus)")
+        ->check(image_words);
+    cmd->add_option("--aim", o.aim, aim_help)->check(aim_words);
+    cmd->add_option("--png", o.png, "Also write a picture to this PNG file (written atomically; never the input)");
+    cmd->add_flag("--json", o.json, "Print one JSON object (schema: docs/cli.md)");
+  };
+
+  SpotCommandOptions spot;
+  CLI::App* spot_cmd = app.add_subcommand("spot", "Spot diagrams per field and wavelength with RMS and GEO radii");
+  add_real_ray_options(spot_cmd, spot.common);
+  CLI::Option* spot_rings = spot_cmd->add_option("--rings", spot.rings, "Hexapolar rings (1 + 3 N (N + 1) rays; default 6 = 127 rays; 1-200)")
+                                ->check(CLI::Range(1, 200));
+  CLI::Option* spot_random = spot_cmd->add_option("--random", spot.random_rays, "Uniform random pupil points instead, this many (1-1000000)")
+                                 ->check(CLI::Range(1, 1000000));
+  spot_cmd->add_option("--seed", spot.seed, "Seed of --random (default 1; the same seed gives the same rays everywhere)")->needs(spot_random);
+  spot_rings->excludes(spot_random);
+
+  SeidelCommandOptions seidel;
+  CLI::App* seidel_cmd = app.add_subcommand("seidel", "Third-order (Seidel) aberrations per surface and summed, and Born & Wolf's B..F");
+  seidel_cmd->add_option("lens", seidel.lens, "Lens file or shipped lens name")->required();
+  seidel_cmd->add_option("-w,--wavelength", seidel.wavelength_nm, "Wavelength, nm (default: the lens's primary; 100-20000)")
+      ->check(CLI::Range(100.0, 20000.0));
+  seidel_cmd->add_option("-d,--object-distance", seidel.object_distance_m, "Object to first vertex, metres (default: the lens's; > 0)")
+      ->check(CLI::PositiveNumber);
+  seidel_cmd->add_option("--field-angle", seidel.field_angle_deg, "Maximum field angle, degrees (default: the lens's; 0-89.9)")
+      ->check(CLI::Range(0.0, 89.9));
+  CLI::Option* seidel_epd = seidel_cmd->add_option("--epd", seidel.epd_mm, "Entrance-pupil diameter, mm (default: the lens's aperture; > 0)")
+                                ->check(CLI::PositiveNumber);
+  seidel_cmd->add_option("--fstop", seidel.f_number, "Image-space F/# = EFL/EPD instead of --epd (> 0)")->check(CLI::PositiveNumber)->excludes(seidel_epd);
+  seidel_cmd->add_option("--png", seidel.png, "Also write the Seidel diagram (per-surface bar chart) to this PNG");
+  seidel_cmd->add_flag("--json", seidel.json, "Print one JSON object (schema: docs/cli.md)");
+
+  FanCommandOptions fan;
+  CLI::App* fan_cmd = app.add_subcommand("fan", "Transverse ray fans (ey against py, ex against px) per field and wavelength");
+  add_real_ray_options(fan_cmd, fan.common);
+  fan_cmd->add_option("--samples", fan.samples, "Pupil points per fan from -1 to 1, odd (default 41; 3-1001)")
+      ->check(CLI::Range(3, 1001));
+
+  AnalyzeCommandOptions analyze;
+  CLI::App* analyze_cmd = app.add_subcommand(
+      "analyze", "Distortion, field curves, chromatic focal shift, relative illumination or the unvignetted pupil");
+  add_real_ray_options(analyze_cmd, analyze.common);
+  analyze_cmd->add_option("--what", analyze.what, "distortion | field-curves | focal-shift | illumination | pupil")
+      ->required()
+      ->check(CLI::IsMember({"distortion", "field-curves", "focal-shift", "illumination", "pupil"}));
+  analyze_cmd->add_option("--samples", analyze.samples,
+                          "Field samples from 0 to 1 (default 21), or wavelength samples for focal-shift (default 41); 2-1001")
+      ->check(CLI::Range(2, 1001));
+  analyze_cmd->add_option("--grid", analyze.grid, "Pupil grid cells across the diameter for illumination and pupil (default 64; 8-1024)")
+      ->check(CLI::Range(8, 1024));
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -72,6 +166,11 @@ int main(int argc, char** argv) {
     if (*info_cmd) return run_info(info, global);
     if (*lenses_cmd) return run_lenses(lenses, global);
     if (*convert_cmd) return run_convert(convert, global);
+    if (*seidel_cmd) return run_seidel(seidel, global);
+    if (*trace_cmd) return run_trace(trace, global);
+    if (*spot_cmd) return run_spot(spot, global);
+    if (*fan_cmd) return run_fan(fan, global);
+    if (*analyze_cmd) return run_analyze(analyze, global);
   } catch (const lensmith::ComputationError& e) {
     std::cerr << "lensmith: " << e.what() << "\n";
     return kExitComputation;

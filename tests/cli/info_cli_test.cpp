@@ -2,42 +2,15 @@
 // and the published first-order values of the shipped reference lenses.
 #include <catch2/catch.hpp>
 
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
-namespace {
+#include "run_lensmith.h"
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string out;  // stdout
-  std::string err;  // stderr
-};
-
-// Runs the lensmith binary with `args` (shell-quoted by the caller), capturing stdout and stderr.
-CommandResult run_lensmith(const std::string& args) {
-  namespace fs = std::filesystem;
-  const fs::path err_file = fs::temp_directory_path() / ("lensmith_cli_test_" + std::to_string(::getpid()) + ".err");
-  const std::string command = std::string(LENSMITH_CLI_PATH) + " " + args + " 2>" + err_file.string();
-  CommandResult result;
-  FILE* pipe = ::popen(command.c_str(), "r");
-  REQUIRE(pipe != nullptr);
-  std::array<char, 4096> buffer{};
-  std::size_t n = 0;
-  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) result.out.append(buffer.data(), n);
-  const int status = ::pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream err(err_file);
-  result.err.assign(std::istreambuf_iterator<char>(err), std::istreambuf_iterator<char>());
-  fs::remove(err_file);
-  return result;
-}
-
-}  // namespace
+using lensmith::testing::run_lensmith;
 
 TEST_CASE("lensmith info --json has every documented key, z measured from surface 1", "[cli]") {
   const auto r = run_lensmith("info sasian-triplet --json");

@@ -1,0 +1,51 @@
+// What `lensmith trace`, `spot`, `fan` and `analyze` share: command-line words to library options,
+// the plot font, and writing pictures without ever touching the input.
+#include <filesystem>
+#include <iostream>
+
+#include "commands.h"
+#include "lensmith/analysis/analysis_context.h"
+#include "lensmith/core/errors.h"
+#include "lensmith/plot/analysis_plots.h"
+
+namespace lensmith::cli {
+
+AnalysisOptions make_analysis_options(const RealRayCommandOptions& options) {
+  AnalysisOptions a;
+  a.relative_fields = options.relative_fields;
+  a.wavelengths_nm = options.wavelengths_nm;
+  a.max_field_angle_deg = options.field_angle_deg;
+  if (options.image == "paraxial") {
+    a.image_plane = TracerOptions::ImagePlane::ParaxialFocus;
+  } else if (options.image != "prescribed") {
+    throw OptionsError("--image " + options.image + ": must be prescribed or paraxial");
+  }
+  if (options.aim == "real") {
+    a.aiming = RayAiming::RealStop;
+  } else if (options.aim != "paraxial") {
+    throw OptionsError("--aim " + options.aim + ": must be paraxial or real");
+  }
+  return a;
+}
+
+plot::PlotOptions make_plot_options(const GlobalOptions& global) {
+  plot::PlotOptions o;
+  static bool warned = false;
+  if (!o.font_path && !global.quiet && !warned) {
+    std::cerr << "warning: DejaVuSans.ttf not found (install fonts-dejavu-core): the picture is drawn without text\n";
+    warned = true;
+  }
+  return o;
+}
+
+void write_picture(const plot::Canvas& canvas, const std::string& png, const std::string& lens, const GlobalOptions& global) {
+  std::error_code ec;
+  const std::string input_file = lens.substr(0, lens.rfind('#'));
+  if (std::filesystem::exists(input_file, ec) && std::filesystem::exists(png, ec) && std::filesystem::equivalent(input_file, png, ec)) {
+    throw IoError(png + ": is the input file; lensmith never overwrites its inputs");
+  }
+  canvas.write_png(png);
+  if (!global.quiet) std::cerr << "wrote " << png << " (" << canvas.width() << " x " << canvas.height() << ")\n";
+}
+
+}  // namespace lensmith::cli
