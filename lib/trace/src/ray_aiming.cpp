@@ -1,13 +1,17 @@
-// Rays from a field point and normalised pupil coordinates: aimed at the paraxial entrance pupil
-// (Welford, Aberrations of Optical Systems, sec. 4.6; Zemax without ray aiming), or by Newton's method on
-// the object-space aim point so the real ray crosses the stop at the requested point (Zemax "real" ray
-// aiming), with a finite-difference Jacobian. Where the rays start: docs/trace.md, "Ray aiming".
+// Rays from a field point and normalised pupil coordinates: aimed at the paraxial entrance pupil (Welford,
+// Aberrations of Optical Systems, sec. 4.6; Zemax without ray aiming), or at a point of the real stop (Zemax
+// "robust" ray aiming). Real-stop aiming traces backward from the stop point and solves, by damped Newton with
+// continuation in field and pupil (Allgower & Georg, Introduction to Numerical Continuation Methods, ch. 2),
+// for the stop-space direction whose ray leaves surface 1 along the requested object-space ray; a forward
+// Newton polish then puts the returned ray on the stop within the tolerance. Details: docs/trace.md, "Ray aiming".
 #include "lensmith/trace/ray_aiming.h"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <vector>
+
+#include <Eigen/Geometry>  // cross product
 
 #include "lensmith/core/errors.h"
 #include "lensmith/core/units.h"
@@ -21,16 +25,42 @@ namespace {
 constexpr double kStartMargin_mm = 1.0;
 // Samples of surface 1's sag when looking for its front-most point (aspheres need not be monotonic).
 constexpr int kFrontSamples = 64;
-// Finite-difference step of the aiming Jacobian, relative to the pupil size: the stop hit is accurate
-// to ~1e-14 mm, so the derivative is good to ~1e-8 and its truncation error to ~1e-6, enough for Newton
-// to gain six digits per iteration.
+
+// Real-stop aiming. The backward solve's residual is the difference of two unit vectors (the object-space
+// direction of the backward ray and the requested one), i.e. the angle between them in radians.
+// Converged: a hundred times the rounding of a 20-surface trace (~1e-14), so the forward polish starts within
+// ~1e-11 mm of the stop point and usually has nothing left to do.
+constexpr double kBackwardTolerance_rad = 1e-12;
+// A backward solve that stalls (rounding) this close still hands a usable start to the forward polish.
+constexpr double kBackwardUsable_rad = 1e-8;
+// Intermediate continuation steps only need to stay on the solution path.
+constexpr double kTrackingTolerance_rad = 1e-8;
+// Finite-difference step of the backward Jacobian in the stop-space tangent (~1): the residual is accurate to
+// ~1e-14, so the derivative is good to ~1e-7 and Newton still gains seven digits per step.
+constexpr double kTangentStep = 1e-7;
+// A backward Newton step moves the stop-space tangent by at most this (~27 degrees near the axis): a trust
+// region that keeps a nearly singular Jacobian from throwing the ray out of the lens.
+constexpr double kMaxTangentStep = 0.5;
+// Line search: Armijo's sufficient decrease on |residual|, at most this many halvings of the step.
+constexpr double kArmijo = 1e-4;
+constexpr int kMaxStepHalvings = 20;
+// Finite-difference step of the forward polish, relative to the pupil size: the stop hit is accurate to ~1e-14 mm,
+// so the derivative is good to ~1e-8, ample for the one step the polish usually needs, if any.
 constexpr double kJacobianRelativeStep = 1e-6;
-// A Newton step that kills the trace or increases the miss is halved at most this many times.
-constexpr int kMaxStepHalvings = 12;
-// Field continuation when the paraxial guess dies: steps of at most a quarter of the field, halved on
-// failure down to 1/1024 of it.
+// A ray whose next crossing lies this far (mm) behind the previous one runs backward between two surfaces: the
+// surfaces cross there (negative edge thickness), so no physical ray takes that path.
+constexpr double kSegmentSlack_mm = 1e-9;
+// Table of real chief rays from the stop centre (meridional plane, primary wavelength): stop-space angles
+// 0..kChiefTableMaxDeg in steps of kChiefTableStepDeg; it ends where the backward trace dies or folds.
+constexpr double kChiefTableStepDeg = 0.5;
+constexpr double kChiefTableMaxDeg = 85.0;
+// Continuation: first step, largest and smallest step of the path parameter (0..1). One solve (the direct
+// attempt or one continuation step) that has not converged after kCorrectorIterations Newton iterations has
+// failed: from a good start Newton needs 3 to 5.
 constexpr double kFirstContinuationStep = 0.25;
+constexpr double kMaxContinuationStep = 0.5;
 constexpr double kMinContinuationStep = 1.0 / 1024.0;
+constexpr int kCorrectorIterations = 12;
 
 // The sag of a surface at radius r (conic + even asphere); false outside its domain.
 bool surface_sag(const Surface& s, double r_mm, double& sag_mm) {
@@ -75,7 +105,583 @@ bool ray_through(const Beam& beam, double qx, double qy, double z_ep_mm, double 
   return true;
 }
 
+// Where the beams of the field points start (fixed per aimer).
+struct BeamGeometry {
+  double z_ep_mm = 0.0;
+  double object_distance_mm = kInfinity;
+  double front_z_mm = 0.0;
+  double beam_radius_mm = 0.0;
+};
+
+// The beam of `field` scaled by `fraction` (1 = the field asked for; smaller values serve the field
+// continuation of RealStop aiming).
+Beam beam_of(const FieldPoint& field, double fraction, const BeamGeometry& g) {
+  Beam beam;
+  const double z_object = -g.object_distance_mm;
+  switch (field.kind) {
+    case FieldPoint::Kind::AngleDeg: {
+      const Eigen::Vector3d d = Eigen::Vector3d(std::tan(rad_from_deg(fraction * field.x)),
+                                                std::tan(rad_from_deg(fraction * field.y)), 1.0)
+                                    .normalized();
+      if (std::isinf(g.object_distance_mm)) {
+        beam.parallel = true;
+        beam.direction = d;
+        // Far enough that a ray within beam_radius_mm of the chief ray starts kStartMargin_mm before the
+        // front of surface 1: its start z is at most z_ep + d_z (rho sin(theta) - L).
+        const double sin_theta = std::hypot(d.x(), d.y());
+        beam.wavefront_distance_mm =
+            g.beam_radius_mm * sin_theta + (g.z_ep_mm - g.front_z_mm + kStartMargin_mm) / d.z();
+      } else {
+        // A finite object: the object point is where the chief ray at this angle, through the EP centre,
+        // meets the object plane.
+        beam.parallel = false;
+        beam.origin = Eigen::Vector3d(0.0, 0.0, g.z_ep_mm) + d * ((z_object - g.z_ep_mm) / d.z());
+      }
+      break;
+    }
+    case FieldPoint::Kind::ObjectHeightMm:
+      // Object point at -h so that the chief ray rises like that of a positive angle (conventions.h).
+      beam.parallel = false;
+      beam.origin = Eigen::Vector3d(-fraction * field.x, -fraction * field.y, z_object);
+      break;
+    case FieldPoint::Kind::ObjectPoint:
+      beam.parallel = false;
+      beam.origin = Eigen::Vector3d(fraction * field.point_mm.x(), fraction * field.point_mm.y(), field.point_mm.z());
+      break;
+  }
+  return beam;
+}
+
+// An orthonormal pair (u1, u2) perpendicular to the unit vector n.
+void perpendicular_basis(const Eigen::Vector3d& n, Eigen::Vector3d& u1, Eigen::Vector3d& u2) {
+  const Eigen::Vector3d helper = std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  u1 = (helper - helper.dot(n) * n).normalized();
+  u2 = n.cross(u1);
+}
+
+// True when every refracting crossing of `path` lies ahead of the previous one along the ray (and, when `start` is
+// given, the first ahead of the start point along `start_direction`); else `surface` is the first crossing that lies
+// behind. Crossings of surfaces that do not refract (`refracts[k - 1]` false: a stop or dummy plane with the same
+// medium on both sides) are skipped: a ray may meet such a plane "behind" the previous surface (a flat stop at the
+// vertex of a convex surface) without leaving the straight line it is on.
+bool runs_forward(const std::vector<SurfaceHit>& path, const std::vector<char>& refracts, int& surface,
+                  const Eigen::Vector3d* start = nullptr, const Eigen::Vector3d* start_direction = nullptr) {
+  const Eigen::Vector3d* from = start;
+  const Eigen::Vector3d* along = start_direction;
+  for (const SurfaceHit& hit : path) {
+    if (!refracts[static_cast<std::size_t>(hit.surface) - 1]) continue;
+    if (from && (hit.point_mm - *from).dot(*along) < -kSegmentSlack_mm) {
+      surface = hit.surface;
+      return false;
+    }
+    from = &hit.point_mm;
+    along = &hit.direction_after;
+  }
+  return true;
+}
+
+// 2x2 solve J x = b by Cramer's rule; false when J is singular.
+bool solve_2x2(const Eigen::Vector2d& column_x, const Eigen::Vector2d& column_y, const Eigen::Vector2d& b,
+               Eigen::Vector2d& x) {
+  const double determinant = column_x.x() * column_y.y() - column_y.x() * column_x.y();
+  if (!(std::abs(determinant) > 0.0) || !std::isfinite(determinant)) return false;
+  x = Eigen::Vector2d((column_y.y() * b.x() - column_y.x() * b.y()) / determinant,
+                      (column_x.x() * b.y() - column_x.y() * b.x()) / determinant);
+  return x.allFinite();
+}
+
 }  // namespace
+
+// Everything real-stop aiming precomputes: the partial tracers, the paraxial map and the chief-ray table.
+struct RayAimer::StopSolver {
+  // One aiming problem: the beam of a field point, the stop point its ray must cross and the frame in which
+  // the object-space direction error is measured.
+  struct Target {
+    Beam beam;
+    Eigen::Vector2d stop_xy{0.0, 0.0};
+    Eigen::Vector3d stop_point_mm{0.0, 0.0, 0.0};  // on the stop surface
+    Eigen::Vector3d nominal{0.0, 0.0, 1.0};        // close to the ray's object-space direction
+    Eigen::Vector3d u1{1.0, 0.0, 0.0};             // perpendicular to nominal
+    Eigen::Vector3d u2{0.0, 1.0, 0.0};
+    bool valid = true;                             // false: the stop point lies outside the stop's sag domain
+  };
+  // The backward ray from the stop point with stop-space tangent v, in object space.
+  struct Backward {
+    RayStatus status = RayStatus::Ok;
+    int surface = 0;
+    Eigen::Vector2d residual{0.0, 0.0};   // (f - g).(u1, u2): f the ray's direction, g the requested one
+    Eigen::Vector3d on_first{0.0, 0.0, 0.0};  // where it leaves surface 1 (the stop point when stop = 1)
+    bool right_way = false;                   // f and g point along `nominal` (not each other's mirror image)
+    bool alive() const { return status == RayStatus::Ok; }
+  };
+  // One real chief ray of the table: stop-space tangent and the object-space ray (meridional plane y-z).
+  struct ChiefSample {
+    double tangent = 0.0;
+    double y1_mm = 0.0, z1_mm = 0.0;  // on surface 1
+    double fy = 0.0, fz = 1.0;        // forward object-space direction
+  };
+  enum class Outcome { Converged, Died, Stalled, OutOfIterations };
+  // The state of aiming one ray: its wavelength, a scratch path and the Newton iterations it has left
+  // (AimOptions::max_iterations over all its solves).
+  struct Work {
+    double wavelength_nm = 0.0;
+    std::vector<SurfaceHit> path;
+    int iterations_left = 0;
+  };
+
+  StopSolver(const SequentialTracer& tracer, const ParaxialSystem& paraxial, double stop_radius_mm, double ep_radius_mm,
+             const BeamGeometry& geometry, const AimOptions& options);
+
+  AimedRay aim(const FieldPoint& field, const Eigen::Vector2d& stop_xy, double wavelength_nm) const;
+
+  Target target(const Beam& beam, const Eigen::Vector2d& stop_xy) const;
+  Eigen::Vector2d guess(const Target& t) const;
+  Backward backward(const Target& t, const Eigen::Vector2d& v, Work& work) const;
+  Outcome newton(const Target& t, Eigen::Vector2d& v, Backward& at_v, double tolerance, int max_iterations,
+                 Work& work) const;
+  template <typename TargetAt>
+  bool follow(TargetAt target_at, Eigen::Vector2d& v, Backward& at_v, Work& work) const;
+  bool polish(const Target& t, const Backward& solved, Ray& ray, Work& work) const;
+  double signed_chief_tangent(const std::vector<double>& reach, double wanted) const;
+
+  int stop = 0;
+  AimOptions options;
+  BeamGeometry geometry;
+  double stop_radius_mm = 0.0;
+  double ep_radius_mm = 0.0;
+  Surface stop_surface;
+  double stop_vertex_z_mm = 0.0;
+  std::shared_ptr<const SequentialTracer> to_stop;      // surfaces 1..stop, apertures not clipped
+  std::shared_ptr<const SequentialTracer> before_stop;  // surfaces 1..stop-1, apertures not clipped; null at stop 1
+  // Paraxial map (primary wavelength) from (object-space slope u0, height y1 on the plane of vertex 1) to
+  // (slope arriving at the stop, height at the stop).
+  double m11 = 1.0, m12 = 0.0, m21 = 0.0, m22 = 1.0;
+  std::vector<char> refracts;            // per surface 1..stop: the index changes across it (else a stop or dummy)
+  std::vector<ChiefSample> chief;        // first branch of real chief rays (monotone field angle)
+  std::vector<double> chief_angle_rad;   // their object-space angles atan(fy / fz)
+};
+
+RayAimer::StopSolver::StopSolver(const SequentialTracer& tracer, const ParaxialSystem& paraxial, double stop_radius,
+                                 double ep_radius, const BeamGeometry& beam_geometry, const AimOptions& aim_options)
+    : stop(paraxial.stop_surface()),
+      options(aim_options),
+      geometry(beam_geometry),
+      stop_radius_mm(stop_radius),
+      ep_radius_mm(ep_radius) {
+  const Prescription& lens = tracer.lens();
+  const std::size_t stop_index = static_cast<std::size_t>(stop) - 1;
+  stop_surface = lens.surfaces[stop_index];
+  stop_vertex_z_mm = tracer.vertex_z_mm(stop);
+  // A surface refracts when the index changes across it at any of the F, d and C lines (a glass pair that happens
+  // to match at one wavelength still refracts at the others).
+  refracts.assign(static_cast<std::size_t>(stop), 0);
+  for (int k = 1; k <= stop; ++k) {
+    for (double w : {kWavelengthF_nm, kWavelengthD_nm, kWavelengthC_nm}) {
+      if (tracer.index_after(k - 1, w) != tracer.index_after(k, w)) refracts[static_cast<std::size_t>(k) - 1] = 1;
+    }
+  }
+
+  // The aiming traces ignore clear apertures: an intermediate guess may pass outside a rim that the converged
+  // ray clears (Zemax's ray aiming does the same); the caller's trace of the aimed ray clips.
+  TracerOptions unclipped;
+  unclipped.clip_apertures = false;
+  unclipped.image_distance_mm = 0.0;
+  Prescription to_stop_lens = lens;
+  to_stop_lens.surfaces.resize(static_cast<std::size_t>(stop));
+  to_stop_lens.surfaces.back().thickness_mm = 0.0;
+  to_stop_lens.image_at_paraxial_focus = false;
+  to_stop = std::make_shared<const SequentialTracer>(to_stop_lens, unclipped);
+  if (stop > 1) {
+    Prescription before = lens;
+    before.surfaces.resize(stop_index);
+    before.image_at_paraxial_focus = false;
+    // Without the stop an aperture that floats by it would not validate; the backward traces need no aperture.
+    before.aperture =
+        ApertureSpec{ApertureSpec::Kind::EntrancePupilDiameter, 2.0 * std::max({ep_radius, stop_radius, 1.0})};
+    before_stop = std::make_shared<const SequentialTracer>(before, unclipped);
+  }
+
+  // Paraxial map to the stop: refraction n' u' = n u - y (n' - n) c, transfer y += t u' (conventions.h).
+  const double wavelength = paraxial.wavelength_nm();
+  auto to_stop_paraxial = [&](double u, double y) {
+    double n = tracer.index_after(0, wavelength);
+    for (int k = 1; k < stop; ++k) {
+      const Surface& s = lens.surfaces[static_cast<std::size_t>(k) - 1];
+      const double n_after = tracer.index_after(k, wavelength);
+      u = (n * u - y * (n_after - n) * s.paraxial_curvature_per_mm()) / n_after;
+      y += s.thickness_mm * u;
+      n = n_after;
+    }
+    return Eigen::Vector2d(u, y);
+  };
+  const Eigen::Vector2d from_slope = to_stop_paraxial(1.0, 0.0);
+  const Eigen::Vector2d from_height = to_stop_paraxial(0.0, 1.0);
+  m11 = from_slope.x();
+  m21 = from_slope.y();
+  m12 = from_height.x();
+  m22 = from_height.y();
+
+  // Real chief rays from the stop centre, traced backward at increasing stop-space angles, until the trace
+  // dies, the ray no longer leaves toward the object, or its field angle stops growing (a fold: beyond it the
+  // stop centre is out of reach, see docs/trace.md).
+  if (stop > 1) {
+    std::vector<SurfaceHit> path;
+    double sign = 0.0;
+    for (double angle_deg = 0.0; angle_deg <= kChiefTableMaxDeg; angle_deg += kChiefTableStepDeg) {
+      const double alpha = rad_from_deg(angle_deg);
+      Ray ray;
+      ray.position_mm = Eigen::Vector3d(0.0, 0.0, stop_vertex_z_mm);
+      ray.direction = Eigen::Vector3d(0.0, -std::sin(alpha), -std::cos(alpha));
+      ray.wavelength_nm = wavelength;
+      const TraceResult r = before_stop->trace_backward(ray, &path);
+      const Eigen::Vector3d* start = refracts[stop_index] ? &ray.position_mm : nullptr;
+      int folded_at = 0;
+      if (!r.ok() || !runs_forward(path, refracts, folded_at, start, start ? &ray.direction : nullptr)) break;
+      const Eigen::Vector3d f = -r.ray.direction;
+      if (!(f.z() > 0.0)) break;
+      const double angle = std::atan2(f.y(), f.z());
+      if (chief.size() == 1) sign = angle > 0.0 ? 1.0 : (angle < 0.0 ? -1.0 : 0.0);
+      if (chief.size() >= 1 && (sign == 0.0 || sign * angle <= sign * chief_angle_rad.back())) break;
+      chief.push_back({std::tan(alpha), r.ray.position_mm.y(), r.ray.position_mm.z(), f.y(), f.z()});
+      chief_angle_rad.push_back(angle);
+    }
+  }
+}
+
+// The stop-space tangent (signed along the field's azimuth) of the table's chief ray whose `reach` (field
+// angle or object-plane height, one value per table entry, 0 at the first) equals `wanted` >= 0: the first
+// crossing along the monotone part of the table, or its end when `wanted` lies beyond it.
+double RayAimer::StopSolver::signed_chief_tangent(const std::vector<double>& reach, double wanted) const {
+  if (reach.size() < 2 || reach[1] == 0.0) return std::nan("");
+  const double sign = reach[1] > 0.0 ? 1.0 : -1.0;
+  for (std::size_t i = 1; i < reach.size(); ++i) {
+    const double here = sign * reach[i];
+    const double before = sign * reach[i - 1];
+    if (here <= before) return sign * chief[i - 1].tangent;  // the end of the monotone part
+    if (here >= wanted) {
+      const double s = (wanted - before) / (here - before);
+      return sign * (chief[i - 1].tangent + s * (chief[i].tangent - chief[i - 1].tangent));
+    }
+  }
+  return sign * chief.back().tangent;
+}
+
+RayAimer::StopSolver::Target RayAimer::StopSolver::target(const Beam& beam, const Eigen::Vector2d& stop_xy) const {
+  Target t;
+  t.beam = beam;
+  t.stop_xy = stop_xy;
+  double sag_mm = 0.0;
+  t.valid = surface_sag(stop_surface, stop_xy.norm(), sag_mm);
+  t.stop_point_mm = Eigen::Vector3d(stop_xy.x(), stop_xy.y(), stop_vertex_z_mm + sag_mm);
+  if (beam.parallel) {
+    t.nominal = beam.direction;
+  } else {
+    const Eigen::Vector3d to_pupil = Eigen::Vector3d(0.0, 0.0, geometry.z_ep_mm) - beam.origin;
+    t.nominal = to_pupil.norm() > 0.0 ? to_pupil.normalized() : Eigen::Vector3d::UnitZ();
+  }
+  perpendicular_basis(t.nominal, t.u1, t.u2);
+  return t;
+}
+
+// Start of the backward solve: the real chief ray of the field from the table (where the table reaches), plus
+// the paraxial change of stop-space slope for the offset of the stop point.
+Eigen::Vector2d RayAimer::StopSolver::guess(const Target& t) const {
+  Eigen::Vector2d chief_v(0.0, 0.0);
+  double per_stop_offset = 0.0;  // paraxial d(stop slope) / d(stop height) at a fixed field
+  if (t.beam.parallel) {
+    const Eigen::Vector3d& d = t.beam.direction;
+    const Eigen::Vector2d transverse(d.x(), d.y());
+    const double rho = transverse.norm();
+    per_stop_offset = m12 / m22;
+    if (rho > 0.0) {
+      const double tangent = signed_chief_tangent(chief_angle_rad, std::atan2(rho, d.z()));
+      // Paraxial chief ray: y_stop = 0 gives y1 = -m21 u0 / m22 and a stop slope (m11 - m12 m21 / m22) u0.
+      chief_v = std::isfinite(tangent) ? Eigen::Vector2d(tangent * transverse / rho)
+                                       : Eigen::Vector2d((m11 - m12 * m21 / m22) * transverse / d.z());
+    }
+  } else {
+    const Eigen::Vector3d& o = t.beam.origin;
+    const Eigen::Vector2d height(o.x(), o.y());
+    const double rho = height.norm();
+    const double z_o = o.z();
+    per_stop_offset = (m11 - m12 * z_o) / (m21 - m22 * z_o);
+    if (rho > 0.0) {
+      std::vector<double> reach(chief.size());
+      for (std::size_t i = 0; i < chief.size(); ++i) {
+        reach[i] = chief[i].y1_mm + (z_o - chief[i].z1_mm) * chief[i].fy / chief[i].fz;
+      }
+      const double tangent = signed_chief_tangent(reach, rho);
+      // Paraxial chief ray from height h at z_o: u0 = -m22 h / (m21 - m22 z_o), y1 = h - z_o u0.
+      const double u0 = -m22 / (m21 - m22 * z_o);
+      chief_v = std::isfinite(tangent) ? Eigen::Vector2d(tangent * height / rho)
+                                       : Eigen::Vector2d((m11 * u0 + m12 * (1.0 - z_o * u0)) * height);
+    }
+  }
+  const Eigen::Vector2d v = chief_v + per_stop_offset * t.stop_xy;
+  return v.allFinite() ? v : Eigen::Vector2d(0.0, 0.0);
+}
+
+RayAimer::StopSolver::Backward RayAimer::StopSolver::backward(const Target& t, const Eigen::Vector2d& v,
+                                                             Work& work) const {
+  Backward out;
+  const Eigen::Vector3d arriving = Eigen::Vector3d(v.x(), v.y(), 1.0).normalized();
+  Eigen::Vector3d f = arriving;
+  out.on_first = t.stop_point_mm;
+  if (before_stop) {
+    Ray ray;
+    ray.position_mm = t.stop_point_mm;
+    ray.direction = -arriving;
+    ray.wavelength_nm = work.wavelength_nm;
+    const TraceResult r = before_stop->trace_backward(ray, &work.path);
+    if (!r.ok()) {
+      out.status = r.status;
+      out.surface = r.surface;
+      return out;
+    }
+    const bool from_stop = refracts[static_cast<std::size_t>(stop) - 1];
+    if (!runs_forward(work.path, refracts, out.surface, from_stop ? &ray.position_mm : nullptr, &ray.direction)) {
+      out.status = RayStatus::Missed;
+      return out;
+    }
+    out.on_first = r.ray.position_mm;
+    f = -r.ray.direction;
+  }
+  Eigen::Vector3d g = t.beam.direction;
+  if (!t.beam.parallel) {
+    const Eigen::Vector3d from_object = out.on_first - t.beam.origin;
+    if (!(from_object.norm() > 0.0)) {
+      out.status = RayStatus::InvalidInput;
+      return out;
+    }
+    g = from_object.normalized();
+  }
+  const Eigen::Vector3d difference = f - g;
+  out.residual = Eigen::Vector2d(difference.dot(t.u1), difference.dot(t.u2));
+  // f - g perpendicular to `nominal` with both along it means f = g (the other root is g's mirror image).
+  out.right_way = f.dot(t.nominal) > 0.0 && g.dot(t.nominal) > 0.0;
+  if (!out.residual.allFinite()) out.status = RayStatus::NotConverged;
+  return out;
+}
+
+// Damped Newton on the backward residual from v (updated in place to the best point found), at most
+// max_iterations steps and no more than the ray has left.
+RayAimer::StopSolver::Outcome RayAimer::StopSolver::newton(const Target& t, Eigen::Vector2d& v, Backward& at_v,
+                                                          double tolerance, int max_iterations, Work& work) const {
+  at_v = backward(t, v, work);
+  if (!at_v.alive()) return Outcome::Died;
+  for (int iteration = 0;; ++iteration) {
+    const double size = at_v.residual.norm();
+    if (size <= tolerance) return at_v.right_way ? Outcome::Converged : Outcome::Stalled;
+    if (iteration >= max_iterations || work.iterations_left <= 0) return Outcome::OutOfIterations;
+    --work.iterations_left;
+    // Forward differences, or backward ones where the forward neighbour's trace dies (a ray near a rim).
+    Eigen::Vector2d columns[2];
+    for (int axis = 0; axis < 2; ++axis) {
+      Eigen::Vector2d offset(0.0, 0.0);
+      offset[axis] = kTangentStep;
+      Backward side = backward(t, v + offset, work);
+      if (!side.alive()) {
+        offset = -offset;
+        side = backward(t, v + offset, work);
+        if (!side.alive()) return Outcome::Stalled;
+      }
+      columns[axis] = (side.residual - at_v.residual) / offset[axis];
+    }
+    Eigen::Vector2d step;
+    if (!solve_2x2(columns[0], columns[1], -at_v.residual, step)) return Outcome::Stalled;
+    if (step.norm() > kMaxTangentStep) step *= kMaxTangentStep / step.norm();
+    bool moved = false;
+    double fraction = 1.0;
+    for (int halving = 0; halving <= kMaxStepHalvings; ++halving, fraction *= 0.5) {
+      const Eigen::Vector2d trial = v + fraction * step;
+      const Backward at_trial = backward(t, trial, work);
+      if (at_trial.alive() && at_trial.residual.norm() <= (1.0 - kArmijo * fraction) * size) {
+        v = trial;
+        at_v = at_trial;
+        moved = true;
+        break;
+      }
+    }
+    if (!moved) return Outcome::Stalled;
+  }
+}
+
+// Continuation: from the solution v of target_at(0) to that of target_at(1), in adaptive steps with a secant
+// predictor; intermediate steps are solved loosely, the last one to kBackwardTolerance_rad.
+template <typename TargetAt>
+bool RayAimer::StopSolver::follow(TargetAt target_at, Eigen::Vector2d& v, Backward& at_v, Work& work) const {
+  double reached = 0.0;
+  double previous_reached = 0.0;
+  Eigen::Vector2d previous_v = v;
+  bool have_previous = false;
+  double increment = kFirstContinuationStep;
+  while (reached < 1.0) {
+    const double next = std::min(1.0, reached + increment);
+    Eigen::Vector2d trial = v;
+    if (have_previous) trial += (next - reached) / (reached - previous_reached) * (v - previous_v);
+    Backward at_trial;
+    const bool last = next == 1.0;
+    const Outcome outcome = newton(target_at(next), trial, at_trial,
+                                   last ? kBackwardTolerance_rad : kTrackingTolerance_rad, kCorrectorIterations, work);
+    const bool usable = outcome == Outcome::Converged ||
+                        (last && outcome == Outcome::Stalled && at_trial.alive() && at_trial.right_way &&
+                         at_trial.residual.norm() <= kBackwardUsable_rad);
+    if (usable) {
+      previous_v = v;
+      previous_reached = reached;
+      have_previous = true;
+      v = trial;
+      at_v = at_trial;
+      reached = next;
+      increment = std::min(2.0 * increment, kMaxContinuationStep);
+    } else {
+      increment *= 0.5;
+      if (increment < kMinContinuationStep || work.iterations_left <= 0) return false;
+    }
+  }
+  return true;
+}
+
+// The forward ray from the backward solution, polished by Newton on its miss at the stop. Unknowns: for a
+// parallel beam the ray's offset in its start wavefront, for an object point the direction's components
+// perpendicular to `nominal`. True when the forward trace reaches the stop point within tolerance_mm along a
+// path that runs forward through every surface.
+bool RayAimer::StopSolver::polish(const Target& t, const Backward& solved, Ray& ray, Work& work) const {
+  const Eigen::Vector3d ep_centre(0.0, 0.0, geometry.z_ep_mm);
+  const Eigen::Vector3d wavefront_centre =
+      t.beam.parallel ? Eigen::Vector3d(ep_centre - t.beam.wavefront_distance_mm * t.beam.direction) : ep_centre;
+  auto make = [&](const Eigen::Vector2d& w) {
+    Ray r;
+    r.wavelength_nm = work.wavelength_nm;
+    if (t.beam.parallel) {
+      r.position_mm = wavefront_centre + w.x() * t.u1 + w.y() * t.u2;
+      r.direction = t.beam.direction;
+    } else {
+      r.position_mm = t.beam.origin;
+      r.direction = (t.nominal + w.x() * t.u1 + w.y() * t.u2).normalized();
+    }
+    return r;
+  };
+  const std::size_t stop_index = static_cast<std::size_t>(stop) - 1;
+  auto miss = [&](const Eigen::Vector2d& w, Eigen::Vector2d& residual) {
+    const Ray r = make(w);
+    to_stop->trace_forward(r, &work.path);
+    if (work.path.size() <= stop_index) return false;
+    int behind = 0;
+    if (!runs_forward(work.path, refracts, behind)) return false;
+    residual = Eigen::Vector2d(work.path[stop_index].point_mm.x(), work.path[stop_index].point_mm.y()) - t.stop_xy;
+    return residual.allFinite();
+  };
+
+  Eigen::Vector2d w;
+  double step = kJacobianRelativeStep * std::max(ep_radius_mm, stop_radius_mm);
+  if (t.beam.parallel) {
+    const Eigen::Vector3d offset = solved.on_first - wavefront_centre;
+    w = Eigen::Vector2d(offset.dot(t.u1), offset.dot(t.u2));
+  } else {
+    const Eigen::Vector3d g = (solved.on_first - t.beam.origin).normalized();
+    w = Eigen::Vector2d(g.dot(t.u1), g.dot(t.u2)) / g.dot(t.nominal);
+    step /= std::max((ep_centre - t.beam.origin).norm(), std::max(ep_radius_mm, stop_radius_mm));
+  }
+  Eigen::Vector2d residual;
+  if (!miss(w, residual)) return false;
+  for (;;) {
+    const double size = residual.norm();
+    if (size <= options.tolerance_mm) break;
+    if (work.iterations_left <= 0) return false;
+    --work.iterations_left;
+    Eigen::Vector2d columns[2];
+    for (int axis = 0; axis < 2; ++axis) {
+      Eigen::Vector2d offset(0.0, 0.0);
+      offset[axis] = step;
+      Eigen::Vector2d side;
+      if (!miss(w + offset, side)) {
+        offset = -offset;
+        if (!miss(w + offset, side)) return false;
+      }
+      columns[axis] = (side - residual) / offset[axis];
+    }
+    Eigen::Vector2d newton_step;
+    if (!solve_2x2(columns[0], columns[1], -residual, newton_step)) return false;
+    bool moved = false;
+    double fraction = 1.0;
+    for (int halving = 0; halving <= kMaxStepHalvings; ++halving, fraction *= 0.5) {
+      Eigen::Vector2d trial_residual;
+      const Eigen::Vector2d trial = w + fraction * newton_step;
+      if (miss(trial, trial_residual) && trial_residual.norm() < size) {
+        w = trial;
+        residual = trial_residual;
+        moved = true;
+        break;
+      }
+    }
+    if (!moved) return false;
+  }
+  ray = make(w);
+  return true;
+}
+
+AimedRay RayAimer::StopSolver::aim(const FieldPoint& field, const Eigen::Vector2d& stop_xy,
+                                   double wavelength_nm) const {
+  AimedRay out;
+  Work work;
+  work.wavelength_nm = wavelength_nm;
+  work.path.reserve(static_cast<std::size_t>(stop));
+  work.iterations_left = options.max_iterations;
+  const Target wanted = target(beam_of(field, 1.0, geometry), stop_xy);
+  if (!wanted.valid) {
+    out.status = RayStatus::Missed;  // the point is not on the stop surface (beyond its sag's domain)
+    out.surface = stop;
+    return out;
+  }
+  auto usable = [](Outcome outcome, const Backward& b) {
+    return outcome == Outcome::Converged ||
+           (outcome == Outcome::Stalled && b.alive() && b.right_way && b.residual.norm() <= kBackwardUsable_rad);
+  };
+  auto accept = [&](const Backward& solved) {
+    if (!polish(wanted, solved, out.ray, work)) return false;
+    out.status = RayStatus::Ok;
+    out.surface = 0;
+    return true;
+  };
+
+  // 1. Directly from the table's chief ray and the paraxial pupil offset.
+  Eigen::Vector2d v = guess(wanted);
+  Backward solved;
+  const Outcome direct = newton(wanted, v, solved, kBackwardTolerance_rad, kCorrectorIterations, work);
+  if (usable(direct, solved) && accept(solved)) return out;
+  // If nothing works, the caller hears how the direct attempt failed: the status of its dying trace, or
+  // NotConverged at the stop (also whenever the iteration budget ran out).
+  auto failure = [&]() {
+    const bool died = direct == Outcome::Died && work.iterations_left > 0;
+    out.status = died ? solved.status : RayStatus::NotConverged;
+    out.surface = died ? solved.surface : stop;
+    return out;
+  };
+
+  // 2. Pupil continuation: from this field's chief ray (through the stop centre) out to the stop point.
+  if (stop_xy.x() != 0.0 || stop_xy.y() != 0.0) {
+    const Target centre = target(wanted.beam, Eigen::Vector2d(0.0, 0.0));
+    Eigen::Vector2d chief_v = guess(centre);
+    Backward at_chief;
+    if (usable(newton(centre, chief_v, at_chief, kTrackingTolerance_rad, kCorrectorIterations, work), at_chief) &&
+        follow([&](double s) { return target(wanted.beam, s * stop_xy); }, chief_v, at_chief, work) &&
+        accept(at_chief)) {
+      return out;
+    }
+  }
+
+  // 3. Field continuation: from the axis (where the paraxial start is good) out to the field, at this stop point.
+  const Target on_axis = target(beam_of(field, 0.0, geometry), stop_xy);
+  Eigen::Vector2d axis_v = guess(on_axis);
+  Backward at_axis;
+  if (usable(newton(on_axis, axis_v, at_axis, kTrackingTolerance_rad, kCorrectorIterations, work), at_axis) &&
+      follow([&](double s) { return target(beam_of(field, s, geometry), stop_xy); }, axis_v, at_axis, work) &&
+      accept(at_axis)) {
+    return out;
+  }
+  return failure();
+}
 
 void AimOptions::validate() const {
   if (!(std::isfinite(tolerance_mm) && tolerance_mm > 0.0)) {
@@ -123,16 +729,12 @@ RayAimer::RayAimer(const SequentialTracer& tracer, const AimOptions& options)
   front_z_mm_ = tracer_.vertex_z_mm(1) + lowest_sag_mm;
   beam_radius_mm_ = std::max(ep_radius_mm, front_radius_mm);
 
-  // RealStop traces only to the stop and ignores clear apertures: an intermediate guess may pass outside
-  // a rim that the converged ray clears (Zemax's ray aiming does the same).
-  Prescription to_stop = lens;
-  to_stop.surfaces.resize(static_cast<std::size_t>(stop));
-  to_stop.surfaces.back().thickness_mm = 0.0;
-  to_stop.image_at_paraxial_focus = false;
-  TracerOptions unclipped;
-  unclipped.clip_apertures = false;
-  unclipped.image_distance_mm = 0.0;
-  to_stop_ = std::make_shared<const SequentialTracer>(to_stop, unclipped);
+  if (options_.aiming == RayAiming::RealStop) {
+    const BeamGeometry geometry{paraxial_.entrance_pupil().z_mm, paraxial_.object_distance_mm(), front_z_mm_,
+                                beam_radius_mm_};
+    stop_solver_ =
+        std::make_shared<const StopSolver>(tracer_, paraxial_, stop_radius_mm_, ep_radius_mm, geometry, options_);
+  }
 }
 
 FieldPoint RayAimer::field_at(double relative) const {
@@ -174,7 +776,6 @@ AimedRay RayAimer::make_ray(const FieldPoint& field, const PupilCoordinate& pupi
   const double z_ep = paraxial_.entrance_pupil().z_mm;
   const double ep_radius = 0.5 * paraxial_.entrance_pupil().diameter_mm;
   const double object_distance = paraxial_.object_distance_mm();
-  const double z_object = -object_distance;
 
   if (field.kind == FieldPoint::Kind::AngleDeg && !(std::abs(field.x) < 90.0 && std::abs(field.y) < 90.0)) {
     out.status = RayStatus::InvalidInput;
@@ -184,152 +785,24 @@ AimedRay RayAimer::make_ray(const FieldPoint& field, const PupilCoordinate& pupi
     throw OptionsError("FieldPoint " + field.to_string() +
                        ": an object-height field needs a finite object distance (the object is at infinity)");
   }
-  // The beam of the field scaled by `fraction` (1 = the field asked for; smaller values serve the field
-  // continuation of RealStop aiming below).
-  auto make_beam = [&](double fraction) {
-    Beam beam;
-    switch (field.kind) {
-      case FieldPoint::Kind::AngleDeg: {
-        const Eigen::Vector3d d = Eigen::Vector3d(std::tan(rad_from_deg(fraction * field.x)),
-                                                  std::tan(rad_from_deg(fraction * field.y)), 1.0)
-                                      .normalized();
-        if (std::isinf(object_distance)) {
-          beam.parallel = true;
-          beam.direction = d;
-          // Far enough that a ray within beam_radius_mm_ of the chief ray starts kStartMargin_mm before the
-          // front of surface 1: its start z is at most z_ep + d_z (rho sin(theta) - L).
-          const double sin_theta = std::hypot(d.x(), d.y());
-          beam.wavefront_distance_mm = beam_radius_mm_ * sin_theta + (z_ep - front_z_mm_ + kStartMargin_mm) / d.z();
-        } else {
-          // A finite object: the object point is where the chief ray at this angle, through the EP centre,
-          // meets the object plane.
-          beam.parallel = false;
-          beam.origin = Eigen::Vector3d(0.0, 0.0, z_ep) + d * ((z_object - z_ep) / d.z());
-        }
-        break;
-      }
-      case FieldPoint::Kind::ObjectHeightMm:
-        // Object point at -h so that the chief ray rises like that of a positive angle (conventions.h).
-        beam.parallel = false;
-        beam.origin = Eigen::Vector3d(-fraction * field.x, -fraction * field.y, z_object);
-        break;
-      case FieldPoint::Kind::ObjectPoint:
-        beam.parallel = false;
-        beam.origin = Eigen::Vector3d(fraction * field.point_mm.x(), fraction * field.point_mm.y(), field.point_mm.z());
-        break;
-    }
-    return beam;
-  };
-  const Beam beam = make_beam(1.0);
-
+  const BeamGeometry geometry{z_ep, object_distance, front_z_mm_, beam_radius_mm_};
+  const Beam beam = beam_of(field, 1.0, geometry);
+  // The paraxial-pupil ray: the answer of ParaxialEntrancePupil aiming, and the reference ray of a failed real aim.
+  const bool through_pupil =
+      ray_through(beam, pupil.px * ep_radius, pupil.py * ep_radius, z_ep, wavelength_nm, out.ray);
   if (options_.aiming == RayAiming::ParaxialEntrancePupil) {
-    if (!ray_through(beam, pupil.px * ep_radius, pupil.py * ep_radius, z_ep, wavelength_nm, out.ray)) {
-      out.status = RayStatus::InvalidInput;
-    }
+    if (!through_pupil) out.status = RayStatus::InvalidInput;
     return out;
   }
 
-  // RealStop: find the EP-plane point q whose real ray meets the stop at the target.
-  const int stop = paraxial_.stop_surface();
-  const std::size_t stop_index = static_cast<std::size_t>(stop) - 1;
-  const Eigen::Vector2d target(pupil.px * stop_radius_mm_, pupil.py * stop_radius_mm_);
-  std::vector<SurfaceHit> path;
-  path.reserve(static_cast<std::size_t>(stop));
-  RayStatus dead_status = RayStatus::Ok;
-  int dead_surface = 0;
-  // The miss on the stop for the ray of `b` through q; false (with the status) when it does not reach the stop.
-  auto miss = [&](const Beam& b, const Eigen::Vector2d& q, Eigen::Vector2d& residual) {
-    Ray ray;
-    if (!ray_through(b, q.x(), q.y(), z_ep, wavelength_nm, ray)) {
-      dead_status = RayStatus::InvalidInput;
-      dead_surface = 0;
-      return false;
-    }
-    const TraceResult result = to_stop_->trace_forward(ray, &path);
-    if (path.size() <= stop_index) {
-      dead_status = result.status;
-      dead_surface = result.surface;
-      return false;
-    }
-    residual = Eigen::Vector2d(path[stop_index].point_mm.x(), path[stop_index].point_mm.y()) - target;
-    return true;
-  };
-
-  // Damped Newton from q (updated in place), at most options_.max_iterations steps.
-  enum class Outcome { Converged, Died, NotConverged };
-  const double step = kJacobianRelativeStep * std::max(ep_radius, stop_radius_mm_);
-  auto solve = [&](const Beam& b, Eigen::Vector2d& q) {
-    Eigen::Vector2d residual;
-    if (!miss(b, q, residual)) return Outcome::Died;
-    if (residual.norm() <= options_.tolerance_mm) return Outcome::Converged;
-    for (int iteration = 0; iteration < options_.max_iterations; ++iteration) {
-      Eigen::Vector2d residual_x;
-      Eigen::Vector2d residual_y;
-      if (!miss(b, q + Eigen::Vector2d(step, 0.0), residual_x) || !miss(b, q + Eigen::Vector2d(0.0, step), residual_y)) {
-        return Outcome::Died;
-      }
-      // Forward-difference Jacobian J = d(stop hit) / d(q); Newton step -J^-1 residual by Cramer's rule.
-      const Eigen::Vector2d dx = (residual_x - residual) / step;
-      const Eigen::Vector2d dy = (residual_y - residual) / step;
-      const double determinant = dx.x() * dy.y() - dy.x() * dx.y();
-      if (!(std::abs(determinant) > 0.0) || !std::isfinite(determinant)) return Outcome::NotConverged;
-      const Eigen::Vector2d newton_step((dx.y() * residual.y() - dy.y() * residual.x()) / determinant,
-                                        (dy.x() * residual.x() - dx.x() * residual.y()) / determinant);
-      // Damped step: halve while the trace dies or the miss grows.
-      double fraction = 1.0;
-      bool moved = false;
-      for (int halving = 0; halving <= kMaxStepHalvings; ++halving, fraction *= 0.5) {
-        Eigen::Vector2d trial_residual;
-        const Eigen::Vector2d trial = q + fraction * newton_step;
-        if (!miss(b, trial, trial_residual)) continue;
-        if (trial_residual.norm() < residual.norm() || halving == kMaxStepHalvings) {
-          q = trial;
-          residual = trial_residual;
-          moved = true;
-          break;
-        }
-      }
-      if (!moved) return Outcome::Died;
-      if (residual.norm() <= options_.tolerance_mm) return Outcome::Converged;
-    }
-    return Outcome::NotConverged;
-  };
-
-  auto finish = [&](RayStatus status, int surface, const Eigen::Vector2d& q) {
-    out.status = status;
-    out.surface = surface;
-    if (!ray_through(beam, q.x(), q.y(), z_ep, wavelength_nm, out.ray)) out.status = RayStatus::InvalidInput;
+  const AimedRay aimed =
+      stop_solver_->aim(field, Eigen::Vector2d(pupil.px * stop_radius_mm_, pupil.py * stop_radius_mm_), wavelength_nm);
+  if (!aimed.ok()) {
+    out.status = aimed.status;
+    out.surface = aimed.surface;
     return out;
-  };
-
-  // Start from the paraxial image of the target in the entrance pupil (signed magnification).
-  const Eigen::Vector2d paraxial_guess = paraxial_.entrance_pupil().magnification * target;
-  Eigen::Vector2d q = paraxial_guess;
-  const Outcome direct = solve(beam, q);
-  if (direct == Outcome::Converged) return finish(RayStatus::Ok, 0, q);
-  if (direct == Outcome::NotConverged) return finish(RayStatus::NotConverged, stop, q);
-
-  // The paraxial guess is too far off for Newton (pupil aberration of wide-angle and fisheye lenses): follow
-  // the solution from the axis out to the field in adaptive steps, each started from the last solution.
-  const RayStatus first_status = dead_status;
-  const int first_surface = dead_surface;
-  Eigen::Vector2d followed = paraxial_guess;
-  if (solve(make_beam(0.0), followed) != Outcome::Converged) return finish(first_status, first_surface, q);
-  double reached = 0.0;
-  double increment = kFirstContinuationStep;
-  while (reached < 1.0) {
-    const double next = std::min(1.0, reached + increment);
-    Eigen::Vector2d trial = followed;
-    if (solve(make_beam(next), trial) == Outcome::Converged) {
-      followed = trial;
-      reached = next;
-      increment = std::min(2.0 * increment, kFirstContinuationStep);
-    } else {
-      increment *= 0.5;
-      if (increment < kMinContinuationStep) return finish(first_status, first_surface, q);
-    }
   }
-  return finish(RayStatus::Ok, 0, followed);
+  return aimed;
 }
 
 }  // namespace lensmith

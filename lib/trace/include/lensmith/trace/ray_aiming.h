@@ -47,21 +47,30 @@ struct PupilCoordinate {
 
 enum class RayAiming {
   ParaxialEntrancePupil,  // aim at (px, py) * EP radius on the paraxial entrance-pupil plane
-  RealStop,               // iterate until the real ray crosses the stop surface at (px, py) * stop radius
+  // Solve for the real ray that crosses the stop surface at (px, py) * stop radius: backward from the stop point
+  // by damped Newton on its stop-space direction, with continuation in pupil and field, then a forward check
+  // (docs/trace.md, "Real-stop aiming"). Fails cleanly where no physical ray exists.
+  RealStop,
 };
 
 struct AimOptions {
   RayAiming aiming = RayAiming::ParaxialEntrancePupil;
-  double tolerance_mm = 1e-10;  // RealStop: accepted miss on the stop surface
-  int max_iterations = 50;      // RealStop: Newton iterations (>= 1)
-  void validate() const;        // throws OptionsError
+  // RealStop: accepted miss (mm) of the returned ray on the stop surface, checked by a forward trace. The
+  // backward solve that finds the ray (docs/trace.md, "Real-stop aiming") has its own angular tolerance; only
+  // this forward miss decides whether a ray is returned.
+  double tolerance_mm = 1e-10;
+  // RealStop: Newton iterations one ray may use over all its solves (direct attempt, continuation steps, forward
+  // check); NotConverged when they run out (>= 1).
+  int max_iterations = 50;
+  void validate() const;  // throws OptionsError
 };
 
 // The result of making a ray: the ray in object space, starting a little before surface 1 (or at
-// the object point), or a status saying why it could not be aimed.
+// the object point), or a status saying why it could not be aimed (then `ray` is the paraxial-pupil ray of
+// the request, for reference only: it does not cross the stop at the requested point).
 struct AimedRay {
-  RayStatus status = RayStatus::Ok;  // NotConverged when real aiming failed
-  int surface = 0;                   // where an aiming trace died, 0 when ok
+  RayStatus status = RayStatus::Ok;  // NotConverged when real aiming failed, or the status of the dying trace
+  int surface = 0;                   // where an aiming trace died (NotConverged: the stop), 0 when ok
   Ray ray;
   bool ok() const { return status == RayStatus::Ok; }
 };
@@ -89,7 +98,10 @@ class RayAimer {
   // Implementation-defined members (ray_aiming.cpp).
   double front_z_mm_ = 0.0;      // front-most z of surface 1 within its clear aperture (<= 0)
   double beam_radius_mm_ = 0.0;  // radius used to place the start wavefront of an angle field before surface 1
-  std::shared_ptr<const SequentialTracer> to_stop_;  // surfaces 1..stop, apertures not clipped (RealStop)
+  // RealStop only (null otherwise): the partial tracers to and from the stop, the paraxial map from object space
+  // to the stop and the table of real chief rays that start each solve (ray_aiming.cpp).
+  struct StopSolver;
+  std::shared_ptr<const StopSolver> stop_solver_;
 };
 
 }  // namespace lensmith
