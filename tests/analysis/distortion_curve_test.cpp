@@ -71,7 +71,7 @@ TEST_CASE("a lens symmetric about its stop at magnification -1 has no distortion
   INFO(d);
   // Mirror symmetry holds to rounding; 1e-8 % of a 6 mm height is 6e-10 mm.
   constexpr double kSymmetryPercent = 1e-8;
-  CHECK_THAT(d.points.back().paraxial_height_mm, WithinAbs(6.0, 1e-9));  // m = -1 of the object at y = -6
+  CHECK_THAT(d.points.back().paraxial_height_mm, WithinAbs(-6.0, 1e-9));  // m = -1 of the object at y = +6
   for (const DistortionPoint& p : d.points) CHECK_THAT(p.distortion_percent, WithinAbs(0.0, kSymmetryPercent));
 
   // The control: the same lens with the object at infinity is not symmetric and distorts.

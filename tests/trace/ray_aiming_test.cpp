@@ -393,10 +393,12 @@ TEST_CASE("paraxial-pupil aiming: each ray crosses the pupil plane at (px, py) x
   }
 }
 
-TEST_CASE("a finite object: object-height rays start at y = -h on the object plane and reproduce the paraxial rays in the small limit",
+TEST_CASE("a finite object: object-height rays start at y = +h on the object plane (as in Zemax) and reproduce the paraxial rays in the small limit",
           "[aiming]") {
-  // Smith's triplet focused on an object 1 m in front, with an object-height field of 100 mm: conventions.h
-  // puts the object point at y = -100 so the chief ray rises in object space and the image lands at y > 0.
+  // Smith's triplet focused on an object 1 m in front, with an object-height field of 100 mm. The paraxial
+  // chief-ray table follows conventions.h (a rising chief ray: object point at y = -100, image at y > 0);
+  // FieldPoint::object_height_mm(h) puts the object point at y = +h as Zemax does, so the paraxial table is
+  // reproduced by the height -h.
   Prescription lens = smith_cooke_triplet();
   lens.object_distance_mm = 1000.0;
   lens.field = FieldSpec{FieldSpec::Kind::ObjectHeightMm, {100.0}};
@@ -408,14 +410,14 @@ TEST_CASE("a finite object: object-height rays start at y = -h on the object pla
 
   const AimedRay full = aimer.make_ray(aimer.field_at(1.0), {0.0, 0.0}, kWavelengthD_nm);
   REQUIRE(full.ok());
-  CHECK(full.ray.position_mm == Eigen::Vector3d(0.0, -100.0, -1000.0));
+  CHECK(full.ray.position_mm == Eigen::Vector3d(0.0, 100.0, -1000.0));
 
   std::vector<SurfaceHit> path;
   for (double s : {1e-4, 1e-5}) {
     const double height_tolerance = kThirdOrderHeight_mm * s * s + kDividedRounding;
     const double slope_tolerance = kThirdOrderSlope * s * s + kDividedRounding;
     const ParaxialRayTable* tables[] = {&*paraxial.chief_ray(), &paraxial.marginal_ray()};
-    const AimedRay rays[] = {aimer.make_ray(FieldPoint::object_height_mm(s * 100.0), {0.0, 0.0}, kWavelengthD_nm),
+    const AimedRay rays[] = {aimer.make_ray(FieldPoint::object_height_mm(-s * 100.0), {0.0, 0.0}, kWavelengthD_nm),
                              aimer.make_ray(FieldPoint::object_height_mm(0.0), {0.0, s}, kWavelengthD_nm)};
     for (int which = 0; which < 2; ++which) {
       INFO((which == 0 ? "chief" : "marginal") << " ray, s = " << s);
@@ -654,7 +656,7 @@ TEST_CASE("real-stop aiming from a near object point: a fisheye 100 mm away, obj
       const AimedRay ray = aimer.make_ray(FieldPoint::object_height_mm(height), pupil, kWavelengthD_nm);
       INFO(to_string(ray.status) << " at surface " << ray.surface);
       check_on_stop(tracer, aimer, ray, pupil);
-      CHECK(ray.ray.position_mm == Eigen::Vector3d(0.0, -height, -100.0));  // from the object point (conventions.h)
+      CHECK(ray.ray.position_mm == Eigen::Vector3d(0.0, height, -100.0));  // from the object point (+h, as in Zemax)
     }
   }
 }

@@ -140,9 +140,9 @@ Beam beam_of(const FieldPoint& field, double fraction, const BeamGeometry& g) {
       break;
     }
     case FieldPoint::Kind::ObjectHeightMm:
-      // Object point at -h so that the chief ray rises like that of a positive angle (conventions.h).
+      // The object point is at (x, y), as in Zemax's object-height fields.
       beam.parallel = false;
-      beam.origin = Eigen::Vector3d(-fraction * field.x, -fraction * field.y, z_object);
+      beam.origin = Eigen::Vector3d(fraction * field.x, fraction * field.y, z_object);
       break;
     case FieldPoint::Kind::ObjectPoint:
       beam.parallel = false;
@@ -754,8 +754,8 @@ FieldPoint RayAimer::field_at(double relative) const {
       const ParaxialRayTable& chief = *paraxial_.chief_ray();
       const double slope = relative * chief.object_slope;
       if (at_infinity) return FieldPoint::angle_deg(deg_from_rad(std::atan(slope)));
-      // An object-height field h puts the object point at y = -h (conventions.h), on the chief ray.
-      return FieldPoint::object_height_mm(slope * (paraxial_.object_distance_mm() + paraxial_.entrance_pupil().z_mm));
+      // The object point on the chief ray of this slope: below the axis for a rising chief ray.
+      return FieldPoint::object_height_mm(-slope * (paraxial_.object_distance_mm() + paraxial_.entrance_pupil().z_mm));
     }
   }
   return FieldPoint::angle_deg(0.0);

@@ -19,8 +19,8 @@ struct FieldPoint {
   enum class Kind {
     AngleDeg,        // x_angle_deg, y_angle_deg: direction (tan x, tan y, 1) normalised; object at infinity
                      // (for a finite object: the object-plane point on the chief ray at that angle)
-    ObjectHeightMm,  // x, y object height at the prescription's (finite) object plane; the object point is
-                     // at (-x, -y) so that the chief ray rises like a positive angle's (docs/paraxial.md)
+    ObjectHeightMm,  // x, y object height at the prescription's (finite) object plane: the object point is
+                     // at (x, y), as in Zemax (its chief ray falls; the image of a real lens lands at -y)
     ObjectPoint,     // an explicit object point in the global frame (mm), any z before surface 1
   };
   Kind kind = Kind::AngleDeg;
