@@ -31,6 +31,18 @@ bool looks_like_lentil(std::string_view text) {
 
 }  // namespace
 
+void resolve_and_validate(Prescription& lens, const GlassCatalog& catalogue, const std::string& file,
+                          const std::function<int(const std::string& message)>& line_of) {
+  try {
+    lens.resolve_materials(catalogue);
+    lens.validate();
+  } catch (const GlassError& e) {
+    throw LensFileError(SourceLocation{file, line_of(e.what()), 0}, e.what());
+  } catch (const PrescriptionError& e) {
+    throw LensFileError(SourceLocation{file, line_of(e.what()), 0}, e.what());
+  }
+}
+
 LensFormat lens_format_from_path(const std::string& path) {
   const std::string ext = lower_extension(path.substr(0, path.find('#')));
   if (ext == ".json") return LensFormat::Json;

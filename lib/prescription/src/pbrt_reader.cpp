@@ -263,18 +263,9 @@ class PbrtParser {
     p.image_at_paraxial_focus = true;
     p.aperture = ApertureSpec{ApertureSpec::Kind::FloatByStop, 0.0};
 
-    try {
-      // Only air and model glasses occur, so no catalogue is needed (or loaded).
-      const GlassCatalog no_catalogue{};
-      p.resolve_materials(no_catalogue);
-    } catch (const GlassError& e) {
-      throw LensFileError(SourceLocation{file_, line_for_message(e.what()), 0}, e.what());
-    }
-    try {
-      p.validate();
-    } catch (const PrescriptionError& e) {
-      throw LensFileError(SourceLocation{file_, line_for_message(e.what()), 0}, e.what());
-    }
+    // Only air and model glasses occur, so no catalogue is needed (or loaded).
+    const GlassCatalog no_catalogue{};
+    resolve_and_validate(p, no_catalogue, file_, [this](const std::string& m) { return line_for_message(m); });
     return result;
   }
 

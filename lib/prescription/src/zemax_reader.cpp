@@ -739,16 +739,7 @@ class ZemaxParser {
     set_field(p);
     set_wavelengths(p);
 
-    try {
-      p.resolve_materials(catalogue_);
-    } catch (const GlassError& e) {
-      throw LensFileError(SourceLocation{file_, line_for_prescription_message(e.what()), 0}, e.what());
-    }
-    try {
-      p.validate();
-    } catch (const PrescriptionError& e) {
-      throw LensFileError(SourceLocation{file_, line_for_prescription_message(e.what()), 0}, e.what());
-    }
+    resolve_and_validate(p, catalogue_, file_, [this](const std::string& m) { return line_for_prescription_message(m); });
     for (const auto& [keyword, u] : unknown_) {
       warn(u.first_line, "unknown keyword " + keyword + " ignored" +
                              (u.count > 1 ? " (" + std::to_string(u.count) + " lines)" : std::string()));
