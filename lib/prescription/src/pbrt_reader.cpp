@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "lensmith/core/errors.h"
+#include "lensmith/core/number_parsing.h"
 
 namespace lensmith {
 namespace {
@@ -50,15 +51,6 @@ std::string format_number(double v) {
   return ec == std::errc() ? std::string(buffer, end) : std::string("?");
 }
 
-// Whole token as a finite decimal number; "nan", "inf", "1.#INF" and out-of-range values fail.
-std::optional<double> parse_finite(std::string_view s) {
-  if (s.size() >= 2 && s.front() == '+' && s[1] != '-' && s[1] != '+') s.remove_prefix(1);
-  if (s.empty()) return std::nullopt;
-  double v = 0.0;
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v, std::chars_format::general);
-  if (ec != std::errc() || end != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
-  return v;
-}
 
 struct Row {
   int line = 0;
@@ -94,7 +86,7 @@ std::optional<double> number_before(std::string_view s, std::size_t end) {
   std::size_t start = head.size();
   while (start > 0 && ((head[start - 1] >= '0' && head[start - 1] <= '9') || head[start - 1] == '.')) --start;
   if (start == head.size()) return std::nullopt;
-  return parse_finite(head.substr(start));
+  return parse_finite_number(head.substr(start));
 }
 
 // Half field angle (degrees) from a header such as "D-GAUSS F/2 22deg HFOV" (half field) or
@@ -170,7 +162,7 @@ class PbrtParser {
       if (count >= kColumns) {
         fail(number, column, "expected 4 columns (radius, thickness, index, aperture diameter), found more");
       }
-      auto v = parse_finite(token);
+      auto v = parse_finite_number(token);
       if (!v) fail(number, column, "expected a finite number, got \"" + shown(token) + "\"");
       row.value[count] = *v;
       row.column[count] = column;

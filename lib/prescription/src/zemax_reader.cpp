@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "lensmith/core/errors.h"
+#include "lensmith/core/number_parsing.h"
 #include "lensmith/core/text_file.h"
 #include "lensmith/core/units.h"
 
@@ -104,16 +105,6 @@ std::string format_number(double v) {
   return std::string(buffer, end);
 }
 
-// Parses a whole token as a finite decimal number. Rejects what OpticStudio and C runtimes write
-// for overflow or invalid values ("1.#INF", "-1.#IND", "nan", "inf") and anything out of range.
-std::optional<double> parse_finite(std::string_view s) {
-  if (s.size() >= 2 && s.front() == '+' && s[1] != '-' && s[1] != '+') s.remove_prefix(1);
-  if (s.empty()) return std::nullopt;
-  double v = 0.0;
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v, std::chars_format::general);
-  if (ec != std::errc() || end != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
-  return v;
-}
 
 std::optional<long long> parse_integer(std::string_view s) {
   if (s.size() >= 2 && s.front() == '+' && s[1] != '-') s.remove_prefix(1);
@@ -272,7 +263,7 @@ class ZemaxParser {
   }
   double number(const ZmxLine& l, std::size_t i, const std::string& what) const {
     const Token& t = required_arg(l, i, what);
-    auto v = parse_finite(t.text);
+    auto v = parse_finite_number(t.text);
     if (!v) fail_at(l, t, "expected a finite number for " + what + ", got \"" + shown(t.text) + "\"");
     return *v;
   }
@@ -453,7 +444,7 @@ class ZemaxParser {
         last = std::min<std::size_t>(2, last);
       }
       for (std::size_t i = first; i < last; ++i) {
-        auto v = parse_finite(l.args[i].text);
+        auto v = parse_finite_number(l.args[i].text);
         if (v && *v != 0.0) {
           fail_at(l, l.args[i],
                   "decentres, tilts and extra surface data are not supported (value " + shown(l.args[i].text) + ")");
@@ -517,9 +508,9 @@ class ZemaxParser {
     g.column = t.column;
     // GLAS NAME solve pickup nd Vd dPgF ...: the nd/Vd fields are optional and are read leniently
     // because OpticStudio also writes them for catalogue glasses, where they mean nothing.
-    if (l.args.size() > 3) g.nd = parse_finite(l.args[3].text);
-    if (l.args.size() > 4) g.vd = parse_finite(l.args[4].text);
-    if (l.args.size() > 5) g.dpgf = parse_finite(l.args[5].text).value_or(0.0);
+    if (l.args.size() > 3) g.nd = parse_finite_number(l.args[3].text);
+    if (l.args.size() > 4) g.vd = parse_finite_number(l.args[4].text);
+    if (l.args.size() > 5) g.dpgf = parse_finite_number(l.args[5].text).value_or(0.0);
     s.glass = std::move(g);
   }
 

@@ -1,0 +1,19 @@
+#include "lensmith/core/number_parsing.h"
+
+#include <charconv>
+#include <cmath>
+#include <system_error>
+
+namespace lensmith {
+
+std::optional<double> parse_finite_number(std::string_view s) {
+  // std::from_chars takes no leading '+'; a doubled sign stays an error.
+  if (s.size() >= 2 && s.front() == '+' && s[1] != '-' && s[1] != '+') s.remove_prefix(1);
+  if (s.empty()) return std::nullopt;
+  double v = 0.0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v, std::chars_format::general);
+  if (ec != std::errc() || end != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+}  // namespace lensmith
