@@ -88,23 +88,26 @@ std::string decode_text(std::string_view bytes, const std::string& file_name) {
   return std::string(bytes);
 }
 
-void write_file_atomically(const std::string& path, std::string_view contents) {
+void write_atomically(const std::string& path, const std::string& extension,
+                      const std::function<void(const std::string& temporary_path)>& write) {
   namespace fs = std::filesystem;
   const fs::path target(path);
-  fs::path dir = target.parent_path();
-  if (dir.empty()) dir = ".";
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  // Hidden and unique, so a crash leaves no half-written file under the final name.
   std::random_device rd;
-  const fs::path temp = dir / (target.filename().string() + ".tmp" + std::to_string(rd()));
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out) throw IoError(path + ": cannot create temporary file " + temp.string());
-    out.write(contents.data(), static_cast<std::streamsize>(contents.size()));
-    out.flush();
-    if (!out) {
-      std::error_code ignored;
-      fs::remove(temp, ignored);
-      throw IoError(path + ": write failed (disk full?)");
-    }
+  // Built with append: GCC 12 warns (-Wrestrict, a false positive) on "." + std::string.
+  std::string name(".");
+  name += target.filename().string();
+  name += ".tmp";
+  name += std::to_string(rd());
+  name += extension;
+  const fs::path temp = dir / name;
+  try {
+    write(temp.string());
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove(temp, ignored);
+    throw;
   }
   std::error_code ec;
   fs::rename(temp, target, ec);
@@ -113,6 +116,16 @@ void write_file_atomically(const std::string& path, std::string_view contents) {
     fs::remove(temp, ignored);
     throw IoError(path + ": cannot rename temporary file into place: " + ec.message());
   }
+}
+
+void write_file_atomically(const std::string& path, std::string_view contents) {
+  write_atomically(path, "", [&](const std::string& temp) {
+    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+    if (!out) throw IoError(path + ": cannot create temporary file " + temp);
+    out.write(contents.data(), static_cast<std::streamsize>(contents.size()));
+    out.flush();
+    if (!out) throw IoError(path + ": write failed (disk full?)");
+  });
 }
 
 }  // namespace lensmith

@@ -8,9 +8,9 @@
 #include <cmath>
 #include <filesystem>
 #include <system_error>
-#include <unistd.h>
 
 #include "lensmith/core/errors.h"
+#include "lensmith/core/text_file.h"
 #include "lensmith/core/units.h"
 
 namespace lensmith::plot {
@@ -376,30 +376,14 @@ Canvas Canvas::read_image(const std::string& path) {
 }
 
 void Canvas::write_png(const std::string& path) const {
-  namespace fs = std::filesystem;
-  const fs::path target(path);
-  const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  // Hidden, unique per process, and ending in .png so OpenImageIO picks the format.
-  std::string name(".");
-  name += target.filename().string();
-  name += ".tmp";
-  name += std::to_string(::getpid());
-  name += ".png";
-  const fs::path temporary = folder / name;
-  // OIIO only reads the buffer; the const_cast is for its wrapping constructor's signature.
-  OIIO::ImageBuf buffer(OIIO::ImageSpec(width_, height_, 3, OIIO::TypeDesc::FLOAT), const_cast<float*>(pixels_.data()));
-  if (!buffer.write(temporary.string(), OIIO::TypeDesc::UINT8, "png")) {
-    std::error_code ec;
-    fs::remove(temporary, ec);
-    throw IoError(path + ": cannot write the PNG image: " + buffer.geterror());
-  }
-  std::error_code ec;
-  fs::rename(temporary, target, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(temporary, ignored);
-    throw IoError(path + ": cannot move the finished image into place: " + ec.message());
-  }
+  // The temporary name ends in .png so OpenImageIO picks the format.
+  write_atomically(path, ".png", [&](const std::string& temporary) {
+    // OIIO only reads the buffer; the const_cast is for its wrapping constructor's signature.
+    OIIO::ImageBuf buffer(OIIO::ImageSpec(width_, height_, 3, OIIO::TypeDesc::FLOAT), const_cast<float*>(pixels_.data()));
+    if (!buffer.write(temporary, OIIO::TypeDesc::UINT8, "png")) {
+      throw IoError(path + ": cannot write the PNG image: " + buffer.geterror());
+    }
+  });
 }
 
 }  // namespace lensmith::plot
