@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <span>
+#include <string>
 
 #include "lensmith/paraxial/paraxial_system.h"
 
@@ -64,5 +65,11 @@ struct ImageConjugate {
 // Throws ComputationError when the image lies at infinity (object in the front focal plane).
 ImageConjugate image_conjugate(const SystemMatrix& system, double n_object, double n_image,
                                double object_distance_mm);
+
+// Listing formatters shared by ParaxialSystem and ParaxialSpectralTable: fixed decimals, with
+// infinities spelled out and a value that rounds to zero printed as 0, not -0.
+std::string format_fixed(double value, int decimals);
+// `text` right-aligned in `width` characters.
+std::string right_aligned(const std::string& text, std::size_t width);
 
 }  // namespace lensmith::paraxial_detail

@@ -16,18 +16,8 @@ namespace lensmith {
 
 namespace {
 
-std::string number(double value, int decimals) {
-  // Print a value that rounds to zero as 0, not -0.
-  if (std::abs(value) < 0.5 * std::pow(10.0, -decimals)) value = 0.0;
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
-  return buffer;
-}
-
-std::string padded(const std::string& text, std::size_t width) {
-  if (text.size() >= width) return text;
-  return std::string(width - text.size(), ' ') + text;
-}
+std::string number(double value, int decimals) { return paraxial_detail::format_fixed(value, decimals); }
+std::string padded(const std::string& text, std::size_t width) { return paraxial_detail::right_aligned(text, width); }
 
 }  // namespace
 
@@ -123,10 +113,15 @@ ParaxialSample ParaxialSpectralTable::at(double wavelength_nm) const {
                                   samples_.size() - 2);
   const ParaxialSample& a = samples_[lo];
   const ParaxialSample& b = samples_[lo + 1];
-  const double t = (wavelength_nm - a.wavelength_nm) / (b.wavelength_nm - a.wavelength_nm);
+  ParaxialSample out = interpolate(a, b, (wavelength_nm - a.wavelength_nm) / (b.wavelength_nm - a.wavelength_nm));
+  out.wavelength_nm = wavelength_nm;  // exact, not re-derived from the interpolation
+  return out;
+}
+
+ParaxialSample interpolate(const ParaxialSample& a, const ParaxialSample& b, double t) {
   auto lerp = [t](double x, double y) { return x + t * (y - x); };
   ParaxialSample out;
-  out.wavelength_nm = wavelength_nm;
+  out.wavelength_nm = lerp(a.wavelength_nm, b.wavelength_nm);
   out.efl_mm = lerp(a.efl_mm, b.efl_mm);
   out.bfl_mm = lerp(a.bfl_mm, b.bfl_mm);
   out.ffl_mm = lerp(a.ffl_mm, b.ffl_mm);

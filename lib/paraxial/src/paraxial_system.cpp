@@ -110,6 +110,20 @@ ImageConjugate image_conjugate(const SystemMatrix& a, double n_object, double n_
   return out;
 }
 
+std::string format_fixed(double value, int decimals) {
+  if (std::isinf(value)) return value > 0 ? "infinity" : "-infinity";
+  if (std::isnan(value)) return "nan";
+  if (std::abs(value) < 0.5 * std::pow(10.0, -decimals)) value = 0.0;
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
+  return buffer;
+}
+
+std::string right_aligned(const std::string& text, std::size_t width) {
+  if (text.size() >= width) return text;
+  return std::string(width - text.size(), ' ') + text;
+}
+
 }  // namespace paraxial_detail
 
 // ---------------------------------------------------------------------------------------------
@@ -118,20 +132,8 @@ namespace {
 using paraxial_detail::CardinalPoints;
 using paraxial_detail::KernelMatrices;
 
-std::string number(double value, int decimals) {
-  if (std::isinf(value)) return value > 0 ? "infinity" : "-infinity";
-  if (std::isnan(value)) return "nan";
-  // Print a value that rounds to zero as 0, not -0.
-  if (std::abs(value) < 0.5 * std::pow(10.0, -decimals)) value = 0.0;
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
-  return buffer;
-}
-
-std::string padded(const std::string& text, std::size_t width) {
-  if (text.size() >= width) return text;
-  return std::string(width - text.size(), ' ') + text;
-}
+std::string number(double value, int decimals) { return paraxial_detail::format_fixed(value, decimals); }
+std::string padded(const std::string& text, std::size_t width) { return paraxial_detail::right_aligned(text, width); }
 
 std::string field(double value, int decimals, std::size_t width) { return padded(number(value, decimals), width); }
 

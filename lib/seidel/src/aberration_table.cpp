@@ -32,31 +32,12 @@ AberrationCoefficients lerp(const AberrationCoefficients& a, const AberrationCoe
   return c;
 }
 
-ParaxialSample lerp(const ParaxialSample& a, const ParaxialSample& b, double t) {
-  auto mix = [t](double x, double y) { return x + (y - x) * t; };
-  ParaxialSample s;
-  s.wavelength_nm = mix(a.wavelength_nm, b.wavelength_nm);
-  s.efl_mm = mix(a.efl_mm, b.efl_mm);
-  s.bfl_mm = mix(a.bfl_mm, b.bfl_mm);
-  s.ffl_mm = mix(a.ffl_mm, b.ffl_mm);
-  s.z_front_principal_mm = mix(a.z_front_principal_mm, b.z_front_principal_mm);
-  s.z_rear_principal_mm = mix(a.z_rear_principal_mm, b.z_rear_principal_mm);
-  s.z_entrance_pupil_mm = mix(a.z_entrance_pupil_mm, b.z_entrance_pupil_mm);
-  s.entrance_pupil_diameter_mm = mix(a.entrance_pupil_diameter_mm, b.entrance_pupil_diameter_mm);
-  s.z_exit_pupil_mm = mix(a.z_exit_pupil_mm, b.z_exit_pupil_mm);
-  s.exit_pupil_diameter_mm = mix(a.exit_pupil_diameter_mm, b.exit_pupil_diameter_mm);
-  s.image_distance_mm = mix(a.image_distance_mm, b.image_distance_mm);
-  s.magnification = mix(a.magnification, b.magnification);
-  s.extrapolated = a.extrapolated || b.extrapolated;
-  return s;
-}
-
 AberrationSample lerp(const AberrationSample& a, const AberrationSample& b, double t) {
   AberrationSample s;
   s.wavelength_nm = a.wavelength_nm + (b.wavelength_nm - a.wavelength_nm) * t;
   s.object_distance_mm = a.object_distance_mm;
   s.coefficients = lerp(a.coefficients, b.coefficients, t);
-  s.paraxial = lerp(a.paraxial, b.paraxial, t);
+  s.paraxial = interpolate(a.paraxial, b.paraxial, t);
   return s;
 }
 

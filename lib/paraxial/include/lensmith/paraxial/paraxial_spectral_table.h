@@ -27,6 +27,10 @@ struct ParaxialSample {
   bool extrapolated = false;       // some glass was evaluated outside its catalogue range
 };
 
+// Linear interpolation between two samples, t in [0, 1] (0 gives `a`); `extrapolated` is set when a
+// sample that contributes (non-zero weight) was extrapolated.
+ParaxialSample interpolate(const ParaxialSample& a, const ParaxialSample& b, double t);
+
 struct SpectralTableOptions {
   double min_wavelength_nm = 380.0;
   double max_wavelength_nm = 780.0;
