@@ -117,7 +117,9 @@ SeidelAnalysis::SeidelAnalysis(const Prescription& lens, const SeidelOptions& op
         po.wavelength_nm = options.wavelength_nm;
         return ParaxialSystem(p, po);
       }()) {
-  const Prescription p = with_overrides(lens, options);
+  // The overrides change only aperture, field and object distance, which the paraxial rays carry;
+  // surfaces and media come from the lens as given.
+  const Prescription& p = lens;
   const ParaxialRayTable& marginal = paraxial_.marginal_ray();
   const ParaxialRayTable& chief = *paraxial_.chief_ray();
   lagrange_ = *paraxial_.lagrange_invariant();
