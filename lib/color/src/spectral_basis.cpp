@@ -5,17 +5,11 @@
 #include <sstream>
 
 #include "lensmith/core/errors.h"
+#include "lensmith/core/number_parsing.h"
 
 namespace lensmith {
 
 namespace {
-
-std::string number(double v) {
-  std::ostringstream os;
-  os.precision(10);
-  os << v;
-  return os.str();
-}
 
 // Logistic step 0 -> 1 centred on crossover_nm. Monotone in wavelength_nm, so S_1 >= S_2 holds
 // in floating point as well and b_g never rounds below 0.
@@ -28,23 +22,23 @@ double step(double wavelength_nm, double crossover_nm, double width_nm) {
 void SpectralBasisOptions::validate() const {
   // Negated comparisons so that NaN fails too.
   if (!(blue_green_crossover_nm >= 400.0 && blue_green_crossover_nm <= 700.0)) {
-    throw OptionsError("SpectralBasisOptions::blue_green_crossover_nm = " + number(blue_green_crossover_nm) +
+    throw OptionsError("SpectralBasisOptions::blue_green_crossover_nm = " + format_number(blue_green_crossover_nm) +
                        ": must be 400 to 700 nm");
   }
   if (!(green_red_crossover_nm > blue_green_crossover_nm && green_red_crossover_nm <= 700.0)) {
-    throw OptionsError("SpectralBasisOptions::green_red_crossover_nm = " + number(green_red_crossover_nm) +
-                       ": must be > blue_green_crossover_nm (" + number(blue_green_crossover_nm) + ") and <= 700 nm");
+    throw OptionsError("SpectralBasisOptions::green_red_crossover_nm = " + format_number(green_red_crossover_nm) +
+                       ": must be > blue_green_crossover_nm (" + format_number(blue_green_crossover_nm) + ") and <= 700 nm");
   }
   if (!(transition_width_nm >= 1.0 && transition_width_nm <= 100.0)) {
-    throw OptionsError("SpectralBasisOptions::transition_width_nm = " + number(transition_width_nm) +
+    throw OptionsError("SpectralBasisOptions::transition_width_nm = " + format_number(transition_width_nm) +
                        ": must be 1 to 100 nm");
   }
 }
 
 std::string SpectralBasisOptions::to_string() const {
-  return "SpectralBasisOptions(blue_green_crossover_nm = " + number(blue_green_crossover_nm) +
-         ", green_red_crossover_nm = " + number(green_red_crossover_nm) +
-         ", transition_width_nm = " + number(transition_width_nm) + ")";
+  return "SpectralBasisOptions(blue_green_crossover_nm = " + format_number(blue_green_crossover_nm) +
+         ", green_red_crossover_nm = " + format_number(green_red_crossover_nm) +
+         ", transition_width_nm = " + format_number(transition_width_nm) + ")";
 }
 
 SpectralBasis::SpectralBasis(const SpectralBasisOptions& options) : options_(options) { options_.validate(); }

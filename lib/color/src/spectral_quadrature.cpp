@@ -8,17 +8,11 @@
 
 #include "lensmith/color/cie1931.h"
 #include "lensmith/core/errors.h"
+#include "lensmith/core/number_parsing.h"
 
 namespace lensmith {
 
 namespace {
-
-std::string number(double v) {
-  std::ostringstream os;
-  os.precision(10);
-  os << v;
-  return os.str();
-}
 
 std::array<double, 3> rec709_unscaled(double wavelength_nm) {
   const Xyz c = cie1931_cmf(wavelength_nm);
@@ -33,23 +27,23 @@ void SpectralQuadratureOptions::validate() const {
                        ": must be 3 to 4096 (three colour channels need at least three wavelengths)");
   }
   if (!(min_wavelength_nm >= 300.0 && min_wavelength_nm <= 900.0)) {
-    throw OptionsError("SpectralQuadratureOptions::min_wavelength_nm = " + number(min_wavelength_nm) +
+    throw OptionsError("SpectralQuadratureOptions::min_wavelength_nm = " + format_number(min_wavelength_nm) +
                        ": must be 300 to 900 nm");
   }
   if (!(max_wavelength_nm > min_wavelength_nm && max_wavelength_nm <= 900.0)) {
-    throw OptionsError("SpectralQuadratureOptions::max_wavelength_nm = " + number(max_wavelength_nm) +
-                       ": must be > min_wavelength_nm (" + number(min_wavelength_nm) + ") and <= 900 nm");
+    throw OptionsError("SpectralQuadratureOptions::max_wavelength_nm = " + format_number(max_wavelength_nm) +
+                       ": must be > min_wavelength_nm (" + format_number(min_wavelength_nm) + ") and <= 900 nm");
   }
 }
 
 std::string SpectralQuadratureOptions::to_string() const {
   return "SpectralQuadratureOptions(sample_count = " + std::to_string(sample_count) +
-         ", min_wavelength_nm = " + number(min_wavelength_nm) + ", max_wavelength_nm = " + number(max_wavelength_nm) + ")";
+         ", min_wavelength_nm = " + format_number(min_wavelength_nm) + ", max_wavelength_nm = " + format_number(max_wavelength_nm) + ")";
 }
 
 std::string WavelengthSample::to_string() const {
-  return "WavelengthSample(index = " + std::to_string(index) + ", wavelength_nm = " + number(wavelength_nm) +
-         ", probability = " + number(probability) + ", pdf_per_nm = " + number(pdf_per_nm) +
+  return "WavelengthSample(index = " + std::to_string(index) + ", wavelength_nm = " + format_number(wavelength_nm) +
+         ", probability = " + format_number(probability) + ", pdf_per_nm = " + format_number(pdf_per_nm) +
          ", rgb_weight = " + rgb_weight.to_string() + ")";
 }
 

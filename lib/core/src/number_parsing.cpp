@@ -16,4 +16,10 @@ std::optional<double> parse_finite_number(std::string_view s) {
   return v;
 }
 
+std::string format_number(double value) {
+  char buffer[32];  // the longest shortest-form double is 24 characters
+  const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return ec == std::errc() ? std::string(buffer, end) : std::string("?");
+}
+
 }  // namespace lensmith

@@ -98,13 +98,6 @@ std::string shown(std::string_view s, std::size_t max_length = kMaxShownKeywordL
   return std::string(s.substr(0, max_length)) + "...";
 }
 
-std::string format_number(double v) {
-  char buffer[32];
-  auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, v);
-  if (ec != std::errc()) return "?";
-  return std::string(buffer, end);
-}
-
 
 std::optional<long long> parse_integer(std::string_view s) {
   if (s.size() >= 2 && s.front() == '+' && s[1] != '-') s.remove_prefix(1);
