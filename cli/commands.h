@@ -123,6 +123,37 @@ struct AnalyzeCommandOptions {
 };
 int run_analyze(const AnalyzeCommandOptions& options, const GlobalOptions& global);
 
+struct BokehCommandOptions {
+  std::string image;                         // --image: all-in-focus picture (EXR/HDR linear; 8-bit sRGB)
+  std::string depth;                         // --depth FILE[:CHANNEL]; empty = the image file's Z channel
+  std::string depth_kind = "z";              // z | distance | inverse
+  std::string depth_unit = "m";              // m | cm | mm
+  std::string invalid_depth = "error";       // error | far | near
+  std::string output;                        // -o: .exr (float + metadata) or .png/.jpg/.tif (sRGB)
+  std::string lens;                          // --lens: file or shipped name
+  bool thin_lens = false;                    // --thin-lens: an ideal thin lens instead
+  std::optional<double> focal_length_mm;     // --focal-length (thin lens)
+  std::optional<double> f_number;            // --fstop; default: the lens's own
+  double focus_m = 0.0;                      // --focus, metres from the camera (entrance pupil)
+  double sensor_width_mm = 36.0;             // --sensor-width of the pinhole image
+  std::optional<double> pinhole_focal_length_mm;  // --pinhole-focal-length; default: the lens EFL
+  std::optional<double> hfov_deg;            // --hfov instead
+  std::optional<int> blades;                 // --blades N
+  double blade_rotation_deg = 0.0;           // --blade-rotation
+  std::string aperture_image;                // --aperture-image PNG
+  std::string model;                         // --model thin|paraxial|seidel|exact; default seidel (thin with --thin-lens)
+  std::string hidden = "extend";             // --hidden extend|stretch
+  bool no_spectral = false;                  // --no-spectral
+  int spectral_samples = 16;                 // --spectral-samples
+  double highlight_gain = 1.0;               // --highlight-gain (8-bit inputs)
+  double highlight_threshold = 0.98;         // --highlight-threshold
+  double layer_spacing_px = 2.0;             // --layer-spacing
+  int subrows = 4;                           // --subrows
+  double max_blur_px = 1000.0;               // --max-blur
+  int threads = 0;                           // --threads (0 = all)
+};
+int run_bokeh(const BokehCommandOptions& options, const GlobalOptions& global);
+
 // Prints the reader's warnings to stderr unless quiet.
 void print_diagnostics(const Diagnostics& diagnostics, const GlobalOptions& global);
 

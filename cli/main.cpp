@@ -149,6 +149,54 @@ int main(int argc, char** argv) {
   analyze_cmd->add_option("--grid", analyze.grid, "Pupil grid cells across the diameter for illumination and pupil (default 64; 8-1024)")
       ->check(CLI::Range(8, 1024));
 
+  BokehCommandOptions bokeh;
+  CLI::App* bokeh_cmd = app.add_subcommand(
+      "bokeh", "Photograph an all-in-focus image and its depth through a lens: defocus, bokeh shape, aberrations");
+  bokeh_cmd->add_option("--image", bokeh.image, "All-in-focus image: EXR/HDR linear radiance, or 8/16-bit sRGB")->required();
+  bokeh_cmd->add_option("--depth", bokeh.depth, "Depth FILE[:CHANNEL] (default: the image's own Z, then depth.Z, then first channel)");
+  bokeh_cmd->add_option("--depth-kind", bokeh.depth_kind, "z (planar, default) | distance (from the camera) | inverse (1/z)")
+      ->check(CLI::IsMember({"z", "distance", "inverse"}));
+  bokeh_cmd->add_option("--depth-unit", bokeh.depth_unit, "m (default) | cm | mm")->check(CLI::IsMember({"m", "cm", "mm"}));
+  bokeh_cmd->add_option("--invalid-depth", bokeh.invalid_depth, "NaN or negative depth: error (default) | far | near")
+      ->check(CLI::IsMember({"error", "far", "near"}));
+  bokeh_cmd->add_option("-o,--output", bokeh.output, "Output: .exr (float, with metadata) or .png/.jpg/.tif (sRGB)")->required();
+  CLI::Option* bokeh_lens = bokeh_cmd->add_option("--lens", bokeh.lens, "Lens file or shipped lens name (lensmith lenses)");
+  CLI::Option* bokeh_thin = bokeh_cmd->add_flag("--thin-lens", bokeh.thin_lens, "An ideal thin lens instead of a prescription");
+  bokeh_thin->excludes(bokeh_lens);
+  bokeh_cmd->add_option("--focal-length", bokeh.focal_length_mm, "Thin-lens focal length, mm (> 0)")->check(CLI::PositiveNumber)->needs(bokeh_thin);
+  bokeh_cmd->add_option("--fstop", bokeh.f_number, "f-number (default: the lens's own; 0.5-512)")->check(CLI::Range(0.5, 512.0));
+  bokeh_cmd->add_option("--focus", bokeh.focus_m, "Focus distance, metres from the camera (> 0; inf for infinity)")->required()
+      ->check(CLI::PositiveNumber);
+  bokeh_cmd->add_option("--sensor-width", bokeh.sensor_width_mm, "Sensor width of the input image's pinhole camera, mm (default 36)")
+      ->check(CLI::PositiveNumber);
+  CLI::Option* bokeh_pf = bokeh_cmd->add_option("--pinhole-focal-length", bokeh.pinhole_focal_length_mm,
+                                                "Focal length of the input's pinhole camera, mm (default: the lens EFL)")
+                              ->check(CLI::PositiveNumber);
+  bokeh_cmd->add_option("--hfov", bokeh.hfov_deg, "Horizontal field of view of the input image, degrees (instead of the focal length)")
+      ->check(CLI::Range(0.01, 179.99))->excludes(bokeh_pf);
+  CLI::Option* bokeh_blades = bokeh_cmd->add_option("--blades", bokeh.blades, "Straight iris blades (3-64; default: a circular iris)")
+                                  ->check(CLI::Range(3, 64));
+  bokeh_cmd->add_option("--blade-rotation", bokeh.blade_rotation_deg, "Rotation of the blade polygon, degrees")->needs(bokeh_blades);
+  bokeh_cmd->add_option("--aperture-image", bokeh.aperture_image, "Aperture transmission from a picture over the pupil square")
+      ->excludes(bokeh_blades);
+  bokeh_cmd->add_option("--model", bokeh.model, "thin | paraxial | seidel (default) | exact")
+      ->check(CLI::IsMember({"thin", "paraxial", "seidel", "exact"}));
+  bokeh_cmd->add_option("--hidden", bokeh.hidden, "Background hidden behind foreground edges: extend (default) | stretch")
+      ->check(CLI::IsMember({"extend", "stretch"}));
+  bokeh_cmd->add_flag("--no-spectral", bokeh.no_spectral, "Trace every ray at 587.6 nm and keep RGB as it is (no colour fringes)");
+  bokeh_cmd->add_option("--spectral-samples", bokeh.spectral_samples, "Wavelengths of the spectral quadrature (3-64, default 16)")
+      ->check(CLI::Range(3, 64));
+  bokeh_cmd->add_option("--highlight-gain", bokeh.highlight_gain, "8/16-bit inputs: boost clipped highlights up to this factor (>= 1; default 1 = off)")
+      ->check(CLI::Range(1.0, 1.0e6));
+  bokeh_cmd->add_option("--highlight-threshold", bokeh.highlight_threshold, "Encoded value from which a channel counts as clipped (default 0.98)")
+      ->check(CLI::Range(0.5, 1.0));
+  bokeh_cmd->add_option("--layer-spacing", bokeh.layer_spacing_px, "Depth-layer step in signed blur diameter, px (default 2)")
+      ->check(CLI::Range(0.1, 1000.0));
+  bokeh_cmd->add_option("--subrows", bokeh.subrows, "Sub-rows per pixel of the scatter (1-16, default 4)")->check(CLI::Range(1, 16));
+  bokeh_cmd->add_option("--max-blur", bokeh.max_blur_px, "Largest blur diameter, px; nearer points are clamped (default 1000)")
+      ->check(CLI::Range(1.0, 1.0e6));
+  bokeh_cmd->add_option("--threads", bokeh.threads, "Threads (default 0 = all cores)")->check(CLI::Range(0, 4096));
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -171,6 +219,7 @@ int main(int argc, char** argv) {
     if (*spot_cmd) return run_spot(spot, global);
     if (*fan_cmd) return run_fan(fan, global);
     if (*analyze_cmd) return run_analyze(analyze, global);
+    if (*bokeh_cmd) return run_bokeh(bokeh, global);
   } catch (const lensmith::ComputationError& e) {
     std::cerr << "lensmith: " << e.what() << "\n";
     return kExitComputation;

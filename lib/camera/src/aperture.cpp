@@ -1,1 +1,181 @@
-// (being written)
+#include "lensmith/camera/aperture.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "lensmith/core/errors.h"
+#include "lensmith/core/number_parsing.h"
+#include "lensmith/core/units.h"
+
+namespace lensmith {
+
+namespace {
+
+// Corner k of a regular polygon inscribed in the unit circle, angle measured from +x.
+double corner_angle(int k, int blades, double rotation_deg) {
+  return kPi / 2.0 + rad_from_deg(rotation_deg) + 2.0 * kPi * k / blades;
+}
+
+double triangle_area(const PupilPoint& a, const PupilPoint& b, const PupilPoint& c) {
+  return 0.5 * std::abs((b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y));
+}
+
+}  // namespace
+
+Aperture Aperture::circular() {
+  Aperture a;
+  a.kind_ = Kind::Circular;
+  a.effective_area_ = kPi;
+  return a;
+}
+
+Aperture Aperture::blades(int blades, double rotation_deg) {
+  if (blades < 3 || blades > 64) {
+    throw OptionsError("aperture blades must be between 3 and 64 (got " + std::to_string(blades) + "); leave it out for a circular iris");
+  }
+  if (!std::isfinite(rotation_deg)) throw OptionsError("blade rotation must be a finite angle in degrees");
+  Aperture a;
+  a.kind_ = Kind::Blades;
+  a.blades_ = blades;
+  a.rotation_deg_ = rotation_deg;
+  a.effective_area_ = 0.5 * blades * std::sin(2.0 * kPi / blades);
+  return a;
+}
+
+Aperture Aperture::mask(int width, int height, std::vector<float> transmission) {
+  if (width < 2 || height < 2 || transmission.size() != static_cast<std::size_t>(width) * height) {
+    throw OptionsError("aperture mask must be at least 2 x 2 samples with one value per sample");
+  }
+  double sum = 0.0;
+  for (float t : transmission) {
+    if (!(std::isfinite(t) && t >= 0.0f)) throw OptionsError("aperture mask values must be finite and >= 0");
+    sum += t;
+  }
+  if (!(sum > 0.0)) throw OptionsError("aperture mask is black everywhere: no light would pass");
+  Aperture a;
+  a.kind_ = Kind::Mask;
+  a.mask_width_ = width;
+  a.mask_height_ = height;
+  a.mask_ = std::move(transmission);
+  a.effective_area_ = 4.0 * sum / static_cast<double>(a.mask_.size());
+  return a;
+}
+
+double Aperture::edge_radius(double theta_rad) const {
+  if (kind_ == Kind::Circular) return 1.0;
+  if (kind_ == Kind::Blades) {
+    // Distance to the polygon edge: apothem / cos(angle from the edge's normal).
+    const double sector = 2.0 * kPi / blades_;
+    const double start = corner_angle(0, blades_, rotation_deg_);
+    double local = std::fmod(theta_rad - start, sector);
+    if (local < 0.0) local += sector;
+    return std::cos(0.5 * sector) / std::cos(local - 0.5 * sector);
+  }
+  throw ComputationError("a mask aperture has no single edge radius");
+}
+
+std::vector<PupilPoint> Aperture::outline(int min_vertices) const {
+  if (kind_ == Kind::Mask) throw ComputationError("a mask aperture has no polygon outline");
+  std::vector<PupilPoint> out;
+  const int per_edge = kind_ == Kind::Blades ? std::max(1, (min_vertices + blades_ - 1) / blades_) : 1;
+  const int n = kind_ == Kind::Blades ? per_edge * blades_ : std::max(3, min_vertices);
+  out.reserve(static_cast<std::size_t>(n));
+  const double start = kind_ == Kind::Blades ? corner_angle(0, blades_, rotation_deg_) : kPi / 2.0;
+  for (int k = 0; k < n; ++k) {
+    const double theta = start + 2.0 * kPi * k / n;
+    const double r = edge_radius(theta);
+    out.push_back({r * std::cos(theta), r * std::sin(theta)});
+  }
+  // Blade outlines: points placed by angle lie on the straight edges, corners included exactly.
+  return out;
+}
+
+double Aperture::transmission(const PupilPoint& p) const {
+  if (kind_ == Kind::Mask) {
+    if (p.x < -1.0 || p.x > 1.0 || p.y < -1.0 || p.y > 1.0) return 0.0;
+    const int col = std::min(mask_width_ - 1, static_cast<int>((p.x + 1.0) * 0.5 * mask_width_));
+    const int row = std::min(mask_height_ - 1, static_cast<int>((1.0 - p.y) * 0.5 * mask_height_));
+    return mask_[static_cast<std::size_t>(row) * mask_width_ + col];
+  }
+  const double r = std::hypot(p.x, p.y);
+  if (r == 0.0) return 1.0;
+  return r <= edge_radius(std::atan2(p.y, p.x)) ? 1.0 : 0.0;
+}
+
+double Aperture::effective_area() const { return effective_area_; }
+
+PupilMesh Aperture::mesh(int rings, int sectors) const {
+  if (rings < 1 || sectors < 3) throw OptionsError("a pupil mesh needs at least 1 ring and 3 sectors");
+  PupilMesh m;
+  if (kind_ == Kind::Mask) {
+    // Cartesian grid of rings x rings cells; each cell's weight is its mean transmission (sampled
+    // 4 x 4 inside the cell), split between its two triangles.
+    const int n = rings;
+    m.rings = n;
+    for (int j = 0; j <= n; ++j) {
+      for (int i = 0; i <= n; ++i) m.points.push_back({-1.0 + 2.0 * i / n, 1.0 - 2.0 * j / n});
+    }
+    double total = 0.0;
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        double t = 0.0;
+        for (int sy = 0; sy < 4; ++sy) {
+          for (int sx = 0; sx < 4; ++sx) {
+            t += transmission({-1.0 + 2.0 * (i + (sx + 0.5) / 4.0) / n, 1.0 - 2.0 * (j + (sy + 0.5) / 4.0) / n});
+          }
+        }
+        if (t <= 0.0) continue;
+        const int p00 = j * (n + 1) + i, p10 = p00 + 1, p01 = p00 + n + 1, p11 = p01 + 1;
+        m.triangles.push_back({p00, p10, p11, t / 32.0});
+        m.triangles.push_back({p00, p11, p01, t / 32.0});
+        total += t / 16.0;
+      }
+    }
+    for (auto& tri : m.triangles) tri.weight /= total;
+    return m;
+  }
+  // Polar mesh: centre, then `rings` rings scaled to the edge, vertices placed on the outline.
+  const std::vector<PupilPoint> edge = outline(sectors);
+  const int s = static_cast<int>(edge.size());
+  m.rings = rings;
+  m.sectors = s;
+  m.points.push_back({0.0, 0.0});
+  for (int k = 1; k <= rings; ++k) {
+    const double f = static_cast<double>(k) / rings;
+    for (const PupilPoint& e : edge) m.points.push_back({f * e.x, f * e.y});
+  }
+  auto index = [s](int ring, int j) { return 1 + (ring - 1) * s + (j % s); };
+  double total = 0.0;
+  for (int j = 0; j < s; ++j) {
+    m.triangles.push_back({0, index(1, j), index(1, j + 1), 0.0});
+    for (int k = 1; k < rings; ++k) {
+      m.triangles.push_back({index(k, j), index(k + 1, j), index(k + 1, j + 1), 0.0});
+      m.triangles.push_back({index(k, j), index(k + 1, j + 1), index(k, j + 1), 0.0});
+    }
+  }
+  for (auto& tri : m.triangles) {
+    tri.weight = triangle_area(m.points[tri.a], m.points[tri.b], m.points[tri.c]);
+    total += tri.weight;
+  }
+  for (auto& tri : m.triangles) tri.weight /= total;
+  return m;
+}
+
+std::string PupilMesh::to_string() const {
+  std::ostringstream os;
+  os << "PupilMesh(" << points.size() << " points, " << triangles.size() << " triangles, " << rings << " rings, "
+     << sectors << " sectors)";
+  return os.str();
+}
+
+std::string Aperture::to_string() const {
+  switch (kind_) {
+    case Kind::Circular: return "circular";
+    case Kind::Blades: return std::to_string(blades_) + " blades at " + format_number(rotation_deg_) + " deg";
+    case Kind::Mask: return "mask " + std::to_string(mask_width_) + " x " + std::to_string(mask_height_);
+  }
+  return "aperture";
+}
+
+}  // namespace lensmith

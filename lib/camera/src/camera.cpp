@@ -1,1 +1,197 @@
-// (being written)
+#include "lensmith/camera/camera.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "lensmith/core/errors.h"
+#include "lensmith/core/number_parsing.h"
+#include "lensmith/paraxial/paraxial_spectral_table.h"
+#include "lensmith/paraxial/paraxial_system.h"
+
+namespace lensmith {
+
+namespace {
+
+constexpr double kMinWavelengthNm = 380.0;
+constexpr double kMaxWavelengthNm = 780.0;
+constexpr int kWavelengthSamples = 64;  // as Asberg's method tabulates its lens parameters
+
+FirstOrderSample blend(const FirstOrderSample& a, const FirstOrderSample& b, double t) {
+  auto mix = [t](double x, double y) { return x + t * (y - x); };
+  FirstOrderSample s;
+  s.wavelength_nm = mix(a.wavelength_nm, b.wavelength_nm);
+  s.efl_mm = mix(a.efl_mm, b.efl_mm);
+  s.z_front_principal_mm = mix(a.z_front_principal_mm, b.z_front_principal_mm);
+  s.z_rear_principal_mm = mix(a.z_rear_principal_mm, b.z_rear_principal_mm);
+  s.z_entrance_pupil_mm = mix(a.z_entrance_pupil_mm, b.z_entrance_pupil_mm);
+  s.z_exit_pupil_mm = mix(a.z_exit_pupil_mm, b.z_exit_pupil_mm);
+  s.entrance_pupil_radius_mm = mix(a.entrance_pupil_radius_mm, b.entrance_pupil_radius_mm);
+  s.exit_pupil_radius_mm = mix(a.exit_pupil_radius_mm, b.exit_pupil_radius_mm);
+  return s;
+}
+
+// 1 / (image distance from the rear principal plane) for an object at w_P = 1 / (distance from the
+// front principal plane), Gauss's lens equation in air, kept away from 0 (object in the front focal
+// plane: image at infinity) so callers need no special case.
+double inverse_image_distance(double efl_mm, double w_principal) {
+  const double v = 1.0 / efl_mm - w_principal;
+  constexpr double kTiny = 1e-12;
+  if (std::abs(v) < kTiny) return v < 0.0 ? -kTiny : kTiny;
+  return v;
+}
+
+}  // namespace
+
+void CameraOptions::validate() const {
+  if (!(focus_distance_m > 0.0) || std::isnan(focus_distance_m)) {
+    throw OptionsError("focus distance must be > 0 m (+inf for infinity), got " + format_number(focus_distance_m));
+  }
+  if (f_number && !(std::isfinite(*f_number) && *f_number >= 0.5 && *f_number <= 512.0)) {
+    throw OptionsError("f-number must be between 0.5 and 512, got " + format_number(*f_number));
+  }
+  framing.validate();
+  if (!(reference_wavelength_nm >= kMinWavelengthNm && reference_wavelength_nm <= kMaxWavelengthNm)) {
+    throw OptionsError("reference wavelength must lie in 380..780 nm, got " + format_number(reference_wavelength_nm));
+  }
+}
+
+std::string CameraOptions::to_string() const {
+  std::ostringstream os;
+  os << "CameraOptions(focus " << focus_distance_m << " m, f/"
+     << (f_number ? format_number(*f_number) : std::string("lens")) << ", " << framing.to_string() << ", reference "
+     << reference_wavelength_nm << " nm)";
+  return os.str();
+}
+
+std::string FirstOrderSample::to_string() const {
+  std::ostringstream os;
+  os.precision(8);
+  os << "FirstOrderSample(" << wavelength_nm << " nm: EFL " << efl_mm << " mm, principal planes " << z_front_principal_mm
+     << " / " << z_rear_principal_mm << " mm, EP " << z_entrance_pupil_mm << " mm r " << entrance_pupil_radius_mm
+     << " mm, XP " << z_exit_pupil_mm << " mm r " << exit_pupil_radius_mm << " mm)";
+  return os.str();
+}
+
+Camera Camera::thin_lens(double focal_length_mm, const CameraOptions& options, int width_px, int height_px) {
+  options.validate();
+  if (!(std::isfinite(focal_length_mm) && focal_length_mm > 0.0)) {
+    throw OptionsError("thin-lens focal length must be a finite length > 0 mm, got " + format_number(focal_length_mm));
+  }
+  if (!options.f_number) throw OptionsError("a thin-lens camera needs an f-number (--fstop)");
+  Camera c(PinholeFrame::from_options(width_px, height_px, options.framing, focal_length_mm));
+  c.options_ = options;
+  c.f_number_ = *options.f_number;
+  c.reference_nm_ = options.reference_wavelength_nm;
+  FirstOrderSample s;
+  s.wavelength_nm = options.reference_wavelength_nm;
+  s.efl_mm = focal_length_mm;
+  s.entrance_pupil_radius_mm = s.exit_pupil_radius_mm = focal_length_mm / (2.0 * c.f_number_);
+  c.samples_ = {s};
+  c.finish();
+  return c;
+}
+
+Camera Camera::from_lens(const Prescription& lens, const CameraOptions& options, int width_px, int height_px) {
+  options.validate();
+  const ParaxialSystem own(lens);
+  if (!(own.efl_mm() > 0.0)) {
+    throw ComputationError("the bokeh renderer needs a lens that forms a real image (EFL > 0); this one has EFL " +
+                           format_number(own.efl_mm()) + " mm");
+  }
+  auto at_f_number = std::make_shared<Prescription>(lens);
+  const double n = options.f_number.value_or(own.f_number());
+  at_f_number->aperture = ApertureSpec{ApertureSpec::Kind::ImageSpaceFNumber, n};
+  // The stop's clear aperture follows the f-number (an iris), so the exact tracer clips the beam
+  // that the paraxial pupils describe; the other clear apertures stay as prescribed (vignetting).
+  const ParaxialSystem at_n(*at_f_number);
+  const std::size_t stop = static_cast<std::size_t>(at_n.stop_surface() - 1);
+  at_f_number->surfaces[stop].semi_diameter_mm = std::abs(at_n.marginal_ray().rows[stop].y_mm);
+
+  Camera c(PinholeFrame::from_options(width_px, height_px, options.framing, own.efl_mm()));
+  c.options_ = options;
+  c.f_number_ = n;
+  c.reference_nm_ = options.reference_wavelength_nm;
+  c.pupil_orientation_ = at_n.exit_pupil().magnification * at_n.entrance_pupil().magnification < 0.0 ? -1.0 : 1.0;
+  SpectralTableOptions table_options;
+  table_options.min_wavelength_nm = kMinWavelengthNm;
+  table_options.max_wavelength_nm = kMaxWavelengthNm;
+  table_options.samples = kWavelengthSamples;
+  table_options.object_distance_mm = kInfinity;
+  const ParaxialSpectralTable table(*at_f_number, table_options);
+  for (const ParaxialSample& p : table.samples()) {
+    FirstOrderSample s;
+    s.wavelength_nm = p.wavelength_nm;
+    s.efl_mm = p.efl_mm;
+    s.z_front_principal_mm = p.z_front_principal_mm;
+    s.z_rear_principal_mm = p.z_rear_principal_mm;
+    s.z_entrance_pupil_mm = p.z_entrance_pupil_mm;
+    s.z_exit_pupil_mm = p.z_exit_pupil_mm;
+    s.entrance_pupil_radius_mm = 0.5 * p.entrance_pupil_diameter_mm;
+    s.exit_pupil_radius_mm = 0.5 * p.exit_pupil_diameter_mm;
+    c.samples_.push_back(s);
+  }
+  c.lens_ = std::move(at_f_number);
+  c.finish();
+  return c;
+}
+
+double Camera::min_wavelength_nm() const { return samples_.front().wavelength_nm; }
+double Camera::max_wavelength_nm() const { return samples_.back().wavelength_nm; }
+
+FirstOrderSample Camera::first_order(double wavelength_nm) const {
+  if (samples_.size() == 1) {
+    FirstOrderSample s = samples_.front();
+    s.wavelength_nm = wavelength_nm;
+    return s;
+  }
+  const double lo = samples_.front().wavelength_nm, hi = samples_.back().wavelength_nm;
+  const double u = std::clamp((wavelength_nm - lo) / (hi - lo), 0.0, 1.0) * static_cast<double>(samples_.size() - 1);
+  const std::size_t i = std::min(static_cast<std::size_t>(u), samples_.size() - 2);
+  return blend(samples_[i], samples_[i + 1], u - static_cast<double>(i));
+}
+
+GaussianImage Camera::gaussian_image(const ScenePoint& p, const FirstOrderSample& s) const {
+  // Object at depth 1/w in front of the perspective centre; Delta = front principal plane minus
+  // perspective centre, so 1 / (object distance from the front principal plane) = w / (1 + Delta w).
+  const double w = p.inverse_depth_per_mm;
+  const double scale = 1.0 / (1.0 + (s.z_front_principal_mm - z_perspective_mm_) * w);
+  const double image_distance = 1.0 / inverse_image_distance(s.efl_mm, w * scale);
+  // Height: m X with m = -s_i / s_o and X = tan * depth, i.e. -s_i * tan * scale (finite at w = 0).
+  return {-image_distance * p.tan_x * scale, -image_distance * p.tan_y * scale, s.z_rear_principal_mm + image_distance};
+}
+
+void Camera::finish() {
+  focus_mm_ = mm_from_m(options_.focus_distance_m);
+  const FirstOrderSample ref = first_order(reference_nm_);
+  z_perspective_mm_ = ref.z_entrance_pupil_mm;
+  const double w_focus = std::isinf(focus_mm_) ? 0.0 : 1.0 / focus_mm_;
+  const double scale = 1.0 / (1.0 + (ref.z_front_principal_mm - z_perspective_mm_) * w_focus);
+  if (!(scale > 0.0) || 1.0 / ref.efl_mm - w_focus * scale <= 0.0) {
+    throw ComputationError("cannot focus at " + format_number(options_.focus_distance_m) +
+                           " m: the plane is not beyond the front focal point (EFL " + format_number(ref.efl_mm) + " mm)");
+  }
+  const GaussianImage focus_image = gaussian_image({1.0, 0.0, w_focus}, ref);
+  z_sensor_mm_ = focus_image.z_mm;
+  // focus_image.x_mm is the sensor height of tangent 1 on the focus plane.
+  px_per_sensor_mm_ = frame_.focal_length_px() / focus_image.x_mm;
+}
+
+double Camera::signed_coc_px(double inverse_depth_per_mm) const {
+  const FirstOrderSample ref = first_order(reference_nm_);
+  const GaussianImage g = gaussian_image({0.0, 0.0, inverse_depth_per_mm}, ref);
+  const double to_pupil = g.z_mm - ref.z_exit_pupil_mm;
+  if (to_pupil == 0.0) return 0.0;
+  return 2.0 * ref.exit_pupil_radius_mm * (g.z_mm - z_sensor_mm_) / to_pupil * std::abs(px_per_sensor_mm_);
+}
+
+std::string Camera::to_string() const {
+  std::ostringstream os;
+  os.precision(8);
+  os << "Camera(" << (lens_ ? "lens '" + lens_->name + "'" : std::string("thin lens")) << ", f/" << f_number_
+     << ", focus " << focus_mm_ << " mm, sensor at z " << z_sensor_mm_ << " mm, perspective centre at z "
+     << z_perspective_mm_ << " mm, " << px_per_sensor_mm_ << " px per sensor mm, " << frame_.to_string() << ")";
+  return os.str();
+}
+
+}  // namespace lensmith

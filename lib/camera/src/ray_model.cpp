@@ -1,1 +1,54 @@
-// (being written)
+#include "lensmith/camera/ray_model.h"
+
+#include <cmath>
+
+#include "lensmith/core/errors.h"
+#include "lensmith/core/number_parsing.h"
+#include "model_implementations.h"
+
+namespace lensmith {
+
+std::string_view to_string(RayModelKind kind) {
+  switch (kind) {
+    case RayModelKind::Thin: return "thin";
+    case RayModelKind::Paraxial: return "paraxial";
+    case RayModelKind::Seidel: return "seidel";
+    case RayModelKind::Exact: return "exact";
+  }
+  return "unknown";
+}
+
+RayModelKind parse_ray_model_kind(std::string_view text) {
+  for (RayModelKind k : {RayModelKind::Thin, RayModelKind::Paraxial, RayModelKind::Seidel, RayModelKind::Exact}) {
+    if (text == to_string(k)) return k;
+  }
+  throw OptionsError("unknown ray model '" + std::string(text) + "': expected thin, paraxial, seidel or exact");
+}
+
+std::string RayModel::to_string() const {
+  return std::string(lensmith::to_string(kind())) + " model, " + camera_.to_string();
+}
+
+void RayModelOptions::validate() const {
+  if (!(std::isfinite(nearest_depth_m) && nearest_depth_m > 0.0)) {
+    throw OptionsError("nearest scene depth must be a finite distance > 0 m, got " + format_number(nearest_depth_m));
+  }
+  if (seidel_distance_samples < 2) throw OptionsError("the Seidel table needs at least 2 object distances");
+}
+
+std::unique_ptr<RayModel> make_ray_model(RayModelKind kind, const Camera& camera, const RayModelOptions& options) {
+  options.validate();
+  if (kind == RayModelKind::Thin) {
+    if (!camera.is_thin_lens()) {
+      throw OptionsError("the thin model needs a thin-lens camera (Camera::thin_lens with the lens's EFL)");
+    }
+    return std::make_unique<camera_detail::ReferenceSphereModel>(kind, camera, options);
+  }
+  if (camera.is_thin_lens()) {
+    throw OptionsError("the " + std::string(to_string(kind)) + " model needs a lens prescription, not a thin lens");
+  }
+  if (kind == RayModelKind::Exact) return std::make_unique<camera_detail::ExactModel>(camera);
+  return std::make_unique<camera_detail::ReferenceSphereModel>(kind, camera, options);
+}
+
+}  // namespace lensmith

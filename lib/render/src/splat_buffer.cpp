@@ -1,1 +1,343 @@
-// (being written)
+// SplatBuffer: polygons scan-converted into sub-row spans whose tent-filtered x profile is written as
+// first differences (at most 3 entries per span end) and integrated by one prefix sum per row at
+// resolve time; Kosloff, Tao & Barsky's constant-time rectangle spreading generalised to polygons.
+#include "lensmith/render/splat_buffer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <sstream>
+
+#include "lensmith/core/errors.h"
+#include "lensmith/render/image.h"
+
+namespace lensmith {
+
+namespace {
+
+constexpr int kChannels = 4;
+constexpr int kMaxSubrows = 16;
+// Below this rasterised area (px^2) a polygon is a point: the rounding of its span ends at 4K
+// coordinates (~1e-12 px), divided by A, would exceed 1e-4 of its value.
+constexpr double kPointArea = 1e-9;
+
+// floor and ceil without a libm call (baseline x86-64 has no rounding instruction); values beyond
+// 2^52 are integers already.
+inline double fast_floor(double v) {
+  if (!(std::abs(v) < 4.5e15)) return v;
+  const auto t = static_cast<double>(static_cast<std::int64_t>(v));
+  return t > v ? t - 1.0 : t;
+}
+inline double fast_ceil(double v) { return -fast_floor(-v); }
+
+// t limited to [-2, width + 2], where every visible pixel already sees h_t = 1 or 0; NaN goes low.
+inline double clamp_end(double t, double width) {
+  return t > width + 2.0 ? width + 2.0 : (t >= -2.0 ? t : -2.0);
+}
+
+// First differences of one span end's tent profile at entries first .. first + 2. A span end t
+// contributes h_t(i) = 1 - Phi(t - (i + 0.5)) to pixel i, Phi the integral of the unit tent: h_t is
+// 0 up to k = floor(t - 1.5) and 1 from k + 3, and its differences at k+1..k+3 are the quadratic
+// B-spline weights of f = t - 1.5 - k. t must be clamped (clamp_end).
+struct EndWeights {
+  int first;
+  double q[3];
+};
+inline EndWeights end_weights(double t) {
+  const double u = t - 1.5;
+  int k = static_cast<int>(u);
+  if (k > u) --k;
+  const double f = u - k;
+  EndWeights e;
+  e.first = k + 1;
+  e.q[0] = 0.5 * (1.0 - f) * (1.0 - f);
+  e.q[2] = 0.5 * f * f;
+  e.q[1] = 1.0 - e.q[0] - e.q[2];
+  return e;
+}
+
+// Adds q[j] * coef[c] to entry first + j, channel c. Entries left of 0 fold into entry 0 (the
+// prefix sums of visible pixels stay right); entries at width and beyond are dropped.
+inline void add_weights(double* row, int width, int first, const double q[3], const double coef[kChannels]) {
+  if (first >= 0 && first + 2 < width) {
+    double* e = row + static_cast<std::ptrdiff_t>(first) * kChannels;
+    for (int j = 0; j < 3; ++j, e += kChannels) {
+      const double qj = q[j];
+      const double e0 = e[0] + qj * coef[0];
+      const double e1 = e[1] + qj * coef[1];
+      const double e2 = e[2] + qj * coef[2];
+      const double e3 = e[3] + qj * coef[3];
+      e[0] = e0;
+      e[1] = e1;
+      e[2] = e2;
+      e[3] = e3;
+    }
+    return;
+  }
+  for (int j = 0; j < 3; ++j) {
+    const int i = first + j;
+    if (i >= width) break;
+    double* e = row + static_cast<std::ptrdiff_t>(std::max(i, 0)) * kChannels;
+    for (int c = 0; c < kChannels; ++c) e[c] += q[j] * coef[c];
+  }
+}
+
+inline bool finite_value(const std::array<float, 4>& value) {
+  return std::isfinite(value[0]) && std::isfinite(value[1]) && std::isfinite(value[2]) && std::isfinite(value[3]);
+}
+
+// floor(a / b) for b > 0.
+inline std::int64_t floor_div(std::int64_t a, std::int64_t b) {
+  const std::int64_t q = a / b;
+  return (a % b != 0 && a < 0) ? q - 1 : q;
+}
+
+}  // namespace
+
+std::string Point2f::to_string() const {
+  std::ostringstream os;
+  os << '(' << x << ", " << y << ')';
+  return os.str();
+}
+
+double polygon_area(std::span<const Point2f> vertices) {
+  const std::size_t n = vertices.size();
+  if (n < 3) return 0.0;
+  double twice = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Point2f& p = vertices[i];
+    const Point2f& q = vertices[(i + 1) % n];
+    twice += static_cast<double>(p.x) * q.y - static_cast<double>(q.x) * p.y;
+  }
+  return 0.5 * std::abs(twice);
+}
+
+void SplatOptions::validate() const {
+  if (subrows < 1 || subrows > kMaxSubrows) {
+    throw OptionsError("SplatOptions::subrows = " + std::to_string(subrows) + ": must lie in [1, " +
+                       std::to_string(kMaxSubrows) + "]");
+  }
+}
+
+std::string SplatOptions::to_string() const { return "SplatOptions(subrows " + std::to_string(subrows) + ")"; }
+
+SplatBuffer::SplatBuffer(int width_px, int row_begin, int row_end, const SplatOptions& options)
+    : width_(width_px), row_begin_(row_begin), row_end_(row_end), options_(options) {
+  options_.validate();
+  if (width_px < 1 || row_begin < 0 || row_end < row_begin) {
+    throw OptionsError("SplatBuffer: width " + std::to_string(width_px) + " px, rows [" + std::to_string(row_begin) +
+                       ", " + std::to_string(row_end) + "): need width >= 1 and 0 <= row_begin <= row_end");
+  }
+  diff_.assign(static_cast<std::size_t>(width_) * static_cast<std::size_t>(row_end_ - row_begin_) * kChannels, 0.0);
+  const int s = options_.subrows;
+  subrow_row_offset_.resize(static_cast<std::size_t>(s));
+  subrow_lower_weight_.resize(static_cast<std::size_t>(s));
+  for (int m = 0; m < s; ++m) {
+    // Sub-row centre relative to its pixel row's centre, in (-0.5, 0.5).
+    const double offset = (m + 0.5) / s - 0.5;
+    const int upper = offset < 0.0 ? -1 : 0;
+    subrow_row_offset_[static_cast<std::size_t>(m)] = upper;
+    subrow_lower_weight_[static_cast<std::size_t>(m)] = offset - upper;
+  }
+}
+
+void SplatBuffer::clear() {
+  std::fill(diff_.begin(), diff_.end(), 0.0);
+  skipped_ = 0;
+}
+
+void SplatBuffer::add_point(Point2f p, const std::array<float, 4>& value) {
+  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !finite_value(value)) {
+    ++skipped_;
+    return;
+  }
+  deposit_point(p.x, p.y, value);
+}
+
+void SplatBuffer::deposit_point(double x_px, double y_px, const std::array<float, 4>& value) {
+  // Only rows whose centres lie within 1 of y receive anything; this also keeps floor() in int range.
+  if (!(y_px > row_begin_ - 0.5 && y_px < row_end_ + 0.5)) return;
+  const double x = clamp_end(x_px, width_);
+  // Bilinear weights: pixel i0 gets 1 - fx, i0 + 1 gets fx; as differences at i0 .. i0 + 2.
+  const double i0 = fast_floor(x - 0.5);
+  const double fx = x - 0.5 - i0;
+  const double q[3] = {1.0 - fx, 2.0 * fx - 1.0, -fx};
+  const double j0 = fast_floor(y_px - 0.5);
+  const double fy = y_px - 0.5 - j0;
+  const int rows[2] = {static_cast<int>(j0), static_cast<int>(j0) + 1};
+  const double row_weight[2] = {1.0 - fy, fy};
+  for (int r = 0; r < 2; ++r) {
+    if (rows[r] < row_begin_ || rows[r] >= row_end_) continue;
+    double coef[kChannels];
+    for (int c = 0; c < kChannels; ++c) coef[c] = row_weight[r] * value[static_cast<std::size_t>(c)];
+    add_weights(diff_.data() + static_cast<std::size_t>(rows[r] - row_begin_) * width_ * kChannels, width_,
+                static_cast<int>(i0), q, coef);
+  }
+}
+
+void SplatBuffer::add_triangle(Point2f a, Point2f b, Point2f c, const std::array<float, 4>& value) {
+  const Point2f v[3] = {a, b, c};
+  add_polygon(v, value);
+}
+
+void SplatBuffer::build_chains(std::span<const Point2f> vertices) {
+  const std::size_t n = vertices.size();
+  std::size_t top = 0;
+  std::size_t bottom = 0;
+  for (std::size_t i = 1; i < n; ++i) {
+    if (vertices[i].y < vertices[top].y) top = i;
+    if (vertices[i].y > vertices[bottom].y) bottom = i;
+  }
+  const double s = options_.subrows;
+  auto build = [&](std::vector<ChainVertex>& chain, bool forward) {
+    chain.clear();
+    double first = -std::numeric_limits<double>::infinity();
+    for (std::size_t i = top;; i = forward ? (i + 1 == n ? 0 : i + 1) : (i == 0 ? n - 1 : i - 1)) {
+      const double x = vertices[i].x;
+      const double y = vertices[i].y;
+      // Sub-row centre (k + 0.5) / S >= y  <=>  k >= y S - 0.5.
+      first = std::max(first, fast_ceil(y * s - 0.5));
+      chain.push_back({x, y, first, 0.0});
+      if (i == bottom) break;
+    }
+    // An edge that covers sub-rows rises strictly in y (its first sub-rows differ), so dy > 0.
+    for (std::size_t k = 0; k + 1 < chain.size(); ++k) {
+      ChainVertex& p = chain[k];
+      const ChainVertex& q = chain[k + 1];
+      if (q.first_subrow > p.first_subrow) p.slope = (q.x - p.x) / (q.y - p.y);
+    }
+  };
+  build(forward_chain_, true);
+  build(backward_chain_, false);
+}
+
+void SplatBuffer::add_polygon(std::span<const Point2f> vertices, const std::array<float, 4>& value) {
+  const std::size_t n = vertices.size();
+  bool finite = n > 0 && finite_value(value);
+  double cx = 0.0;
+  double cy = 0.0;
+  for (const Point2f& p : vertices) {
+    finite = finite && std::isfinite(p.x) && std::isfinite(p.y);
+    cx += p.x;
+    cy += p.y;
+  }
+  if (!finite) {
+    ++skipped_;
+    return;
+  }
+  cx /= static_cast<double>(n);
+  cy /= static_cast<double>(n);
+  if (n < 3) {
+    deposit_point(cx, cy, value);
+    return;
+  }
+  build_chains(vertices);
+
+  // Rasterised area in closed form, O(vertices): an edge is linear in y over its sub-rows, so the sum
+  // of its x over them is count * x(mean sub-row y). The scan below assigns sub-rows to edges by the
+  // same first_subrow bounds, so what it deposits sums to this area up to rounding.
+  const double s = options_.subrows;
+  auto chain_x_sum = [s](const std::vector<ChainVertex>& chain) {
+    double sum = 0.0;
+    for (std::size_t k = 0; k + 1 < chain.size(); ++k) {
+      const ChainVertex& p = chain[k];
+      const double count = chain[k + 1].first_subrow - p.first_subrow;
+      const double mean_y = (p.first_subrow + chain[k + 1].first_subrow) / (2.0 * s);
+      if (count > 0.0) sum += count * (p.x + p.slope * (mean_y - p.y));
+    }
+    return sum;
+  };
+  // Spans run from the forward chain (enter, +) to the backward chain (leave, -); for the other
+  // winding both the spans and the area change sign, so the deposit does not.
+  const double area = (chain_x_sum(backward_chain_) - chain_x_sum(forward_chain_)) / s;
+  if (!std::isfinite(area)) {
+    ++skipped_;
+    return;
+  }
+  if (std::abs(area) < kPointArea) {
+    deposit_point(cx, cy, value);
+    return;
+  }
+
+  // Sub-rows that reach a band row: centres within 1 of a band row's centre, (row_begin - 0.5,
+  // row_end + 0.5) in y.
+  const double subrow_top = forward_chain_.front().first_subrow;
+  const double subrow_bottom = forward_chain_.back().first_subrow;  // exclusive
+  const double lo = std::max(subrow_top, fast_ceil((row_begin_ - 0.5) * s - 0.5));
+  const double hi = std::min(subrow_bottom, fast_ceil((row_end_ + 0.5) * s - 0.5));
+  if (!(lo < hi)) return;
+
+  double unit[kChannels];  // deposit per unit span length of one sub-row
+  for (int c = 0; c < kChannels; ++c) unit[c] = value[static_cast<std::size_t>(c)] / (area * s);
+
+  // Walk both chains: each edge is entered once, so the scan costs O(vertices + sub-rows).
+  const ChainVertex* ef = forward_chain_.data();
+  const ChainVertex* eb = backward_chain_.data();
+  while (ef[1].first_subrow <= lo) ++ef;
+  while (eb[1].first_subrow <= lo) ++eb;
+  const int subrows = options_.subrows;
+  const auto s_lo = static_cast<std::int64_t>(lo);
+  const auto s_hi = static_cast<std::int64_t>(hi);
+  std::int64_t pixel_row = floor_div(s_lo, subrows);
+  auto m = static_cast<int>(s_lo - pixel_row * subrows);
+  const double inv_s = 1.0 / s;
+  const double w = width_;
+  for (std::int64_t sub = s_lo; sub < s_hi; ++sub) {
+    const auto sub_d = static_cast<double>(sub);
+    while (ef[1].first_subrow <= sub_d) ++ef;
+    while (eb[1].first_subrow <= sub_d) ++eb;
+    const double y = (sub_d + 0.5) * inv_s;
+    const EndWeights a = end_weights(clamp_end(ef->x + ef->slope * (y - ef->y), w));
+    const EndWeights b = end_weights(clamp_end(eb->x + eb->slope * (y - eb->y), w));
+    const double minus_qb[3] = {-b.q[0], -b.q[1], -b.q[2]};
+
+    const int upper = static_cast<int>(pixel_row) + subrow_row_offset_[static_cast<std::size_t>(m)];
+    const double lower_weight = subrow_lower_weight_[static_cast<std::size_t>(m)];
+    for (int r = 0; r < 2; ++r) {
+      const int row = upper + r;
+      if (row < row_begin_ || row >= row_end_) continue;
+      const double row_weight = r == 0 ? 1.0 - lower_weight : lower_weight;
+      double coef[kChannels];
+      for (int c = 0; c < kChannels; ++c) coef[c] = row_weight * unit[c];
+      double* row_diff = diff_.data() + static_cast<std::size_t>(row - row_begin_) * width_ * kChannels;
+      add_weights(row_diff, width_, a.first, a.q, coef);
+      add_weights(row_diff, width_, b.first, minus_qb, coef);
+    }
+    if (++m == subrows) {
+      m = 0;
+      ++pixel_row;
+    }
+  }
+}
+
+void SplatBuffer::resolve_into(float* rgba_full_image) const {
+  const std::size_t row_size = static_cast<std::size_t>(width_) * kChannels;
+  for (int row = row_begin_; row < row_end_; ++row) {
+    const double* d = diff_.data() + static_cast<std::size_t>(row - row_begin_) * row_size;
+    float* out = rgba_full_image + static_cast<std::size_t>(row) * row_size;
+    double sum[kChannels] = {0.0, 0.0, 0.0, 0.0};
+    for (std::size_t i = 0; i < row_size; i += kChannels) {
+      for (int c = 0; c < kChannels; ++c) {
+        sum[c] += d[i + c];
+        out[i + c] += static_cast<float>(sum[c]);
+      }
+    }
+  }
+}
+
+void SplatBuffer::resolve_into(Image& rgba) const {
+  if (rgba.width != width_ || rgba.channels != kChannels || rgba.height < row_end_) {
+    throw OptionsError("SplatBuffer::resolve_into: " + rgba.to_string() + " must be " + std::to_string(width_) +
+                       " px wide with 4 channels and at least " + std::to_string(row_end_) + " rows");
+  }
+  resolve_into(rgba.data.data());
+}
+
+std::string SplatBuffer::to_string() const {
+  return "SplatBuffer(" + std::to_string(width_) + " px wide, rows [" + std::to_string(row_begin_) + ", " +
+         std::to_string(row_end_) + "), " + std::to_string(options_.subrows) + " sub-rows, " +
+         std::to_string(skipped_) + " skipped)";
+}
+
+}  // namespace lensmith

@@ -1,0 +1,151 @@
+// `lensmith bokeh`: an all-in-focus image and its depth, photographed through a lens
+// (docs/bokeh.md). Reads the inputs, builds the camera and the ray model, renders, writes.
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <limits>
+
+#include "commands.h"
+#include "lensmith/core/errors.h"
+#include "lensmith/core/units.h"
+#include "lensmith/paraxial/paraxial_system.h"
+#include "lensmith/render/bokeh_renderer.h"
+#include "lensmith/render/image_io.h"
+
+namespace lensmith::cli {
+
+namespace {
+
+// A one-line progress bar on stderr, drawn only on a terminal and without --quiet.
+class ProgressBar {
+ public:
+  ProgressBar(std::string label, bool enabled) : label_(std::move(label)), enabled_(enabled && isatty(STDERR_FILENO)) {}
+  void update(double fraction) {
+    if (!enabled_) return;
+    const int percent = static_cast<int>(std::lround(100.0 * fraction));
+    if (percent == last_) return;
+    last_ = percent;
+    const int filled = percent * kWidth / 100;
+    std::cerr << "\r" << label_ << " [" << std::string(static_cast<std::size_t>(filled), '#')
+              << std::string(static_cast<std::size_t>(kWidth - filled), ' ') << "] " << std::setw(3) << percent << "%"
+              << std::flush;
+  }
+  void finish() {
+    if (enabled_ && last_ >= 0) std::cerr << "\n";
+  }
+
+ private:
+  static constexpr int kWidth = 40;
+  std::string label_;
+  bool enabled_;
+  int last_ = -1;
+};
+
+Aperture make_aperture(const BokehCommandOptions& o) {
+  if (!o.aperture_image.empty()) {
+    // The picture's luminance is the aperture's transmission over [-1, 1]^2 (top row = top).
+    const Image picture = read_radiance_image(o.aperture_image);
+    std::vector<float> transmission(picture.pixel_count());
+    for (std::size_t i = 0; i < transmission.size(); ++i) {
+      transmission[i] = (picture.data[3 * i] + picture.data[3 * i + 1] + picture.data[3 * i + 2]) / 3.0f;
+    }
+    return Aperture::mask(picture.width, picture.height, std::move(transmission));
+  }
+  if (o.blades) return Aperture::blades(*o.blades, o.blade_rotation_deg);
+  return Aperture::circular();
+}
+
+}  // namespace
+
+int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
+  const auto started = std::chrono::steady_clock::now();
+  // Inputs.
+  const std::filesystem::path output = o.output;
+  const DepthSource depth_source = DepthSource::parse(o.depth.empty() ? o.image : o.depth);
+  ensure_not_an_input(output, {o.image, depth_source.file});
+  if (!o.aperture_image.empty()) ensure_not_an_input(output, {o.aperture_image});
+  RadianceReadOptions read;
+  read.highlight_gain = o.highlight_gain;
+  read.highlight_threshold = o.highlight_threshold;
+  read.validate();
+  const Image image = read_radiance_image(o.image, read);
+
+  // Camera and ray model.
+  CameraOptions camera;
+  camera.focus_distance_m = o.focus_m;
+  camera.f_number = o.f_number;
+  camera.framing.sensor_width_mm = o.sensor_width_mm;
+  camera.framing.focal_length_mm = o.pinhole_focal_length_mm;
+  camera.framing.horizontal_fov_deg = o.hfov_deg;
+  std::string lens_name;
+  RayModelKind kind = o.model.empty() ? (o.thin_lens ? RayModelKind::Thin : RayModelKind::Seidel) : parse_ray_model_kind(o.model);
+  std::optional<Camera> cam;
+  if (o.thin_lens) {
+    if (kind != RayModelKind::Thin) {
+      throw OptionsError("--thin-lens has no prescription: only --model thin applies (got --model " + o.model + ")");
+    }
+    if (!o.focal_length_mm) throw OptionsError("--thin-lens needs --focal-length MM");
+    cam = Camera::thin_lens(*o.focal_length_mm, camera, image.width, image.height);
+    lens_name = "thin lens f = " + std::to_string(*o.focal_length_mm) + " mm";
+  } else {
+    if (o.lens.empty()) throw OptionsError("give --lens LENS (a file or shipped lens name) or --thin-lens --focal-length MM");
+    const Prescription lens = load_lens(o.lens, global);
+    lens_name = lens.name.empty() ? o.lens : lens.name;
+    if (kind == RayModelKind::Thin) {
+      // The ideal thin lens with this lens's focal length and f-number.
+      const ParaxialSystem p(lens);
+      if (!camera.f_number) camera.f_number = p.f_number();
+      cam = Camera::thin_lens(p.efl_mm(), camera, image.width, image.height);
+    } else {
+      cam = Camera::from_lens(lens, camera, image.width, image.height);
+    }
+  }
+  DepthReadOptions depth_options;
+  depth_options.kind = parse_depth_kind(o.depth_kind);
+  depth_options.unit = parse_depth_unit(o.depth_unit);
+  depth_options.invalid = parse_invalid_depth(o.invalid_depth);
+  const DepthMap depth = read_depth(depth_source, depth_options, cam->frame());
+  float nearest_m = std::numeric_limits<float>::infinity();
+  for (float z : depth.z_m) nearest_m = std::min(nearest_m, z);
+  RayModelOptions model_options;
+  model_options.nearest_depth_m = std::isfinite(nearest_m) ? std::max(0.01, static_cast<double>(nearest_m)) : 1.0;
+  const auto model = make_ray_model(kind, *cam, model_options);
+  const Aperture aperture = make_aperture(o);
+
+  // Render.
+  BokehOptions options;
+  options.threads = o.threads;
+  options.hidden = parse_hidden_surfaces(o.hidden);
+  options.spectral = !o.no_spectral;
+  options.spectral_samples = o.spectral_samples;
+  options.layer_spacing_px = o.layer_spacing_px;
+  options.splat.subrows = o.subrows;
+  options.max_blur_px = o.max_blur_px;
+  ProgressBar bar("bokeh", !global.quiet);
+  options.progress = [&bar](double f) { bar.update(f); };
+  BokehStatistics stats;
+  const Image out = render_bokeh(image, depth, *model, aperture, options, &stats);
+  bar.finish();
+
+  OutputMetadata meta;
+  meta.lens = lens_name;
+  meta.model = std::string(to_string(kind));
+  meta.lensmith_version = LENSMITH_VERSION;
+  meta.f_number = cam->f_number();
+  meta.focus_m = o.focus_m;
+  meta.extra = {{"aperture", aperture.to_string()}, {"hidden_surfaces", std::string(to_string(options.hidden))},
+                {"spectral", options.spectral ? std::to_string(options.spectral_samples) + " nodes" : "off"}};
+  write_output_image(output, out, meta);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  std::cout << "wrote " << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed
+            << std::setprecision(2) << seconds << " s\n"
+            << "  lens " << lens_name << ", model " << to_string(kind) << ", f/" << std::setprecision(2) << cam->f_number()
+            << ", focus " << std::setprecision(3) << o.focus_m << " m, aperture " << aperture.to_string() << "\n"
+            << "  " << stats.to_string() << "\n";
+  return kExitOk;
+}
+
+}  // namespace lensmith::cli

@@ -1,0 +1,122 @@
+// A camera for the bokeh renderer: a lens (a real prescription or an ideal thin lens) at an
+// f-number, focused on a plane by moving the sensor (unit focusing, as a real lens does), and the
+// framing that maps sensor points back to the pixels of the all-in-focus (pinhole) input image.
+//
+// Conventions (docs/bokeh.md):
+// - Scene depth is planar, measured along the axis from the perspective centre: the entrance pupil
+//   of the lens at the reference wavelength (the lens itself for a thin lens). Scene points are
+//   given by the direction tangents of the pinhole image's pixels and their inverse depth.
+// - The sensor sits at the paraxial image of the focus plane at the reference wavelength.
+// - Output framing keeps points on the focus plane at their input pixels: an output pixel is the
+//   sensor point divided by the focus plane's magnification and seen through the pinhole frame.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "lensmith/camera/pinhole_frame.h"
+#include "lensmith/core/units.h"
+#include "lensmith/prescription/prescription.h"
+
+namespace lensmith {
+
+struct CameraOptions {
+  double focus_distance_m = 0.0;          // focus plane, metres from the perspective centre (> 0, may be +inf)
+  std::optional<double> f_number;         // empty: the lens's own (a thin lens needs one)
+  PinholeFrameOptions framing;            // sensor width / pinhole focal length (default: the lens EFL) / hfov
+  double reference_wavelength_nm = kWavelengthD_nm;  // focus and framing are set at this wavelength
+  void validate() const;                  // throws OptionsError naming the option
+  std::string to_string() const;
+};
+
+// First-order data of the lens at one wavelength (z in mm, z = 0 at surface 1; thin lens: all 0).
+struct FirstOrderSample {
+  double wavelength_nm = 0.0;
+  double efl_mm = 0.0;
+  double z_front_principal_mm = 0.0;
+  double z_rear_principal_mm = 0.0;
+  double z_entrance_pupil_mm = 0.0;
+  double z_exit_pupil_mm = 0.0;
+  double entrance_pupil_radius_mm = 0.0;
+  double exit_pupil_radius_mm = 0.0;
+  std::string to_string() const;
+};
+
+// A point of the scene: the direction tangents of the line from the perspective centre through it
+// (x right, y up) and its inverse planar depth (1/mm; 0 = infinitely far).
+struct ScenePoint {
+  double tan_x = 0.0;
+  double tan_y = 0.0;
+  double inverse_depth_per_mm = 0.0;
+};
+
+// The paraxial (Gaussian) image of a scene point at one wavelength: a point in the lens frame.
+struct GaussianImage {
+  double x_mm = 0.0;
+  double y_mm = 0.0;
+  double z_mm = 0.0;
+};
+
+class Camera {
+ public:
+  // An ideal thin lens of focal length f (mm) at f-number N; pupils and principal planes at z = 0.
+  static Camera thin_lens(double focal_length_mm, const CameraOptions& options, int width_px, int height_px);
+  // A real lens (materials resolved). Its first-order data is tabulated at 64 wavelengths from
+  // 380 to 780 nm. Throws ComputationError for afocal lenses or a focus plane the lens cannot image.
+  static Camera from_lens(const Prescription& lens, const CameraOptions& options, int width_px, int height_px);
+
+  bool is_thin_lens() const { return !lens_; }
+  // The prescription at the chosen f-number (aperture spec and stop semi-diameter set to it); null
+  // for a thin lens.
+  const Prescription* lens() const { return lens_.get(); }
+  const PinholeFrame& frame() const { return frame_; }
+  const CameraOptions& options() const { return options_; }
+  double f_number() const { return f_number_; }
+  double focus_distance_mm() const { return focus_mm_; }
+  double reference_wavelength_nm() const { return reference_nm_; }
+  double z_sensor_mm() const { return z_sensor_mm_; }
+  double z_perspective_mm() const { return z_perspective_mm_; }  // entrance pupil at the reference wavelength
+  // -1 when the exit pupil is an inverted image of the entrance pupil, else +1.
+  double pupil_orientation() const { return pupil_orientation_; }
+  // Lowest and highest tabulated wavelengths (nm).
+  double min_wavelength_nm() const;
+  double max_wavelength_nm() const;
+
+  // First-order data at a wavelength (linear interpolation between the tabulated samples).
+  FirstOrderSample first_order(double wavelength_nm) const;
+  // Paraxial image of a scene point through first-order data `s` (air on both sides).
+  GaussianImage gaussian_image(const ScenePoint& p, const FirstOrderSample& s) const;
+  // Output pixel of a sensor point (mm, lens frame x/y).
+  PixelPoint output_pixel(double x_mm, double y_mm) const {
+    return {0.5 * frame_.width_px() + x_mm * px_per_sensor_mm_, 0.5 * frame_.height_px() - y_mm * px_per_sensor_mm_};
+  }
+  // Output pixels per sensor millimetre, signed (< 0: the real image is inverted and the output is not).
+  double px_per_sensor_mm() const { return px_per_sensor_mm_; }
+  // Signed diameter (output pixels) of the paraxial blur disc of an on-axis point at this inverse
+  // depth, reference wavelength: > 0 nearer than the focus plane, < 0 beyond it.
+  double signed_coc_px(double inverse_depth_per_mm) const;
+
+  std::string to_string() const;
+  friend std::ostream& operator<<(std::ostream& os, const Camera& c) { return os << c.to_string(); }
+
+ private:
+  Camera(const PinholeFrame& frame) : frame_(frame) {}
+  void finish();  // sensor, framing scale
+
+  std::shared_ptr<const Prescription> lens_;
+  PinholeFrame frame_;
+  CameraOptions options_;
+  double f_number_ = 0.0;
+  double focus_mm_ = 0.0;
+  double reference_nm_ = kWavelengthD_nm;
+  std::vector<FirstOrderSample> samples_;  // evenly spaced in wavelength (one for a thin lens)
+  double z_sensor_mm_ = 0.0;
+  double z_perspective_mm_ = 0.0;
+  double pupil_orientation_ = 1.0;
+  double px_per_sensor_mm_ = 0.0;
+};
+
+}  // namespace lensmith

@@ -1,0 +1,72 @@
+// The seam between lens and renderer (DESIGN.md): a ray model takes a scene point, points of the
+// aperture (normalised pupil coordinates) and a wavelength, and says where each ray meets the
+// sensor, or that it does not (vignetted, failed). The renderer does not know how.
+//
+//   thin      an ideal thin lens (Cycles' and pbrt's thin-lens camera)
+//   paraxial  the real lens's first-order data per wavelength: principal planes, pupils, focal
+//             length; rays from the exit pupil through the Gaussian image point (no aberrations)
+//   seidel    Asberg's method (Marsicano 2023, sec. 3.10): the Gaussian image point plus Born &
+//             Wolf's third-order aberration vector, the ray leaving the Gaussian reference sphere
+//   exact     each ray traced through the prescription from the scene point, aimed so it crosses
+//             the aperture stop at the requested point: slow, the reference
+#pragma once
+
+#include <memory>
+#include <ostream>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "lensmith/camera/aperture.h"
+#include "lensmith/camera/camera.h"
+
+namespace lensmith {
+
+enum class RayModelKind { Thin, Paraxial, Seidel, Exact };
+
+// "thin", "paraxial", "seidel", "exact" (the --model spelling).
+std::string_view to_string(RayModelKind kind);
+// Throws OptionsError listing the choices.
+RayModelKind parse_ray_model_kind(std::string_view text);
+
+// Where a ray meets the sensor plane (mm, lens frame), or ok = false when it does not get there.
+struct SensorHit {
+  double x_mm = 0.0;
+  double y_mm = 0.0;
+  bool ok = false;
+};
+
+class RayModel {
+ public:
+  virtual ~RayModel() = default;
+  virtual RayModelKind kind() const = 0;
+  // True when, for a fixed scene point and wavelength, the sensor point is an affine function of the
+  // pupil point: the bokeh is then the aperture's outline mapped by one affine map.
+  virtual bool affine_in_pupil() const = 0;
+  // Sensor hits for `pupil` points (normalised: the unit circle is the aperture at the camera's
+  // f-number; for the exact model, on the aperture stop) of one scene point at one wavelength.
+  // `hits` has the size of `pupil`. Thread-safe; allocates nothing per call once warm.
+  virtual void map(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
+                   std::span<SensorHit> hits) const = 0;
+  const Camera& camera() const { return camera_; }
+  virtual std::string to_string() const;
+  friend std::ostream& operator<<(std::ostream& os, const RayModel& m) { return os << m.to_string(); }
+
+ protected:
+  explicit RayModel(Camera camera) : camera_(std::move(camera)) {}
+  Camera camera_;
+};
+
+struct RayModelOptions {
+  // Nearest scene depth the model must serve (m, > 0): the Seidel coefficients are tabulated from it
+  // to infinity, evenly in inverse distance.
+  double nearest_depth_m = 0.5;
+  int seidel_distance_samples = 12;  // >= 2
+  void validate() const;             // throws OptionsError
+};
+
+// Thin needs a thin-lens camera; the others a camera made from a prescription. Throws OptionsError
+// for a mismatch and what the Seidel analysis throws.
+std::unique_ptr<RayModel> make_ray_model(RayModelKind kind, const Camera& camera, const RayModelOptions& options = {});
+
+}  // namespace lensmith

@@ -1,0 +1,78 @@
+// The bokeh renderer: an all-in-focus image and its planar depth, photographed through a ray
+// model (docs/bokeh.md).
+//
+// Every source pixel is a small patch of the scene at its depth. Its point-spread function comes
+// from the ray model: the aperture's outline mapped to the sensor (one uniformly lit polygon for the
+// thin and paraxial models, whose map is affine in the pupil) or a pupil mesh mapped triangle by
+// triangle (seidel, exact: uneven light, folds and caustics included). Footprints are deposited
+// exactly, at a cost that grows with their height, not their area (SplatBuffer), so a highlight
+// becomes a solid, noise-free disc at any size; nothing is random, so output is deterministic.
+//
+// Visibility (Lee, Eisemann & Seidel 2009): pixels are split into depth layers spaced evenly in
+// signed circle of confusion; each layer is scattered alone into colour and coverage, then layers
+// are composited front over back. A blurred background never spreads over a sharp foreground, and
+// a blurred foreground spreads over what lies behind it. What a single image cannot show (the
+// background hidden behind a foreground edge) is estimated: with HiddenSurfaces::Extend each layer
+// is continued under nearer pixels by push-pull interpolation of its own colours, as far as the
+// nearer layers' blur reaches; with Stretch nothing is invented and the visible colours are
+// renormalised over the gap.
+//
+// Colour: each pixel's linear Rec.709 RGB becomes a smooth spectrum (SpectralBasis); its light is
+// carried at the wavelength nodes of a SpectralQuadrature, grouped where the lens's chromatic
+// spread for that pixel is below a tolerance, and integrated back with the CIE 1931 observer, so
+// grey stays grey wherever the lens does not separate colours.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <ostream>
+#include <string>
+
+#include "lensmith/camera/aperture.h"
+#include "lensmith/camera/ray_model.h"
+#include "lensmith/render/image.h"
+#include "lensmith/render/splat_buffer.h"
+
+namespace lensmith {
+
+enum class HiddenSurfaces {
+  Extend,   // continue each depth layer under nearer layers (push-pull), as far as their blur reaches
+  Stretch,  // invent nothing: renormalise the visible layers' colours over what no layer covers
+};
+std::string_view to_string(HiddenSurfaces h);
+HiddenSurfaces parse_hidden_surfaces(std::string_view text);  // "extend" | "stretch"; OptionsError otherwise
+
+struct BokehOptions {
+  int threads = 0;                       // 0 = all hardware threads
+  SplatOptions splat;                    // sub-rows per pixel row of the scatter
+  double layer_spacing_px = 2.0;         // signed circle-of-confusion step between depth layers (> 0)
+  int max_layers = 64;                   // cap; the spacing grows when the blur range needs more (1..1024)
+  HiddenSurfaces hidden = HiddenSurfaces::Extend;
+  bool spectral = true;                  // false: every ray at the reference wavelength, RGB as given
+  int spectral_samples = 16;             // wavelength nodes of the quadrature (3..64)
+  double chromatic_tolerance_px = 0.5;   // largest colour separation left unresolved within a pixel's bokeh
+  double max_blur_px = 1000.0;           // nearer points are clamped to this blur diameter (output px)
+  std::function<void(double)> progress;  // called with the fraction done (0..1), from the calling thread
+  void validate() const;                 // throws OptionsError naming the option
+  std::string to_string() const;
+};
+
+struct BokehStatistics {
+  int layers = 0;                   // non-empty depth layers
+  double layer_spacing_px = 0.0;    // signed CoC spacing used
+  std::size_t source_pixels = 0;    // input pixels scattered
+  std::size_t extended_pixels = 0;  // hidden-surface pixels invented (Extend)
+  std::size_t footprints = 0;       // (pixel, wavelength group) footprints deposited
+  std::size_t triangles = 0;        // mesh triangles deposited (seidel, exact, masks)
+  std::size_t clamped_depths = 0;   // pixels brought back to max_blur_px or in front of the lens
+  double max_abs_coc_px = 0.0;      // largest |signed CoC| among the source pixels
+  std::string to_string() const;
+};
+
+// The picture `model` takes of the scene (image: linear Rec.709 RGB, 3 channels; depth: planar
+// metres, same size, all valid). Output: linear RGB, the input's size and framing.
+// Throws OptionsError for mismatched sizes or options.
+Image render_bokeh(const Image& image, const DepthMap& depth, const RayModel& model, const Aperture& aperture,
+                   const BokehOptions& options = {}, BokehStatistics* statistics = nullptr);
+
+}  // namespace lensmith

@@ -1,0 +1,160 @@
+// Reading the renderer's inputs (an all-in-focus picture and its depth map) and writing its output,
+// through OpenImageIO. The sRGB transfer curve is the piecewise one of IEC 61966-2-1:1999, 5.2/5.3.
+// Pixel layout and units are those of image.h: linear float, row-major, top row first; depth in metres.
+#pragma once
+
+#include <filesystem>
+#include <ostream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "lensmith/camera/pinhole_frame.h"
+#include "lensmith/core/errors.h"
+#include "lensmith/render/image.h"
+
+namespace lensmith {
+
+// An image or depth file was read but its contents are not what lensmith can use (a NaN pixel,
+// a missing channel, integer depth, a size that does not match): the message names the file, the
+// pixel and value where there is one, and what to do. Files that cannot be opened at all are IoError.
+class ImageFileError : public Error {
+ public:
+  using Error::Error;
+};
+
+// sRGB-encoded value in [0, 1] from linear light (IEC 61966-2-1: 12.92 l below l = 0.0031308, else
+// 1.055 l^(1/2.4) - 0.055). Not clamped: values outside [0, 1] follow the same formulas (negative
+// values the linear segment).
+float srgb_encode(float linear);
+// Linear light from an sRGB-encoded value (e / 12.92 at or below e = 0.04045, else
+// ((e + 0.055) / 1.055)^2.4); the inverse of srgb_encode.
+float srgb_decode(float encoded);
+
+// How read_radiance_image treats 8/16-bit (display-referred) pictures.
+struct RadianceReadOptions {
+  // Encoded value in (0, 1] at or above which a channel of an 8/16-bit file counts as clipped.
+  double highlight_threshold = 0.98;
+  // >= 1 (finite). The linear values of a pixel whose largest encoded channel e reaches the
+  // threshold t are multiplied by 1 + (gain - 1) s((e - t) / (1 - t)), s the smoothstep
+  // 3u^2 - 2u^3: 1 at the threshold, `gain` at full scale. A clipped highlight in an LDR photo
+  // stands for light of unknown strength; a gain > 1 lets it carry more energy into the bokeh.
+  // 1 = off. Float files (true radiance) are never changed.
+  double highlight_gain = 1.0;
+
+  void validate() const;  // throws OptionsError naming the field and the constraint
+  std::string to_string() const;  // "RadianceReadOptions(highlight_threshold 0.98, highlight_gain 1)"
+  friend std::ostream& operator<<(std::ostream& os, const RadianceReadOptions& o) { return os << o.to_string(); }
+};
+
+// Reads any picture OpenImageIO reads (first subimage) as linear Rec.709 RGB, 3 channels.
+// - Float/half channels (EXR, HDR, float TIFF, PFM) are linear radiance as stored; a NaN, infinite
+//   or negative value is an ImageFileError naming the first such pixel, channel and value.
+// - 8/16-bit integer channels are sRGB-encoded and decoded by srgb_decode, unless the file says it
+//   is linear (OpenImageIO's "oiio:ColorSpace" = "Linear"), then taken as stored in [0, 1].
+// - Channels R, G, B by name when all three exist, else the first three; a 1- or 2-channel
+//   (gray, gray + alpha) picture is replicated to R = G = B. Alpha is ignored: premultiplied
+//   colours are taken as they are.
+// - The data window must be the display window (no crop or overscan).
+// Throws IoError (with OpenImageIO's message) when the file cannot be opened or read,
+// OptionsError for invalid options.
+Image read_radiance_image(const std::filesystem::path& path, const RadianceReadOptions& options = {});
+
+// A depth input named on a command line as FILE[:CHANNEL].
+struct DepthSource {
+  std::filesystem::path file;
+  std::string channel;  // empty = the default choice of read_depth
+
+  // If the whole spec names an existing file it is the file (so "C:\depth.exr" or a name with a
+  // ':' works); otherwise the spec splits at its last ':' into FILE and a non-empty CHANNEL; with
+  // no ':' it is a file name. Throws OptionsError for an empty spec, file or channel.
+  static DepthSource parse(const std::string& spec);
+  std::string to_string() const;  // "depth.exr:depth.Z", or "depth.exr" with no channel
+  friend std::ostream& operator<<(std::ostream& os, const DepthSource& s) { return os << s.to_string(); }
+};
+
+// What the numbers in a depth channel measure.
+enum class DepthKind {
+  Z,         // planar distance along the optical axis (Blender/Cycles "Z", pbrt, most renderers)
+  Distance,  // Euclidean distance from the pinhole; planar z = d / sqrt(1 + tx^2 + ty^2)
+  Inverse,   // 1 / z in 1 / unit (disparity-like maps from depth estimators); 0 = infinitely far
+};
+// The length unit of a depth channel (of z, d, or of 1 / value for Inverse).
+enum class DepthUnit { M, Cm, Mm };
+// What to do with a depth that names no point in front of the camera: NaN, negative, zero
+// (a point at the pinhole) or, for Inverse, NaN, negative or infinite values.
+enum class InvalidDepth {
+  Error,  // refuse the map, naming the first bad pixel
+  Far,    // treat as infinitely far (+inf)
+  Near,   // treat as the nearest valid depth of the map
+};
+
+// "z" | "distance" | "inverse", "m" | "cm" | "mm", "error" | "far" | "near"; anything else is an
+// OptionsError listing the allowed values. to_string gives back the same words.
+DepthKind parse_depth_kind(const std::string& text);
+DepthUnit parse_depth_unit(const std::string& text);
+InvalidDepth parse_invalid_depth(const std::string& text);
+std::string to_string(DepthKind kind);
+std::string to_string(DepthUnit unit);
+std::string to_string(InvalidDepth invalid);
+
+struct DepthReadOptions {
+  DepthKind kind = DepthKind::Z;
+  DepthUnit unit = DepthUnit::M;
+  InvalidDepth invalid = InvalidDepth::Error;
+  std::string to_string() const;  // "DepthReadOptions(kind z, unit m, invalid error)"
+  friend std::ostream& operator<<(std::ostream& os, const DepthReadOptions& o) { return os << o.to_string(); }
+};
+
+// Reads one channel of a depth file as planar depth z in metres (+inf = infinitely far), pixel
+// (x, y) of the map belonging to pixel (x, y) of `frame`; Distance is converted with the frame's
+// tangents at pixel centres (x + 0.5, y + 0.5).
+// The channel is source.channel, or by default "Z", then "depth.Z", then the first channel.
+// Throws IoError when the file cannot be read, and ImageFileError when the channel is missing
+// (listing the file's channels), stored as integers (normalised integers carry no metric depth:
+// store float EXR, float TIFF or PFM), of another size than the frame, or holds an invalid depth
+// under InvalidDepth::Error (naming the first bad pixel and how to override).
+DepthMap read_depth(const DepthSource& source, const DepthReadOptions& options, const PinholeFrame& frame);
+
+// What the renderer records in its output files.
+struct OutputMetadata {
+  std::string lens;              // lens name or file; empty = not recorded
+  std::string model;             // renderer model name; empty = not recorded
+  std::string lensmith_version;  // empty = not recorded
+  double f_number = 0.0;         // working f-number; 0 = not recorded
+  double focus_m = 0.0;          // focus distance, m (inf allowed); 0 = not recorded
+  std::vector<std::pair<std::string, std::string>> extra;  // written as "lensmith:<key>"
+
+  std::string to_string() const;  // "lens X, f/2.8, focus 2 m, model Y" (the ImageDescription)
+  friend std::ostream& operator<<(std::ostream& os, const OutputMetadata& m) { return os << m.to_string(); }
+};
+
+// Writes a linear RGB image (3 channels, else OptionsError; a NaN is a ComputationError naming the
+// pixel, since whatever made the image failed), the format chosen by the extension (any case):
+//   .exr             32-bit float RGB, ZIP compression, linear as given;
+//   .hdr             Radiance RGBE float, linear as given;
+//   .png .jpg .jpeg  8-bit sRGB (srgb_encode, clamped to [0, 1], rounded; JPEG quality 95);
+//   .tif .tiff       16-bit sRGB, the same way.
+// Every format gets "Software" = "lensmith <version>" and an ImageDescription from meta; EXR (and
+// any format that keeps free attributes) also "lensmith:lens", "lensmith:f_number",
+// "lensmith:focus_m", "lensmith:model", "lensmith:version" and "lensmith:<key>" for meta.extra.
+// The file is written to a temporary file beside `path` and renamed onto it, so a failure never
+// leaves a half-written picture. Throws OptionsError for another extension (listing the supported
+// ones) and IoError when writing fails.
+void write_output_image(const std::filesystem::path& path, const Image& linear_rgb, const OutputMetadata& meta);
+
+// Writes every channel of `image` to a 32-bit float EXR (ZIP) with the given channel names (one
+// per channel): depth or other passes for tools that read them by name. Written atomically like
+// write_output_image. Throws OptionsError when the path does not end in .exr or the names do not
+// match the channels, IoError when writing fails.
+void write_float_exr(const std::filesystem::path& path, const Image& image, const std::vector<std::string>& channel_names);
+
+// The metadata of an image file as (name, value) text pairs, in the order OpenImageIO lists them:
+// string attributes as stored, numbers in the shortest text that reads back exactly. Throws IoError.
+std::vector<std::pair<std::string, std::string>> read_image_metadata(const std::filesystem::path& path);
+
+// Throws OptionsError when `output` names the same file as one of `inputs` (the same file on disk
+// when both exist, else the same normalised absolute path), so a render cannot overwrite its input.
+void ensure_not_an_input(const std::filesystem::path& output, const std::vector<std::filesystem::path>& inputs);
+
+}  // namespace lensmith

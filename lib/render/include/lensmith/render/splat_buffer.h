@@ -1,0 +1,123 @@
+// The scatter primitive of the bokeh renderer: deposits the energy of convex polygons (a pixel's PSF
+// footprint, or the triangles of a mapped pupil mesh) into a band of image rows at O(polygon height)
+// cost, by first differences along each row that a final prefix sum integrates ("constant-time
+// rectangle spreading", Kosloff, Tao & Barsky, "An algorithm for rendering generalized depth of
+// field effects based on simulated heat diffusion", ICCSA 2007 / TVC 2009, generalised to polygons).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <ostream>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace lensmith {
+
+struct Image;
+
+// A point in continuous output pixel coordinates, px: pixel (i, j) covers [i, i+1] x [j, j+1],
+// x to the right, y down.
+struct Point2f {
+  float x = 0.0f;
+  float y = 0.0f;
+
+  std::string to_string() const;  // "(12.5, 3.25)"
+  friend std::ostream& operator<<(std::ostream& os, const Point2f& p) { return os << p.to_string(); }
+};
+
+// Area of a simple polygon by the shoelace formula, px^2, for either winding; 0 for fewer than 3
+// vertices. The exact area, not the rasterised one SplatBuffer normalises by.
+double polygon_area(std::span<const Point2f> vertices);
+
+struct SplatOptions {
+  // Sub-rows per pixel row, in [1, 16]: y is sampled at k + (m + 0.5) / subrows on the global pixel
+  // grid. The y quadrature error of a polygon's deposit falls as 1 / subrows^2; cost grows as subrows.
+  int subrows = 4;
+
+  // Throws OptionsError naming the field and the violated constraint.
+  void validate() const;
+  std::string to_string() const;  // "SplatOptions(subrows 4)"
+  friend std::ostream& operator<<(std::ostream& os, const SplatOptions& o) { return os << o.to_string(); }
+};
+
+// Accumulates RGBA energy deposits for rows [row_begin, row_end) of an image width_px wide.
+//
+// Filtering: a polygon P carrying value v deposits into pixel (i, j)
+//   v / A * integral over P of T(x - (i + 0.5)) T(y - (j + 0.5)) dx dy,   T(u) = max(0, 1 - |u|),
+// exactly in x and by S = subrows midpoint sub-rows per pixel in y, where A is P's area as rasterised
+// (the sum over its sub-rows of span length / S), so that a polygon deposits exactly v in total
+// before clipping at the image's left/right edges and at the band. T is the source pixel's box
+// convolved with the output pixel's box: a point on a pixel centre lands entirely in that pixel.
+// Polygons too thin to cross a sub-row (|A| below 1e-9 px^2) are deposited as points at their vertex
+// centroid with bilinear (tent) weights.
+//
+// Footprints are clipped to the band, and sub-rows lie on the global grid, so bands filled
+// separately (one per thread) and resolved into one image give what one full-height buffer gives.
+// A polygon costs O(vertices + sub-rows inside the band); add_* never allocate once the scratch
+// space has grown to the largest polygon seen. Not thread-safe: one buffer per thread.
+class SplatBuffer {
+ public:
+  // Throws OptionsError for width_px < 1, row_begin < 0, row_end < row_begin or invalid options.
+  SplatBuffer(int width_px, int row_begin, int row_end, const SplatOptions& options = {});
+
+  // Zeroes the accumulated deposits (and the skipped count) without releasing memory.
+  void clear();
+
+  // Convex polygon, either winding, vertices in px; value = (R, G, B, alpha) energy it deposits.
+  // Polygons with no vertex, a non-finite vertex or a non-finite value are not deposited but counted
+  // in skipped(); 1 or 2 vertices are a point at their centroid. A non-convex polygon is deposited as the
+  // region between its two y-monotone chains from the topmost to the bottommost vertex.
+  void add_polygon(std::span<const Point2f> vertices, const std::array<float, 4>& value);
+  void add_triangle(Point2f a, Point2f b, Point2f c, const std::array<float, 4>& value);
+  // A point deposit with bilinear weights over the 2 x 2 pixels whose centres surround p.
+  void add_point(Point2f p, const std::array<float, 4>& value);
+
+  // Prefix-sums each row and adds the band into rgba_full_image: the full image, width() x (at
+  // least row_end()) pixels x 4 floats, row-major, top row first; rows outside the band untouched.
+  void resolve_into(float* rgba_full_image) const;
+  // The same into an Image; throws OptionsError unless it is width() wide, 4 channels and at least
+  // row_end() rows high.
+  void resolve_into(Image& rgba) const;
+
+  int width() const { return width_; }
+  int row_begin() const { return row_begin_; }
+  int row_end() const { return row_end_; }
+  const SplatOptions& options() const { return options_; }
+  // Polygons and points rejected for non-finite coordinates or values since construction or clear().
+  std::size_t skipped() const { return skipped_; }
+
+  std::string to_string() const;  // "SplatBuffer(640 px wide, rows [0, 37), 4 sub-rows, 0 skipped)"
+  friend std::ostream& operator<<(std::ostream& os, const SplatBuffer& b) { return os << b.to_string(); }
+
+ private:
+  // One vertex of a chain from the topmost to the bottommost vertex.
+  struct ChainVertex {
+    double x;
+    double y;
+    // The first global sub-row with centre at or below y, made non-decreasing along the chain; the
+    // chain edge from this vertex covers sub-rows [first_subrow, next vertex's first_subrow).
+    double first_subrow;
+    double slope;  // dx/dy of that edge; 0 when it covers no sub-row
+  };
+
+  void build_chains(std::span<const Point2f> vertices);
+  void deposit_point(double x_px, double y_px, const std::array<float, 4>& value);
+
+  int width_;
+  int row_begin_;
+  int row_end_;
+  SplatOptions options_;
+  std::size_t skipped_ = 0;
+  // First differences along x, double: width_ x (row_end_ - row_begin_) x 4 channels, row-major.
+  // double keeps a bright highlight's rounding from streaking along its row through the prefix sum.
+  std::vector<double> diff_;
+  // Per sub-row class m in [0, subrows): the upper of its two rows relative to the pixel row it
+  // lies in (-1 or 0), and the tent weight of the lower row (the upper row gets 1 - weight).
+  std::vector<int> subrow_row_offset_;
+  std::vector<double> subrow_lower_weight_;
+  std::vector<ChainVertex> forward_chain_;   // scratch: top to bottom vertex by increasing index
+  std::vector<ChainVertex> backward_chain_;  // scratch: top to bottom vertex by decreasing index
+};
+
+}  // namespace lensmith

@@ -1,0 +1,213 @@
+// The bokeh renderer against outside truth: the thin-lens circle of confusion (the formula of
+// path tracers' thin-lens cameras, pbrt-v3 sec. 6.2.3, Cycles), energy conservation, the occlusion
+// rules of layered depth of field (Lee, Eisemann & Seidel 2009), and the exact tracer.
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "lensmith/core/units.h"
+#include "lensmith/prescription/lens_library.h"
+#include "lensmith/render/bokeh_renderer.h"
+
+using namespace lensmith;
+
+namespace {
+
+constexpr double kSensorWidthMm = 36.0;
+
+CameraOptions camera_options(double focus_m, double f_number) {
+  CameraOptions o;
+  o.focus_distance_m = focus_m;
+  o.f_number = f_number;
+  o.framing.sensor_width_mm = kSensorWidthMm;
+  return o;
+}
+
+// A single bright pixel at depth_m on a black background at background_m (the focus distance, so
+// the background is sharp and only the highlight spreads).
+struct Scene {
+  Image image;
+  DepthMap depth;
+};
+Scene highlight_scene(int w, int h, double depth_m, double background_m, int hx, int hy, float radiance = 1000.0f) {
+  Scene s{Image(w, h, 3, 0.0f), DepthMap(w, h, static_cast<float>(background_m))};
+  for (int c = 0; c < 3; ++c) s.image.at(hx, hy, c) = radiance;
+  s.depth.at(hx, hy) = static_cast<float>(depth_m);
+  return s;
+}
+
+// Diameter (px) of the disc: from the area of pixels at or above half the disc's interior level.
+double disc_diameter_px(const Image& img, int channel = 1) {
+  float peak = 0.0f;
+  for (int y = 0; y < img.height; ++y) {
+    for (int x = 0; x < img.width; ++x) peak = std::max(peak, img.at(x, y, channel));
+  }
+  // The interior level: the median of the pixels above a tenth of the peak (robust to edge pixels).
+  std::vector<float> inside;
+  for (int y = 0; y < img.height; ++y) {
+    for (int x = 0; x < img.width; ++x) {
+      if (img.at(x, y, channel) > 0.1f * peak) inside.push_back(img.at(x, y, channel));
+    }
+  }
+  std::nth_element(inside.begin(), inside.begin() + static_cast<long>(inside.size() / 2), inside.end());
+  const float level = inside[inside.size() / 2];
+  std::size_t count = 0;
+  for (int y = 0; y < img.height; ++y) {
+    for (int x = 0; x < img.width; ++x) count += img.at(x, y, channel) >= 0.5f * level ? 1 : 0;
+  }
+  return 2.0 * std::sqrt(static_cast<double>(count) / kPi);
+}
+
+double total(const Image& img, int channel) { return img.mean(channel) * static_cast<double>(img.pixel_count()); }
+
+double max_abs_difference(const Image& a, const Image& b) {
+  double m = 0.0;
+  for (std::size_t i = 0; i < a.data.size(); ++i) m = std::max(m, static_cast<double>(std::abs(a.data[i] - b.data[i])));
+  return m;
+}
+
+Image test_pattern(int w, int h) {
+  Image img(w, h, 3);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      img.at(x, y, 0) = static_cast<float>(0.5 + 0.5 * std::sin(0.37 * x + 0.11 * y));
+      img.at(x, y, 1) = static_cast<float>(((x / 3 + y / 5) % 2) * 0.8 + 0.1);
+      img.at(x, y, 2) = static_cast<float>((x * 7 + y * 13) % 17) / 16.0f;
+    }
+  }
+  return img;
+}
+
+}  // namespace
+
+TEST_CASE("A plane at the focus distance comes out as it went in, through the thin and paraxial models", "[render]") {
+  const int w = 64, h = 48;
+  const Image img = test_pattern(w, h);
+  const DepthMap depth(w, h, 2.5f);
+  SECTION("thin lens") {
+    const Camera cam = Camera::thin_lens(50.0, camera_options(2.5, 2.0), w, h);
+    const auto model = make_ray_model(RayModelKind::Thin, cam);
+    CHECK(max_abs_difference(render_bokeh(img, depth, *model, Aperture::circular()), img) < 1e-5);
+  }
+  SECTION("paraxial model of the Sasian triplet, at the reference wavelength") {
+    const Camera cam = Camera::from_lens(LensLibrary::load("sasian-triplet").prescription, camera_options(2.5, 4.0), w, h);
+    const auto model = make_ray_model(RayModelKind::Paraxial, cam);
+    BokehOptions o;
+    o.spectral = false;
+    CHECK(max_abs_difference(render_bokeh(img, depth, *model, Aperture::circular(), o), img) < 1e-4);
+  }
+}
+
+TEST_CASE("A highlight's disc has the thin-lens circle of confusion A f |z - s| / (z s) within a pixel", "[render]") {
+  // The convention: output pixels of the pinhole image, so the sensor CoC is scaled by (s - f) / s.
+  const double f = 50.0, n = 2.0, s_m = 2.0;
+  const int w = 480, h = 320;
+  const Camera cam = Camera::thin_lens(f, camera_options(s_m, n), w, h);
+  const auto model = make_ray_model(RayModelKind::Thin, cam);
+  const double pitch_mm = kSensorWidthMm / w;
+  for (const double z_m : {1.6, 1.1, 0.7, 5.0, 1000.0}) {
+    const Scene scene = highlight_scene(w, h, z_m, std::max(z_m, s_m), w / 2, h / 2);
+    const Image out = render_bokeh(scene.image, scene.depth, *model, Aperture::circular());
+    const double z = mm_from_m(z_m), s = mm_from_m(s_m), a = f / n;
+    const double expected_px = a * f * std::abs(z - s) / (z * s) / pitch_mm;
+    INFO("depth " << z_m << " m: expected diameter " << expected_px << " px");
+    CHECK(disc_diameter_px(out) == Approx(expected_px).margin(1.0));
+    // Energy: the disc holds what the pixel sent.
+    CHECK(total(out, 1) == Approx(1000.0).epsilon(1e-4));
+  }
+}
+
+TEST_CASE("A 200-pixel highlight is a solid, noise-free disc, and a 5-bladed iris makes a pentagon", "[render]") {
+  const int w = 300, h = 300;
+  const double f = 100.0, s_m = 1.0;
+  const double pitch_mm = kSensorWidthMm / w;
+  // Depth for a 200 px disc, nearer than focus: A f (s - z) / (z s) = 200 pitch.
+  const double a = f / 1.4, s = mm_from_m(s_m);
+  const double z = a * f * s / (a * f + 200.0 * pitch_mm * s);
+  const Camera cam = Camera::thin_lens(f, camera_options(s_m, 1.4), w, h);
+  const auto model = make_ray_model(RayModelKind::Thin, cam);
+  const Scene scene = highlight_scene(w, h, m_from_mm(z), s_m, w / 2, h / 2);
+  const Image out = render_bokeh(scene.image, scene.depth, *model, Aperture::circular());
+  CHECK(disc_diameter_px(out) == Approx(200.0).margin(1.0));
+  // Inside 90 % of the radius every pixel has the same level (no speckle).
+  double lo = kInfinity, hi = 0.0;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      if (std::hypot(x + 0.5 - w / 2.0 - 0.5, y + 0.5 - h / 2.0 - 0.5) < 90.0) {
+        lo = std::min(lo, static_cast<double>(out.at(x, y, 1)));
+        hi = std::max(hi, static_cast<double>(out.at(x, y, 1)));
+      }
+    }
+  }
+  CHECK((hi - lo) / hi < 1e-3);
+  // A regular pentagon inscribed in the same circle has 5/(2 pi) sin(72 deg) of its area.
+  const Image pentagon = render_bokeh(scene.image, scene.depth, *model, Aperture::blades(5, 0.0));
+  const double ratio = std::pow(disc_diameter_px(pentagon) / disc_diameter_px(out), 2.0);
+  CHECK(ratio == Approx(5.0 / (2.0 * kPi) * std::sin(2.0 * kPi / 5.0)).epsilon(0.02));
+}
+
+TEST_CASE("A flat image at one depth keeps its mean whatever the blur", "[render]") {
+  const int w = 96, h = 64;
+  Image img(w, h, 3);
+  for (std::size_t i = 0; i < img.data.size(); i += 3) {
+    img.data[i] = 0.25f;
+    img.data[i + 1] = 0.5f;
+    img.data[i + 2] = 1.0f;
+  }
+  const Camera cam = Camera::from_lens(LensLibrary::load("sasian-triplet").prescription, camera_options(3.0, 4.0), w, h);
+  for (RayModelKind kind : {RayModelKind::Paraxial, RayModelKind::Seidel}) {
+    const auto model = make_ray_model(kind, cam);
+    const Image out = render_bokeh(img, DepthMap(w, h, 0.8f), *model, Aperture::circular());
+    INFO(to_string(kind));
+    CHECK(out.mean(0) == Approx(0.25).epsilon(2e-3));
+    CHECK(out.mean(1) == Approx(0.5).epsilon(2e-3));
+    CHECK(out.mean(2) == Approx(1.0).epsilon(2e-3));
+  }
+}
+
+TEST_CASE("Occlusion: a blurred background stays behind a sharp foreground; a blurred foreground spreads over a sharp background",
+          "[render]") {
+  const int w = 120, h = 40;
+  Image img(w, h, 3);
+  DepthMap near_left(w, h, 0.0f);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const bool left = x < w / 2;
+      for (int c = 0; c < 3; ++c) img.at(x, y, c) = left ? 1.0f : 0.0f;
+      near_left.at(x, y) = left ? 1.0f : 4.0f;
+    }
+  }
+  const double f = 100.0;  // at f/1.4 the far plane's blur is 18 px when focused near, and the near plane's when focused far
+  SECTION("focused on the near plane: its edge pixels keep their value, the background is blurred but does not enter") {
+    const Camera cam = Camera::thin_lens(f, camera_options(1.0, 1.4), w, h);
+    const auto model = make_ray_model(RayModelKind::Thin, cam);
+    const Image out = render_bokeh(img, near_left, *model, Aperture::circular());
+    for (int y = 5; y < h - 5; ++y) CHECK(out.at(w / 2 - 1, y, 1) == Approx(1.0).margin(1e-4));
+  }
+  SECTION("focused on the far plane: the near plane's blur covers the background next to the edge") {
+    const Camera cam = Camera::thin_lens(f, camera_options(4.0, 1.4), w, h);
+    const auto model = make_ray_model(RayModelKind::Thin, cam);
+    for (HiddenSurfaces hidden : {HiddenSurfaces::Extend, HiddenSurfaces::Stretch}) {
+      BokehOptions o;
+      o.hidden = hidden;
+      const Image out = render_bokeh(img, near_left, *model, Aperture::circular(), o);
+      INFO(to_string(hidden));
+      CHECK(out.at(w / 2 + 2, h / 2, 1) > 0.2f);   // the foreground's light falls on the background
+      CHECK(out.at(w - 3, h / 2, 1) < 1e-4f);       // far from the edge the background is untouched
+    }
+  }
+}
+
+TEST_CASE("Rendering is deterministic", "[render]") {
+  const int w = 64, h = 48;
+  const Image img = test_pattern(w, h);
+  DepthMap depth(w, h, 1.0f);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) depth.at(x, y) = 0.6f + 0.05f * static_cast<float>(x % 9);
+  }
+  const Camera cam = Camera::from_lens(LensLibrary::load("sasian-triplet").prescription, camera_options(0.8, 4.0), w, h);
+  const auto model = make_ray_model(RayModelKind::Seidel, cam);
+  const Image a = render_bokeh(img, depth, *model, Aperture::circular());
+  const Image b = render_bokeh(img, depth, *model, Aperture::circular());
+  CHECK(a.data == b.data);
+}
