@@ -1,0 +1,86 @@
+// lensmith bokeh at 1920 x 1080: per ray model, blur size and thread count (docs/performance.md).
+// The scene: a textured image with highlights; the left half on the focus plane, the right half in
+// front of it at the depth whose thin-lens blur diameter is the benchmark's argument (pixels of the pinhole image).
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+
+#include "lensmith/core/units.h"
+#include "lensmith/prescription/lens_library.h"
+#include "lensmith/render/bokeh_renderer.h"
+
+using namespace lensmith;
+
+namespace {
+
+constexpr int kWidth = 1920, kHeight = 1080;
+constexpr double kFocalMm = 50.0, kFNumber = 2.0, kFocusMm = 2000.0, kSensorMm = 36.0;
+
+struct BenchScene {
+  Image image{kWidth, kHeight, 3};
+  DepthMap depth{kWidth, kHeight, 2.0f};
+};
+
+// Depth (m) in front of the focus plane whose thin-lens blur is `blur_px` output pixels.
+double depth_for_blur(double blur_px) {
+  const double pitch = kSensorMm / kWidth, a = kFocalMm / kFNumber;
+  // A f (s - z) / (z s) = b p  ->  z = A f s / (A f + b p s)
+  return m_from_mm(a * kFocalMm * kFocusMm / (a * kFocalMm + blur_px * pitch * kFocusMm));
+}
+
+BenchScene make_scene(double blur_px) {
+  BenchScene s;
+  const auto far_m = static_cast<float>(depth_for_blur(blur_px));
+  for (int y = 0; y < kHeight; ++y) {
+    for (int x = 0; x < kWidth; ++x) {
+      const float checker = ((x / 24 + y / 24) % 2) ? 0.8f : 0.2f;
+      s.image.at(x, y, 0) = checker * (0.5f + 0.5f * std::sin(0.01f * static_cast<float>(x)));
+      s.image.at(x, y, 1) = checker;
+      s.image.at(x, y, 2) = checker * (0.5f + 0.5f * std::cos(0.013f * static_cast<float>(y)));
+      if (x % 97 == 0 && y % 89 == 0) {
+        for (int c = 0; c < 3; ++c) s.image.at(x, y, c) = 100.0f;
+      }
+      s.depth.at(x, y) = x < kWidth / 2 ? static_cast<float>(m_from_mm(kFocusMm)) : far_m;
+    }
+  }
+  return s;
+}
+
+void run(benchmark::State& state, RayModelKind kind) {
+  const double blur = static_cast<double>(state.range(0));
+  const BenchScene scene = make_scene(blur);
+  CameraOptions o;
+  o.focus_distance_m = m_from_mm(kFocusMm);
+  o.f_number = kFNumber;
+  o.framing.sensor_width_mm = kSensorMm;
+  o.framing.focal_length_mm = kFocalMm;
+  const Camera camera = kind == RayModelKind::Thin
+                            ? Camera::thin_lens(kFocalMm, o, kWidth, kHeight)
+                            : Camera::from_lens(LensLibrary::load("pbrt-dgauss-50mm").prescription, o, kWidth, kHeight);
+  RayModelOptions mo;
+  mo.nearest_depth_m = 0.2;
+  const auto model = make_ray_model(kind, camera, mo);
+  BokehOptions options;
+  options.threads = static_cast<int>(state.range(1));
+  for (auto _ : state) {
+    Image out = render_bokeh(scene.image, scene.depth, *model, Aperture::circular(), options);
+    benchmark::DoNotOptimize(out.data.data());
+  }
+  state.counters["Mpixel/s"] = benchmark::Counter(static_cast<double>(kWidth) * kHeight * 1e-6,
+                                                  benchmark::Counter::kIsIterationInvariantRate);
+}
+
+void args(benchmark::internal::Benchmark* b) {
+  for (int threads : {1, 2}) {
+    for (int blur : {4, 16, 48, 128}) b->Args({blur, threads});
+  }
+  b->ArgNames({"blur_px", "threads"})->Unit(benchmark::kSecond)->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true)->UseRealTime();
+}
+
+}  // namespace
+
+BENCHMARK_CAPTURE(run, thin, RayModelKind::Thin)->Apply(args);
+BENCHMARK_CAPTURE(run, paraxial, RayModelKind::Paraxial)->Apply(args);
+BENCHMARK_CAPTURE(run, seidel, RayModelKind::Seidel)->Apply(args);
+
+BENCHMARK_MAIN();

@@ -1,0 +1,90 @@
+// `lensmith bokeh` as a user runs it: outputs and their metadata, and clear errors for bad input.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include "lensmith/render/image_io.h"
+#include "run_lensmith.h"
+
+using lensmith::testing::run_lensmith;
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kScene = std::string(LENSMITH_SOURCE_DIR) + "/examples/bokeh-scene.exr";
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("lensmith_bokeh_cli_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  return dir / name;
+}
+
+std::string value_of(const std::vector<std::pair<std::string, std::string>>& meta, const std::string& key) {
+  for (const auto& [k, v] : meta) {
+    if (k == key) return v;
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("lensmith bokeh renders the bundled scene to an EXR that says how it was made, and to a PNG", "[cli][bokeh]") {
+  const fs::path exr = scratch("out.exr"), png = scratch("out.png");
+  const auto r = run_lensmith("bokeh --image " + kScene + " --lens sasian-triplet --fstop 4 --focus 3 --model paraxial -o " +
+                              exr.string() + " --quiet");
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.err.empty());  // --quiet: no progress bar, no warnings
+  const lensmith::Image out = lensmith::read_radiance_image(exr);
+  CHECK(out.width == 640);
+  CHECK(out.height == 360);
+  const auto meta = lensmith::read_image_metadata(exr);
+  CHECK(value_of(meta, "lensmith:model") == "paraxial");
+  CHECK(value_of(meta, "lensmith:lens").find("Sasian") != std::string::npos);
+  CHECK(std::stod(value_of(meta, "lensmith:f_number")) == Approx(4.0));
+  CHECK(std::stod(value_of(meta, "lensmith:focus_m")) == Approx(3.0));
+  CHECK_FALSE(value_of(meta, "lensmith:version").empty());
+  const auto p = run_lensmith("bokeh --image " + kScene + " --thin-lens --focal-length 50 --fstop 2 --focus 1.2 -o " +
+                              png.string() + " --quiet");
+  CHECK(p.exit_code == 0);
+  CHECK(fs::file_size(png) > 1000);
+}
+
+TEST_CASE("lensmith bokeh refuses to overwrite its input and leaves it as it was", "[cli][bokeh]") {
+  const fs::path copy = scratch("scene.exr");
+  fs::copy_file(kScene, copy, fs::copy_options::overwrite_existing);
+  const auto size = fs::file_size(copy);
+  const auto r = run_lensmith("bokeh --image " + copy.string() + " --thin-lens --focal-length 50 --fstop 2 --focus 3 -o " +
+                              copy.string());
+  CHECK(r.exit_code == 3);
+  CHECK(r.err.find("input") != std::string::npos);
+  CHECK(fs::file_size(copy) == size);
+}
+
+TEST_CASE("lensmith bokeh names the pixel of a NaN depth, and --invalid-depth far accepts it", "[cli][bokeh]") {
+  lensmith::Image depth(640, 360, 1, 3.0f);
+  depth.at(17, 5, 0) = std::numeric_limits<float>::quiet_NaN();
+  const fs::path depth_file = scratch("depth-nan.exr"), out = scratch("nan.exr");
+  lensmith::write_float_exr(depth_file, depth, {"Z"});
+  const std::string common = "bokeh --image " + kScene + " --depth " + depth_file.string() +
+                             " --thin-lens --focal-length 50 --fstop 2 --focus 3 --quiet -o " + out.string();
+  const auto r = run_lensmith(common);
+  CHECK(r.exit_code == 3);
+  CHECK(r.err.find("(17, 5)") != std::string::npos);
+  CHECK(run_lensmith(common + " --invalid-depth far").exit_code == 0);
+}
+
+TEST_CASE("lensmith bokeh rejects a depth map of another size and a thin lens without a focal length", "[cli][bokeh]") {
+  const fs::path depth_file = scratch("depth-small.exr"), out = scratch("x.exr");
+  lensmith::write_float_exr(depth_file, lensmith::Image(320, 180, 1, 2.0f), {"Z"});
+  const auto r = run_lensmith("bokeh --image " + kScene + " --depth " + depth_file.string() +
+                              " --lens sasian-triplet --focus 3 -o " + out.string());
+  CHECK(r.exit_code == 3);
+  CHECK(r.err.find("320") != std::string::npos);
+  const auto t = run_lensmith("bokeh --image " + kScene + " --thin-lens --fstop 2 --focus 3 -o " + out.string());
+  CHECK(t.exit_code == 3);
+  CHECK(t.err.find("--focal-length") != std::string::npos);
+  CHECK_FALSE(fs::exists(out));
+}
