@@ -12,7 +12,7 @@
 using Catch::Matchers::WithinAbs;
 using namespace lensmith;
 
-TEST_CASE("off-axis analyses of a lens without a field ask for a field angle; on axis needs none", "[analysis][context]") {
+TEST_CASE("off-axis analyses of a lens without a field ask for a field angle, on axis needs none", "[analysis][context]") {
   Prescription lens = lensmith::testing::angenieux_double_gauss();
   lens.field.reset();
   CHECK_THROWS_WITH(AnalysisContext(lens), Catch::Contains("states no field") && Catch::Contains("--field-angle"));

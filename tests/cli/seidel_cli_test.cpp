@@ -28,7 +28,7 @@ TEST_CASE("lensmith seidel --json has the documented keys and the Sasian triplet
   CHECK_THAT(j["surfaces"][1]["S5"].get<double>(), Catch::Matchers::WithinAbs(-0.431229, kSixDecimals));
 }
 
-TEST_CASE("lensmith seidel: --epd and --field-angle override the lens; --png writes the Seidel diagram", "[cli][seidel]") {
+TEST_CASE("lensmith seidel: --epd and --field-angle override the lens, --png writes the Seidel diagram", "[cli][seidel]") {
   namespace fs = std::filesystem;
   const fs::path png = fs::temp_directory_path() / "lensmith_cli_seidel.png";
   fs::remove(png);

@@ -140,7 +140,7 @@ TEST_CASE("lensmith spot --random is reproducible with --seed, and --rings with 
   CHECK(run_lensmith("spot sasian-triplet --fields 0,1.5").exit_code == 2);
 }
 
-TEST_CASE("lensmith spot --png writes a PNG of the picture's size; the input is never overwritten", "[cli][spot][png]") {
+TEST_CASE("lensmith spot --png writes a PNG of the picture's size, the input is never overwritten", "[cli][spot][png]") {
   ScratchFolder scratch;
   const std::string png = scratch.file("spot.png");
   const auto r = run_lensmith("spot sasian-triplet --png " + png);
@@ -211,7 +211,7 @@ TEST_CASE("lensmith analyze: each --what prints JSON with its curve and writes i
   }
 }
 
-TEST_CASE("lensmith analyze: a lens without a field needs --field-angle; unknown analyses are refused", "[cli][analyze]") {
+TEST_CASE("lensmith analyze: a lens without a field needs --field-angle, unknown analyses are refused", "[cli][analyze]") {
   const auto r = run_lensmith("analyze angenieux-double-gauss-1953 --what distortion");
   CHECK(r.exit_code == 3);
   CHECK(r.err.find("--field-angle") != std::string::npos);

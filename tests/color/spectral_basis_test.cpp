@@ -28,7 +28,7 @@ TEST_CASE("spectral basis: b_r + b_g + b_b = 1 at 1000 wavelengths from 380 to 7
   }
 }
 
-TEST_CASE("spectral basis: blue dominates at 450 nm, green at 540 nm, red at 650 nm; equal at the crossovers", "[color][basis]") {
+TEST_CASE("spectral basis: blue dominates at 450 nm, green at 540 nm, red at 650 nm, equal at the crossovers", "[color][basis]") {
   const SpectralBasis basis;
   const Rgb blue = basis.basis_values(450.0);
   const Rgb green = basis.basis_values(540.0);

@@ -147,7 +147,7 @@ TEST_CASE("lens JSON: floating by stop size needs a stop semi-diameter", "[presc
   CHECK_THAT(read_error(text).what(), Contains("floats by stop size"));
 }
 
-TEST_CASE("lens JSON: the field takes one kind; an object-height field needs a finite object", "[prescription][json]") {
+TEST_CASE("lens JSON: the field takes one kind, an object-height field needs a finite object", "[prescription][json]") {
   auto e = read_error(lens_with("{\"radius_mm\": \"flat\", \"thickness_mm\": 95}", "  \"field\": {\"object_height_mm\": 10},\n"));
   CHECK_THAT(e.what(), Contains("object-height field needs a finite object distance"));
   auto r = read_lens_json(lens_with("{\"radius_mm\": \"flat\", \"thickness_mm\": 95}",

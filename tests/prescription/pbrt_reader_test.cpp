@@ -183,7 +183,7 @@ TEST_CASE("pbrt: a file without a stop row is an error", "[prescription][pbrt]")
   CHECK_THAT(pbrt_error("50 5 1.6 20\n-80 0 1 20\n").what(), Contains("no aperture stop"));
 }
 
-TEST_CASE("pbrt: index 0 is allowed only on the stop row; indices below 1 are errors", "[prescription][pbrt]") {
+TEST_CASE("pbrt: index 0 is allowed only on the stop row, indices below 1 are errors", "[prescription][pbrt]") {
   CHECK(pbrt_error("50 5 0 20\n0 3 0 16\n-80 0 1 20\n").where().line == 1);
   CHECK(pbrt_error("50 5 0.8 20\n0 3 0 16\n-80 0 1 20\n").where().column == 6);
 }

@@ -478,7 +478,7 @@ TEST_CASE("Zemax: a curved image surface is a warning", "[prescription][zemax]")
   CHECK(has_diagnostic(r.diagnostics, Diagnostic::Severity::Warning, line_of(text, "CURV -0.01"), "curved"));
 }
 
-TEST_CASE("Zemax: NOTE lines join into the notes; NOTE 0 pieces continue the same line", "[prescription][zemax]") {
+TEST_CASE("Zemax: NOTE lines join into the notes, NOTE 0 pieces continue the same line", "[prescription][zemax]") {
   const std::string text = mini_zmx("NOTE 0 first half of a long li\nNOTE 0 ne\nNOTE 4\nNOTE 0 second line\nNOTE 4\n");
   CHECK(read_zemax(text, "t.zmx").prescription.notes == "first half of a long line\nsecond line");
 }

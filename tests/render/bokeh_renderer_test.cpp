@@ -165,7 +165,7 @@ TEST_CASE("A flat image at one depth keeps its mean whatever the blur", "[render
   }
 }
 
-TEST_CASE("Occlusion: a blurred background stays behind a sharp foreground; a blurred foreground spreads over a sharp background",
+TEST_CASE("Occlusion: a blurred background stays behind a sharp foreground, a blurred foreground spreads over a sharp background",
           "[render]") {
   const int w = 120, h = 40;
   Image img(w, h, 3);

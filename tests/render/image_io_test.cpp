@@ -311,7 +311,7 @@ TEST_CASE("highlight gain leaves float pictures alone", "[render][image_io]") {
   CHECK(read_radiance_image(exr, options).at(0, 0, 0) == 1.0f);
 }
 
-TEST_CASE("RadianceReadOptions: threshold must be in (0, 1] and gain >= 1", "[render][image_io]") {
+TEST_CASE("RadianceReadOptions: the threshold must lie above 0 and at most 1, and the gain be at least 1", "[render][image_io]") {
   RadianceReadOptions options;
   CHECK_NOTHROW(options.validate());
   options.highlight_threshold = 0.0;
@@ -345,7 +345,7 @@ TEST_CASE("depth sources: FILE:CHANNEL splits at the last ':', an existing file 
   CHECK_THROWS_AS(DepthSource::parse(""), OptionsError);
 }
 
-TEST_CASE("depth words parse and print back; other words list the allowed ones", "[render][image_io][depth]") {
+TEST_CASE("depth words parse and print back, other words list the allowed ones", "[render][image_io][depth]") {
   for (const char* word : {"z", "distance", "inverse"}) CHECK(to_string(parse_depth_kind(word)) == word);
   for (const char* word : {"m", "cm", "mm"}) CHECK(to_string(parse_depth_unit(word)) == word);
   for (const char* word : {"error", "far", "near"}) CHECK(to_string(parse_invalid_depth(word)) == word);
@@ -376,7 +376,7 @@ TEST_CASE("depth is read from the Z channel of an EXR that also holds RGB", "[re
   CHECK(read_radiance_image(exr).at(2, 1, 0) == 0.5f);
 }
 
-TEST_CASE("the default depth channel is Z, then depth.Z, then the first channel; FILE:CHANNEL overrides", "[render][image_io][depth]") {
+TEST_CASE("the default depth channel is Z, then depth.Z, then the first channel, FILE:CHANNEL overrides", "[render][image_io][depth]") {
   TempDir dir;
   Image three(4, 3, 3);
   for (std::size_t i = 0; i < three.pixel_count(); ++i) {
@@ -449,7 +449,7 @@ TEST_CASE("depth in centimetres and millimetres is converted to metres", "[rende
   CHECK_THAT(read_depth(DepthSource{inverse, ""}, options, small_frame()).at(0, 0), WithinRel(0.25, kFloatDepth));
 }
 
-TEST_CASE("NaN, negative or zero depth is an error naming the pixel; far and near override it", "[render][image_io][depth]") {
+TEST_CASE("NaN, negative or zero depth is an error naming the pixel, far and near override it", "[render][image_io][depth]") {
   TempDir dir;
   const PinholeFrame frame = small_frame();
   std::vector<float> values(12, 3.0f);

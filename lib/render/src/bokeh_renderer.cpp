@@ -59,6 +59,13 @@ int step_index(const std::array<int, N>& steps, double wanted) {
   return static_cast<int>(N) - 1;
 }
 
+// Footprint heights (px, with margins) from which half and a quarter of the sub-rows are used.
+constexpr float kMediumFootprintPx = 20.0f;
+// Footprints narrower than this (px) are deposited as points: the 2 px tent hides their shape.
+constexpr double kPointFootprintPx = 0.2;
+constexpr int kPointPath = -2;
+constexpr float kTallFootprintPx = 68.0f;
+
 // Sectors so a polygon inscribed in a circle of diameter d px departs from it by < 0.1 px.
 double sectors_for(double diameter_px) { return kPi * std::sqrt(2.5 * std::max(diameter_px, 0.0)); }
 
@@ -70,6 +77,13 @@ class Renderer {
     threads_ = options.threads > 0 ? options.threads : omp_get_max_threads();
     build_spectral_groups();
     build_meshes();
+    // The probe: the pupil centre and 8 points on the aperture's edge, from the top anticlockwise.
+    probe_[0] = {0.0, 0.0};
+    for (int k = 0; k < 8; ++k) {
+      const double a = kPi / 2.0 + 2.0 * kPi * k / 8.0;
+      const double r = aperture_.kind() == Aperture::Kind::Mask ? 1.0 : aperture_.edge_radius(a);
+      probe_[static_cast<std::size_t>(k) + 1] = {r * std::cos(a), r * std::sin(a)};
+    }
   }
 
   Image run(BokehStatistics& stats);
@@ -83,6 +97,12 @@ class Renderer {
   void scatter(const Source& s, const Plan& p, SplatBuffer& buffer, std::vector<SensorHit>& hits,
                std::vector<Point2f>& points, std::size_t& triangles) const;
   std::vector<Source> extend_layer(const std::vector<int>& layer_of, int layer, double reach_px) const;
+  // The splat options with the sub-row count divided by `divisor` (at least 1).
+  SplatOptions subrow_options(int divisor) const {
+    SplatOptions o = options_.splat;
+    o.subrows = std::max(1, o.subrows / divisor);
+    return o;
+  }
 
   const Image& image_;
   const DepthMap& depth_;
@@ -95,6 +115,7 @@ class Renderer {
   double lambda_lo_ = 0.0, lambda_hi_ = 0.0;         // extreme nodes, for the chromatic probe
   std::vector<PupilMesh> meshes_;                    // polar: ring step * sectors + sector step; masks: grid steps
   std::vector<std::vector<PupilPoint>> outlines_;    // per sector step (blades: corners only)
+  std::array<PupilPoint, 9> probe_{};
 };
 
 void Renderer::build_spectral_groups() {
@@ -179,13 +200,7 @@ Plan Renderer::plan(const Source& s, std::vector<PupilPoint>& pupil, std::vector
   Plan p;
   const bool affine = model_.affine_in_pupil() && aperture_.is_uniform_convex();
   // Probe: the pupil centre and its edge (8 points) at the extreme wavelengths and the reference.
-  pupil.clear();
-  pupil.push_back({0.0, 0.0});
-  for (int k = 0; k < 8; ++k) {
-    const double a = kPi / 2.0 + 2.0 * kPi * k / 8.0;
-    const double r = aperture_.kind() == Aperture::Kind::Mask ? 1.0 : aperture_.edge_radius(a);
-    pupil.push_back({r * std::cos(a), r * std::sin(a)});
-  }
+  pupil.assign(probe_.begin(), probe_.end());
   hits.resize(pupil.size());
   const std::array<double, 3> lambdas{camera_.reference_wavelength_nm(), lambda_lo_, lambda_hi_};
   std::array<std::array<PixelPoint, 9>, 3> px{};
@@ -237,7 +252,9 @@ Plan Renderer::plan(const Source& s, std::vector<PupilPoint>& pupil, std::vector
   p.y_min = static_cast<float>(y_min - margin);
   p.y_max = static_cast<float>(y_max + margin);
   const int sector_step = step_index(kSectorSteps, sectors_for(size));
-  if (near_affine) {
+  if (near_affine && size < kPointFootprintPx) {
+    p.outline = kPointPath;
+  } else if (near_affine) {
     p.outline = sector_step;
   } else if (aperture_.kind() == Aperture::Kind::Mask) {
     p.mesh = step_index(kGridSteps, size / 1.5);
@@ -256,6 +273,15 @@ void Renderer::scatter(const Source& s, const Plan& p, SplatBuffer& buffer, std:
     std::array<float, 4> value{};
     for (int c = 0; c < 3; ++c) value[c] = g.m[c][0] * s.rgb[0] + g.m[c][1] * s.rgb[1] + g.m[c][2] * s.rgb[2];
     value[3] = g.alpha;
+    if (p.outline == kPointPath) {
+      static constexpr std::array<PupilPoint, 1> kCentre{{{0.0, 0.0}}};
+      hits.resize(1);
+      model_.map(point, g.wavelength_nm, kCentre, std::span<SensorHit>(hits.data(), 1));
+      if (!hits[0].ok) continue;
+      const PixelPoint c = camera_.output_pixel(hits[0].x_mm, hits[0].y_mm);
+      buffer.add_point({static_cast<float>(c.x), static_cast<float>(c.y)}, value);
+      continue;
+    }
     if (p.mesh < 0) {
       // Affine model, uniform convex aperture: the outline mapped by the affine map of three rays.
       static constexpr std::array<PupilPoint, 3> kBasis{{{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}}};
@@ -478,15 +504,20 @@ Image Renderer::run(BokehStatistics& stats) {
       for (int b = 0; b < bands; ++b) {
         const int row_begin = b * h / bands, row_end = (b + 1) * h / bands;
         if (row_begin == row_end) continue;
-        SplatBuffer buffer(w, row_begin, row_end, options_.splat);
+        // Tall footprints need fewer sub-rows: only their top and bottom rows see the y sampling.
+        std::array<SplatBuffer, 3> buffers{SplatBuffer(w, row_begin, row_end, subrow_options(1)),
+                                           SplatBuffer(w, row_begin, row_end, subrow_options(2)),
+                                           SplatBuffer(w, row_begin, row_end, subrow_options(4))};
         for (std::size_t i = 0; i < layer.size(); ++i) {
           if (plans[i].y_max < static_cast<float>(row_begin) - 1.0f || plans[i].y_min > static_cast<float>(row_end) + 1.0f) continue;
+          const float height = plans[i].y_max - plans[i].y_min;
+          SplatBuffer& buffer = buffers[height < kMediumFootprintPx ? 0 : height < kTallFootprintPx ? 1 : 2];
           scatter(layer[i], plans[i], buffer, hits, points, local_triangles);
           local_footprints += static_cast<std::size_t>(plans[i].groups);
         }
         float* rows = layer_rgba.data() + static_cast<std::size_t>(row_begin) * w * 4;
         std::fill(rows, rows + static_cast<std::size_t>(row_end - row_begin) * w * 4, 0.0f);
-        buffer.resolve_into(layer_rgba.data());
+        for (const SplatBuffer& buffer : buffers) buffer.resolve_into(layer_rgba.data());
         // Within a layer, overlapping footprints of one surface average; its coverage is at most 1.
         for (std::size_t k = static_cast<std::size_t>(row_begin) * w; k < static_cast<std::size_t>(row_end) * w; ++k) {
           double c[4] = {layer_rgba[4 * k], layer_rgba[4 * k + 1], layer_rgba[4 * k + 2], layer_rgba[4 * k + 3]};
