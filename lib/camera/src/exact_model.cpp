@@ -105,8 +105,15 @@ void ExactModel::map(const ScenePoint& point, double wavelength_nm, std::span<co
       hits[i] = {};
       continue;
     }
-    const TraceResult t = clipped_->trace_forward(ray_towards(point, z_persp, tx, ty, z_target, wavelength_nm, start_z));
-    hits[i] = t.ok() ? SensorHit{t.ray.position_mm.x(), t.ray.position_mm.y(), true} : SensorHit{};
+    const Ray ray = ray_towards(point, z_persp, tx, ty, z_target, wavelength_nm, start_z);
+    const TraceResult t = clipped_->trace_forward(ray);
+    if (t.ok()) {
+      hits[i] = SensorHit{t.ray.position_mm.x(), t.ray.position_mm.y(), true, true};
+      continue;
+    }
+    // Stopped by a clear aperture: where it would have landed, for the edge of the beam.
+    const TraceResult f = t.status == RayStatus::Vignetted ? free_->trace_forward(ray) : TraceResult{};
+    hits[i] = f.ok() ? SensorHit{f.ray.position_mm.x(), f.ray.position_mm.y(), false, true} : SensorHit{};
   }
 }
 

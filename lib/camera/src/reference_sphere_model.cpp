@@ -39,7 +39,7 @@ void ReferenceSphereModel::map(const ScenePoint& point, double wavelength_nm, st
     const double t = (z_sensor - z_exit) / (g.z_mm - z_exit);
     for (std::size_t i = 0; i < pupil.size(); ++i) {
       const double px = r_exit * pupil[i].x, py = r_exit * pupil[i].y;
-      hits[i] = {px + (g.x_mm - px) * t, py + (g.y_mm - py) * t, true};
+      hits[i] = {px + (g.x_mm - px) * t, py + (g.y_mm - py) * t, true, true};
     }
     return;
   }
@@ -78,7 +78,7 @@ void ReferenceSphereModel::map(const ScenePoint& point, double wavelength_nm, st
     const double qx = g.x_mm + ux * scale, qy = g.y_mm + uy * scale, qz = g.z_mm + uz * scale;
     const double d_x = p1x - qx, d_y = p1y - qy, d_z = g.z_mm - qz;
     const double s = (z_sensor - g.z_mm) / d_z;
-    hits[i] = {p1x + d_x * s, p1y + d_y * s, true};
+    hits[i] = {p1x + d_x * s, p1y + d_y * s, true, true};
   }
 }
 

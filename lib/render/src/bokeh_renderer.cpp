@@ -64,10 +64,62 @@ constexpr float kMediumFootprintPx = 20.0f;
 // Footprints narrower than this (px) are deposited as points: the 2 px tent hides their shape.
 constexpr double kPointFootprintPx = 0.2;
 constexpr int kPointPath = -2;
+// Pixels covered at least this much are known colour for filling the gaps of others (coverage of
+// a tiling of distorted footprints wanders a few per cent around 1; a pixel whose own light spread
+// away is far below).
+constexpr double kKnownCoverage = 0.9;
 constexpr float kTallFootprintPx = 68.0f;
 
 // Sectors so a polygon inscribed in a circle of diameter d px departs from it by < 0.1 px.
 double sectors_for(double diameter_px) { return kPi * std::sqrt(2.5 * std::max(diameter_px, 0.0)); }
+
+// Push-pull interpolation (Gortler, Grzeszczuk, Szeliski & Cohen, "The Lumigraph", SIGGRAPH 1996):
+// `cells` holds, per pixel, four weighted sums and their weight (0 = unknown). Pull sums 2 x 2
+// blocks down to one cell; push gives every unknown cell its parent's normalised value. On return
+// every cell holds normalised values and weight 1 (all zero if no cell was known).
+void push_pull(int w, int h, std::vector<std::array<double, 5>>& cells) {
+  std::vector<std::vector<std::array<double, 5>>> levels;
+  std::vector<std::pair<int, int>> sizes{{w, h}};
+  while (sizes.back().first > 1 || sizes.back().second > 1) {
+    const auto [fw, fh] = sizes.back();
+    const std::vector<std::array<double, 5>>& f = levels.empty() ? cells : levels.back();
+    const int cw = (fw + 1) / 2, ch = (fh + 1) / 2;
+    std::vector<std::array<double, 5>> c(static_cast<std::size_t>(cw) * ch, std::array<double, 5>{});
+    for (int y = 0; y < fh; ++y) {
+      for (int x = 0; x < fw; ++x) {
+        auto& dst = c[static_cast<std::size_t>(y / 2) * cw + x / 2];
+        const auto& src = f[static_cast<std::size_t>(y) * fw + x];
+        for (int k = 0; k < 5; ++k) dst[k] += src[k];
+      }
+    }
+    levels.push_back(std::move(c));
+    sizes.push_back({cw, ch});
+  }
+  auto normalise = [](std::array<double, 5>& v) {
+    if (v[4] > 0.0) {
+      for (int k = 0; k < 4; ++k) v[k] /= v[4];
+      v[4] = 1.0;
+    }
+  };
+  if (!levels.empty()) normalise(levels.back()[0]);
+  // Push from the coarsest level to the finest (level index l - 1; cells themselves at the end).
+  for (std::size_t l = levels.size(); l-- > 0;) {
+    std::vector<std::array<double, 5>>& f = l == 0 ? cells : levels[l - 1];
+    const std::vector<std::array<double, 5>>& c = levels[l];
+    const auto [fw, fh] = sizes[l];
+    const int cw = sizes[l + 1].first;
+    for (int y = 0; y < fh; ++y) {
+      for (int x = 0; x < fw; ++x) {
+        auto& v = f[static_cast<std::size_t>(y) * fw + x];
+        if (v[4] > 0.0) {
+          normalise(v);
+        } else {
+          v = c[static_cast<std::size_t>(y / 2) * cw + x / 2];
+        }
+      }
+    }
+  }
+}
 
 class Renderer {
  public:
@@ -259,7 +311,7 @@ Plan Renderer::plan(const Source& s, std::vector<PupilPoint>& pupil, std::vector
   } else if (aperture_.kind() == Aperture::Kind::Mask) {
     p.mesh = step_index(kGridSteps, size / 1.5);
   } else {
-    const double rings = model_.kind() == RayModelKind::Exact ? std::max(2.0, size / 8.0) : size / 16.0;
+    const double rings = model_.kind() == RayModelKind::Exact ? std::max(4.0, size / 6.0) : size / 16.0;
     p.mesh = step_index(kRingSteps, rings) * static_cast<int>(kSectorSteps.size()) + sector_step;
   }
   return p;
@@ -304,30 +356,38 @@ void Renderer::scatter(const Source& s, const Plan& p, SplatBuffer& buffer, std:
     model_.map(point, g.wavelength_nm, mesh.points, hits);
     points.resize(mesh.points.size());
     for (std::size_t i = 0; i < mesh.points.size(); ++i) {
-      if (!hits[i].ok) continue;
+      if (!hits[i].unclipped && !hits[i].ok) continue;
       const PixelPoint q = camera_.output_pixel(hits[i].x_mm, hits[i].y_mm);
       points[i] = {static_cast<float>(q.x), static_cast<float>(q.y)};
     }
+    // A triangle whose corners a clear aperture partly stops (the exact model) passes the fraction
+    // of its corners that get through, in place: the beam's edge falls inside it, to first order.
+    auto passing = [&hits](const PupilTriangle& tri) {
+      const PupilTriangle& t = tri;
+      if (!(hits[t.a].ok || hits[t.a].unclipped) || !(hits[t.b].ok || hits[t.b].unclipped) ||
+          !(hits[t.c].ok || hits[t.c].unclipped)) {
+        return 0.0;
+      }
+      return ((hits[t.a].ok ? 1.0 : 0.0) + (hits[t.b].ok ? 1.0 : 0.0) + (hits[t.c].ok ? 1.0 : 0.0)) / 3.0;
+    };
     // Colour carries the transmitted fraction (vignetting darkens); coverage is normalised over the
-    // rays that pass, so a vignetted point is still an opaque surface.
+    // light that passes, so a vignetted point is still an opaque surface.
     double passed = 0.0;
-    for (const PupilTriangle& tri : mesh.triangles) {
-      if (hits[tri.a].ok && hits[tri.b].ok && hits[tri.c].ok) passed += tri.weight;
-    }
+    for (const PupilTriangle& tri : mesh.triangles) passed += tri.weight * passing(tri);
     if (!(passed > 0.0)) continue;
     for (const PupilTriangle& tri : mesh.triangles) {
-      if (!(hits[tri.a].ok && hits[tri.b].ok && hits[tri.c].ok)) continue;
-      const auto w = static_cast<float>(tri.weight);
+      const double fraction = passing(tri);
+      if (fraction == 0.0) continue;
+      const auto w = static_cast<float>(tri.weight * fraction);
       buffer.add_triangle(points[tri.a], points[tri.b], points[tri.c],
-                          {value[0] * w, value[1] * w, value[2] * w, static_cast<float>(value[3] * tri.weight / passed)});
+                          {value[0] * w, value[1] * w, value[2] * w, static_cast<float>(value[3] * tri.weight * fraction / passed)});
       ++triangles;
     }
   }
 }
 
-// Push-pull interpolation (Gortler et al., "The Lumigraph", 1996) of the layer's own colours and
-// inverse depths into the nearer pixels within reach of it: the surface the layer is assumed to
-// continue as behind them.
+// The layer's own colours and inverse depths interpolated (push-pull) into the nearer pixels within
+// reach of it: the surface the layer is assumed to continue as behind them.
 std::vector<Source> Renderer::extend_layer(const std::vector<int>& layer_of, int layer, double reach_px) const {
   const int w = image_.width, h = image_.height;
   // Distance (chessboard, px) from each pixel to the nearest pixel of the layer, two-pass.
@@ -361,56 +421,20 @@ std::vector<Source> Renderer::extend_layer(const std::vector<int>& layer_of, int
     if (layer_of[i] > layer && dist[i] <= reach_px) targets.push_back(i);
   }
   if (targets.empty()) return {};
-  // Pull: a pyramid of weighted sums (r, g, b, inverse depth, weight) down to 1 x 1.
-  struct Level {
-    int w, h;
-    std::vector<std::array<double, 5>> v;
-  };
-  std::vector<Level> levels;
-  levels.push_back({w, h, std::vector<std::array<double, 5>>(static_cast<std::size_t>(w) * h)});
+  std::vector<std::array<double, 5>> cells(static_cast<std::size_t>(w) * h, std::array<double, 5>{});
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * w + x;
       if (layer_of[i] != layer) continue;
       const double z = depth_.at(x, y);
-      levels[0].v[i] = {image_.at(x, y, 0), image_.at(x, y, 1), image_.at(x, y, 2),
-                        std::isinf(z) ? 0.0 : 1.0 / mm_from_m(z), 1.0};
+      cells[i] = {image_.at(x, y, 0), image_.at(x, y, 1), image_.at(x, y, 2), std::isinf(z) ? 0.0 : 1.0 / mm_from_m(z), 1.0};
     }
   }
-  while (levels.back().w > 1 || levels.back().h > 1) {
-    const Level& f = levels.back();
-    Level c{(f.w + 1) / 2, (f.h + 1) / 2, {}};
-    c.v.assign(static_cast<std::size_t>(c.w) * c.h, {});
-    for (int y = 0; y < f.h; ++y) {
-      for (int x = 0; x < f.w; ++x) {
-        auto& dst = c.v[static_cast<std::size_t>(y / 2) * c.w + x / 2];
-        const auto& src = f.v[static_cast<std::size_t>(y) * f.w + x];
-        for (int k = 0; k < 5; ++k) dst[k] += src[k];
-      }
-    }
-    levels.push_back(std::move(c));
-  }
-  // Push: each level's empty cells take their parent's normalised value.
-  for (std::size_t l = levels.size() - 1; l-- > 0;) {
-    Level& f = levels[l];
-    const Level& c = levels[l + 1];
-    for (int y = 0; y < f.h; ++y) {
-      for (int x = 0; x < f.w; ++x) {
-        auto& v = f.v[static_cast<std::size_t>(y) * f.w + x];
-        if (v[4] > 0.0) {
-          for (int k = 0; k < 4; ++k) v[k] /= v[4];
-          v[4] = 1.0;
-          continue;
-        }
-        const auto& parent = c.v[static_cast<std::size_t>(y / 2) * c.w + x / 2];
-        v = parent;
-      }
-    }
-  }
+  push_pull(w, h, cells);
   std::vector<Source> out;
   out.reserve(targets.size());
   for (std::size_t i : targets) {
-    const auto& v = levels[0].v[i];
+    const auto& v = cells[i];
     Source s;
     s.x = static_cast<int>(i % static_cast<std::size_t>(w));
     s.y = static_cast<int>(i / static_cast<std::size_t>(w));
@@ -539,12 +563,24 @@ Image Renderer::run(BokehStatistics& stats) {
   stats.footprints = footprints;
   stats.triangles = triangles;
 
-  // Where no layer covers fully (image borders, gaps between layers), renormalise.
+  // Where no layer covers fully (image borders, seams between layers, a pixel whose own light
+  // spread away with nothing behind it), fill the rest with the colour of the (nearly) fully
+  // covered pixels around, by push-pull: a flat image stays flat, and a pixel that lost most of its
+  // coverage takes its neighbours' colour rather than its own amplified light.
+  std::vector<std::array<double, 5>> fill(static_cast<std::size_t>(w) * h, std::array<double, 5>{});
+  bool any_gap = false;
+  for (std::size_t k = 0; k < fill.size(); ++k) {
+    const double coverage = result[4 * k + 3];
+    any_gap = any_gap || coverage < 1.0 - 1e-9;
+    if (coverage >= kKnownCoverage) fill[k] = {result[4 * k], result[4 * k + 1], result[4 * k + 2], 0.0, coverage};
+  }
+  if (any_gap) push_pull(w, h, fill);
   Image out(w, h, 3);
   for (std::size_t k = 0; k < out.pixel_count(); ++k) {
-    const double coverage = result[4 * k + 3];
-    const double scale = coverage > 1e-6 ? 1.0 / coverage : 0.0;
-    for (int c = 0; c < 3; ++c) out.data[3 * k + c] = static_cast<float>(std::max(0.0, result[4 * k + c] * scale));
+    const double gap = std::max(0.0, 1.0 - result[4 * k + 3]);
+    for (int c = 0; c < 3; ++c) {
+      out.data[3 * k + c] = static_cast<float>(std::max(0.0, result[4 * k + c] + (gap > 0.0 ? gap * fill[k][c] : 0.0)));
+    }
   }
   return out;
 }

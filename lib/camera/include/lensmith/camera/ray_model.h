@@ -29,11 +29,14 @@ std::string_view to_string(RayModelKind kind);
 // Throws OptionsError listing the choices.
 RayModelKind parse_ray_model_kind(std::string_view text);
 
-// Where a ray meets the sensor plane (mm, lens frame), or ok = false when it does not get there.
+// Where a ray meets the sensor plane (mm, lens frame). ok = false when it does not get there; then
+// `unclipped` says whether x, y still hold where it would land if no clear aperture stopped it (the
+// exact model), so callers can place the edge of a vignetted beam between rays.
 struct SensorHit {
   double x_mm = 0.0;
   double y_mm = 0.0;
   bool ok = false;
+  bool unclipped = false;
 };
 
 class RayModel {
