@@ -127,7 +127,9 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   ProgressBar bar("bokeh", !global.quiet);
   options.progress = [&bar](double f) { bar.update(f); };
   BokehStatistics stats;
+  const auto render_started = std::chrono::steady_clock::now();
   const Image out = render_bokeh(image, depth, *model, aperture, options, &stats);
+  const double render_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - render_started).count();
   bar.finish();
 
   OutputMetadata meta;
@@ -141,7 +143,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   write_output_image(output, out, meta);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   std::cout << "wrote " << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed
-            << std::setprecision(2) << seconds << " s\n"
+            << std::setprecision(2) << seconds << " s (rendering " << render_seconds << " s)\n"
             << "  lens " << lens_name << ", model " << to_string(kind) << ", f/" << std::setprecision(2) << cam->f_number()
             << ", focus " << std::setprecision(3) << o.focus_m << " m, aperture " << aperture.to_string() << "\n"
             << "  " << stats.to_string() << "\n";

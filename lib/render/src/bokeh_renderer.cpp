@@ -6,7 +6,9 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <vector>
 
@@ -258,7 +260,9 @@ Plan Renderer::plan(const Source& s, std::vector<PupilPoint>& pupil, std::vector
   std::array<std::array<PixelPoint, 9>, 3> px{};
   std::array<std::array<bool, 9>, 3> ok{};
   double x_min = kInfinity, x_max = -kInfinity, y_min = kInfinity, y_max = -kInfinity;
-  for (std::size_t l = 0; l < 3; ++l) {
+  // Without dispersion (a thin lens, or colour off) one wavelength tells all.
+  const std::size_t wavelengths = camera_.is_thin_lens() || !options_.spectral ? 1 : 3;
+  for (std::size_t l = 0; l < wavelengths; ++l) {
     model_.map(point, lambdas[l], pupil, hits);
     for (std::size_t i = 0; i < 9; ++i) {
       ok[l][i] = hits[i].ok;
@@ -390,55 +394,81 @@ void Renderer::scatter(const Source& s, const Plan& p, SplatBuffer& buffer, std:
 // reach of it: the surface the layer is assumed to continue as behind them.
 std::vector<Source> Renderer::extend_layer(const std::vector<int>& layer_of, int layer, double reach_px) const {
   const int w = image_.width, h = image_.height;
-  // Distance (chessboard, px) from each pixel to the nearest pixel of the layer, two-pass.
-  std::vector<int> dist(static_cast<std::size_t>(w) * h);
-  const int far = std::numeric_limits<int>::max() / 2;
-  for (std::size_t i = 0; i < dist.size(); ++i) dist[i] = layer_of[i] == layer ? 0 : far;
+  // Nearer pixels within a (2 reach + 1)-pixel square of a pixel of the layer: a separable
+  // dilation, rows then columns, each line independent (threads).
+  const int reach = static_cast<int>(reach_px);
+  const int far = std::numeric_limits<int>::max() / 4;
+  std::vector<int> row_distance(static_cast<std::size_t>(w) * h);
+#pragma omp parallel for num_threads(threads_) schedule(static)
   for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      int& d = dist[static_cast<std::size_t>(y) * w + x];
-      if (x > 0) d = std::min(d, dist[static_cast<std::size_t>(y) * w + x - 1] + 1);
-      if (y > 0) {
-        for (int dx = -1; dx <= 1; ++dx) {
-          if (x + dx >= 0 && x + dx < w) d = std::min(d, dist[static_cast<std::size_t>(y - 1) * w + x + dx] + 1);
-        }
-      }
-    }
+    int* d = row_distance.data() + static_cast<std::size_t>(y) * w;
+    const int* l = layer_of.data() + static_cast<std::size_t>(y) * w;
+    int last = far;
+    for (int x = 0; x < w; ++x) d[x] = l[x] == layer ? (last = 0) : (last = std::min(far, last + 1));
+    last = far;
+    for (int x = w - 1; x >= 0; --x) d[x] = std::min(d[x], l[x] == layer ? (last = 0) : (last = std::min(far, last + 1)));
   }
-  for (int y = h - 1; y >= 0; --y) {
-    for (int x = w - 1; x >= 0; --x) {
-      int& d = dist[static_cast<std::size_t>(y) * w + x];
-      if (x < w - 1) d = std::min(d, dist[static_cast<std::size_t>(y) * w + x + 1] + 1);
-      if (y < h - 1) {
-        for (int dx = -1; dx <= 1; ++dx) {
-          if (x + dx >= 0 && x + dx < w) d = std::min(d, dist[static_cast<std::size_t>(y + 1) * w + x + dx] + 1);
-        }
-      }
+  std::vector<std::uint8_t> within(static_cast<std::size_t>(w) * h, 0);
+#pragma omp parallel for num_threads(threads_) schedule(static)
+  for (int x = 0; x < w; ++x) {
+    int last = far;
+    for (int y = 0; y < h; ++y) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      last = row_distance[i] <= reach ? 0 : std::min(far, last + 1);
+      within[i] = last <= reach ? 1 : 0;
+    }
+    last = far;
+    for (int y = h - 1; y >= 0; --y) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      last = row_distance[i] <= reach ? 0 : std::min(far, last + 1);
+      within[i] = (within[i] || last <= reach) ? 1 : 0;
     }
   }
   std::vector<std::size_t> targets;
-  for (std::size_t i = 0; i < dist.size(); ++i) {
-    if (layer_of[i] > layer && dist[i] <= reach_px) targets.push_back(i);
+  int x0 = w, x1 = -1, y0 = h, y1 = -1;
+  for (std::size_t i = 0; i < within.size(); ++i) {
+    if (layer_of[i] > layer && within[i]) {
+      targets.push_back(i);
+      const int x = static_cast<int>(i % static_cast<std::size_t>(w)), y = static_cast<int>(i / static_cast<std::size_t>(w));
+      x0 = std::min(x0, x);
+      x1 = std::max(x1, x);
+      y0 = std::min(y0, y);
+      y1 = std::max(y1, y);
+    }
   }
   if (targets.empty()) return {};
-  std::vector<std::array<double, 5>> cells(static_cast<std::size_t>(w) * h, std::array<double, 5>{});
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
+  // Push-pull over the window of the targets widened by the reach, where the layer's pixels that
+  // feed them lie.
+  x0 = std::max(0, x0 - reach);
+  y0 = std::max(0, y0 - reach);
+  x1 = std::min(w - 1, x1 + reach);
+  y1 = std::min(h - 1, y1 + reach);
+  const int ww = x1 - x0 + 1, wh = y1 - y0 + 1;
+  std::vector<std::array<double, 5>> cells(static_cast<std::size_t>(ww) * wh, std::array<double, 5>{});
+  for (int y = y0; y <= y1; ++y) {
+    for (int x = x0; x <= x1; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * w + x;
       if (layer_of[i] != layer) continue;
       const double z = depth_.at(x, y);
-      cells[i] = {image_.at(x, y, 0), image_.at(x, y, 1), image_.at(x, y, 2), std::isinf(z) ? 0.0 : 1.0 / mm_from_m(z), 1.0};
+      // Interpolated as x / (1 + x), so a few HDR highlights do not flood the invented surface.
+      auto tone = [](float v) { return static_cast<double>(v) / (1.0 + static_cast<double>(v)); };
+      cells[static_cast<std::size_t>(y - y0) * ww + (x - x0)] = {tone(image_.at(x, y, 0)), tone(image_.at(x, y, 1)),
+                                                                  tone(image_.at(x, y, 2)),
+                                                                  std::isinf(z) ? 0.0 : 1.0 / mm_from_m(z), 1.0};
     }
   }
-  push_pull(w, h, cells);
+  push_pull(ww, wh, cells);
   std::vector<Source> out;
   out.reserve(targets.size());
   for (std::size_t i : targets) {
-    const auto& v = cells[i];
+    const std::size_t wx = i % static_cast<std::size_t>(w) - static_cast<std::size_t>(x0);
+    const std::size_t wy = i / static_cast<std::size_t>(w) - static_cast<std::size_t>(y0);
+    const auto& v = cells[wy * static_cast<std::size_t>(ww) + wx];
     Source s;
     s.x = static_cast<int>(i % static_cast<std::size_t>(w));
     s.y = static_cast<int>(i / static_cast<std::size_t>(w));
-    s.rgb = {static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2])};
+    auto untone = [](double t) { return static_cast<float>(std::min(t, 0.999) / (1.0 - std::min(t, 0.999))); };
+    s.rgb = {untone(v[0]), untone(v[1]), untone(v[2])};
     s.inverse_depth_per_mm = v[3];
     s.coc_px = camera_.signed_coc_px(v[3]);
     out.push_back(s);
@@ -529,19 +559,26 @@ Image Renderer::run(BokehStatistics& stats) {
         const int row_begin = b * h / bands, row_end = (b + 1) * h / bands;
         if (row_begin == row_end) continue;
         // Tall footprints need fewer sub-rows: only their top and bottom rows see the y sampling.
-        std::array<SplatBuffer, 3> buffers{SplatBuffer(w, row_begin, row_end, subrow_options(1)),
-                                           SplatBuffer(w, row_begin, row_end, subrow_options(2)),
-                                           SplatBuffer(w, row_begin, row_end, subrow_options(4))};
+        // A buffer is made only for the classes this band meets in this layer.
+        std::array<std::optional<SplatBuffer>, 3> buffers;
         for (std::size_t i = 0; i < layer.size(); ++i) {
           if (plans[i].y_max < static_cast<float>(row_begin) - 1.0f || plans[i].y_min > static_cast<float>(row_end) + 1.0f) continue;
           const float height = plans[i].y_max - plans[i].y_min;
-          SplatBuffer& buffer = buffers[height < kMediumFootprintPx ? 0 : height < kTallFootprintPx ? 1 : 2];
-          scatter(layer[i], plans[i], buffer, hits, points, local_triangles);
+          const int kind = height < kMediumFootprintPx ? 0 : height < kTallFootprintPx ? 1 : 2;
+          std::optional<SplatBuffer>& buffer = buffers[static_cast<std::size_t>(kind)];
+          if (!buffer) buffer.emplace(w, row_begin, row_end, subrow_options(1 << kind));
+          scatter(layer[i], plans[i], *buffer, hits, points, local_triangles);
           local_footprints += static_cast<std::size_t>(plans[i].groups);
         }
         float* rows = layer_rgba.data() + static_cast<std::size_t>(row_begin) * w * 4;
         std::fill(rows, rows + static_cast<std::size_t>(row_end - row_begin) * w * 4, 0.0f);
-        for (const SplatBuffer& buffer : buffers) buffer.resolve_into(layer_rgba.data());
+        bool any = false;
+        for (const std::optional<SplatBuffer>& buffer : buffers) {
+          if (!buffer) continue;
+          buffer->resolve_into(layer_rgba.data());
+          any = true;
+        }
+        if (!any) continue;  // nothing of this layer reaches these rows: the result is unchanged
         // Within a layer, overlapping footprints of one surface average; its coverage is at most 1.
         for (std::size_t k = static_cast<std::size_t>(row_begin) * w; k < static_cast<std::size_t>(row_end) * w; ++k) {
           double c[4] = {layer_rgba[4 * k], layer_rgba[4 * k + 1], layer_rgba[4 * k + 2], layer_rgba[4 * k + 3]};
