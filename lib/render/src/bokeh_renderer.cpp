@@ -418,12 +418,11 @@ void Renderer::scatter(const Source& s, const Plan& p, SplatBuffer& buffer, std:
     // A triangle whose corners a clear aperture partly stops (the exact model) passes the fraction
     // of its corners that get through, in place: the beam's edge falls inside it, to first order.
     auto passing = [&hits](const PupilTriangle& tri) {
-      const PupilTriangle& t = tri;
-      if (!(hits[t.a].ok || hits[t.a].unclipped) || !(hits[t.b].ok || hits[t.b].unclipped) ||
-          !(hits[t.c].ok || hits[t.c].unclipped)) {
+      if (!(hits[tri.a].ok || hits[tri.a].unclipped) || !(hits[tri.b].ok || hits[tri.b].unclipped) ||
+          !(hits[tri.c].ok || hits[tri.c].unclipped)) {
         return 0.0;
       }
-      return ((hits[t.a].ok ? 1.0 : 0.0) + (hits[t.b].ok ? 1.0 : 0.0) + (hits[t.c].ok ? 1.0 : 0.0)) / 3.0;
+      return ((hits[tri.a].ok ? 1.0 : 0.0) + (hits[tri.b].ok ? 1.0 : 0.0) + (hits[tri.c].ok ? 1.0 : 0.0)) / 3.0;
     };
     // Colour carries the transmitted fraction (vignetting darkens); coverage is normalised over the
     // light that passes, so a vignetted point is still an opaque surface.

@@ -1,0 +1,402 @@
+"""Renders a procedural scene with Cycles twice, as an all-in-focus input and a thin-lens reference.
+
+Run:  blender -b --factory-startup -t 2 --python bench/blender/make_reference.py -- \
+          --out DIR --width 960 --height 540 --fstop 1.4 --focus 3 --spp 1024
+
+Writes (see bench/blender/README.md):
+  DIR/pinhole.exr    depth of field off; channels R, G, B (linear, 32-bit float) and Z (Cycles' depth
+                     pass: planar depth along the view axis in metres, 1e10 where the ray escapes to
+                     the sky)
+  DIR/reference.exr  the same camera with a thin lens: f-number N, focus distance M (planar), round
+                     aperture (0 blades); R, G, B only
+  DIR/scene.json     camera, render settings, timings and where each part of the scene lies
+
+Camera: at the origin looking along +Y (Blender world), up +Z, so a point's planar depth is its Y
+coordinate. 50 mm focal length on a 36 mm wide sensor, sensor fit horizontal. Both renders use the
+same seed, sample count, a 1-px box pixel filter, no adaptive sampling, no denoiser, no clamping.
+"""
+import argparse
+import json
+import math
+import os
+import sys
+import time
+
+import bpy
+
+FOCAL_LENGTH_MM = 50.0
+SENSOR_WIDTH_MM = 36.0
+
+# Planar depths (metres) of the scene's parts; the camera looks along +Y.
+WALL_Y = 3.0
+WALL_TOP_Z = 0.15
+GROUND_Z = -0.45
+FAR_Y = 20.0
+FAR_TOP_Z = 2.6
+OCCLUDER_Y = 1.2
+
+
+def parse_args():
+    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    p = argparse.ArgumentParser(prog="make_reference.py", description=__doc__.splitlines()[0])
+    p.add_argument("--out", required=True, help="output directory (created)")
+    p.add_argument("--width", type=int, required=True, help="image width, px")
+    p.add_argument("--height", type=int, required=True, help="image height, px")
+    p.add_argument("--fstop", type=float, required=True, help="f-number N of the thin-lens reference (> 0)")
+    p.add_argument("--focus", type=float, required=True, help="focus distance M, metres, planar (> 0)")
+    p.add_argument("--spp", type=int, required=True, help="samples per pixel for both renders (>= 1)")
+    p.add_argument("--threads", type=int, default=0, help="render threads, 0 = all (also pass blender -t)")
+    p.add_argument("--seed", type=int, default=0, help="Cycles seed, the same for both renders")
+    p.add_argument("--skip-pinhole", action="store_true",
+                   help="render only reference.exr (reuse an existing DIR/pinhole.exr)")
+    a = p.parse_args(argv)
+    for name in ("width", "height", "spp"):
+        if getattr(a, name) < 1:
+            p.error(f"--{name} = {getattr(a, name)}: must be >= 1")
+    if not a.fstop > 0 or not a.focus > 0:
+        p.error("--fstop and --focus must be > 0")
+    return a
+
+
+def material(name, build):
+    """A node material; build(nodes, links) returns the BSDF/emission output socket."""
+    m = bpy.data.materials.new(name)
+    m.use_nodes = True
+    nodes, links = m.node_tree.nodes, m.node_tree.links
+    nodes.clear()
+    out = nodes.new("ShaderNodeOutputMaterial")
+    links.new(build(nodes, links), out.inputs["Surface"])
+    return m
+
+
+def diffuse(name, colour_socket_fn):
+    def build(nodes, links):
+        bsdf = nodes.new("ShaderNodeBsdfDiffuse")
+        colour_socket_fn(nodes, links, bsdf.inputs["Color"])
+        return bsdf.outputs["BSDF"]
+    return material(name, build)
+
+
+def emission(name, rgb, strength):
+    def build(nodes, links):
+        e = nodes.new("ShaderNodeEmission")
+        e.inputs["Color"].default_value = (*rgb, 1.0)
+        e.inputs["Strength"].default_value = strength
+        return e.outputs["Emission"]
+    return material(name, build)
+
+
+def brick_colour(nodes, links, target):
+    tc = nodes.new("ShaderNodeTexCoord")
+    brick = nodes.new("ShaderNodeTexBrick")
+    brick.inputs["Scale"].default_value = 4.0          # object coordinates: ~0.23 x 0.08 m bricks
+    brick.inputs["Mortar Size"].default_value = 0.015
+    brick.inputs["Color1"].default_value = (0.40, 0.12, 0.06, 1)
+    brick.inputs["Color2"].default_value = (0.20, 0.17, 0.19, 1)
+    brick.inputs["Mortar"].default_value = (0.30, 0.29, 0.27, 1)
+    brick.offset_frequency = 2
+    brick.squash_frequency = 2
+    noise = nodes.new("ShaderNodeTexNoise")
+    noise.inputs["Scale"].default_value = 60.0
+    noise.inputs["Detail"].default_value = 4.0
+    mix = nodes.new("ShaderNodeMixRGB")
+    mix.blend_type = "MULTIPLY"
+    mix.inputs["Fac"].default_value = 0.5
+    # The brick texture is 2-D in (x, y); turn the wall's (x, z) into (x, y).
+    mapping = nodes.new("ShaderNodeMapping")
+    mapping.inputs["Rotation"].default_value = (math.radians(90.0), 0.0, 0.0)
+    links.new(tc.outputs["Object"], mapping.inputs["Vector"])
+    links.new(mapping.outputs["Vector"], brick.inputs["Vector"])
+    links.new(tc.outputs["Object"], noise.inputs["Vector"])
+    links.new(brick.outputs["Color"], mix.inputs["Color1"])
+    links.new(noise.outputs["Color"], mix.inputs["Color2"])
+    links.new(mix.outputs["Color"], target)
+
+
+def checker_colour(scale, c1, c2):
+    def fn(nodes, links, target):
+        tc = nodes.new("ShaderNodeTexCoord")
+        ch = nodes.new("ShaderNodeTexChecker")
+        ch.inputs["Scale"].default_value = scale
+        ch.inputs["Color1"].default_value = (*c1, 1)
+        ch.inputs["Color2"].default_value = (*c2, 1)
+        links.new(tc.outputs["Object"], ch.inputs["Vector"])
+        links.new(ch.outputs["Color"], target)
+    return fn
+
+
+def noise_colour(scale, c1, c2):
+    def fn(nodes, links, target):
+        tc = nodes.new("ShaderNodeTexCoord")
+        n = nodes.new("ShaderNodeTexNoise")
+        n.inputs["Scale"].default_value = scale
+        n.inputs["Detail"].default_value = 6.0
+        ramp = nodes.new("ShaderNodeValToRGB")
+        ramp.color_ramp.elements[0].color = (*c1, 1)
+        ramp.color_ramp.elements[1].color = (*c2, 1)
+        links.new(tc.outputs["Object"], n.inputs["Vector"])
+        links.new(n.outputs["Fac"], ramp.inputs["Fac"])
+        links.new(ramp.outputs["Color"], target)
+    return fn
+
+
+def flat_colour(rgb):
+    def fn(nodes, links, target):
+        target.default_value = (*rgb, 1)
+    return fn
+
+
+def box(name, x0, x1, y0, y1, z0, z1, mat):
+    """An axis-aligned box from corner to corner (metres)."""
+    import bmesh
+    mesh = bpy.data.meshes.new(name)
+    bm = bmesh.new()
+    bmesh.ops.create_cube(bm, size=1.0)
+    for v in bm.verts:
+        v.co.x = x0 if v.co.x < 0 else x1
+        v.co.y = y0 if v.co.y < 0 else y1
+        v.co.z = z0 if v.co.z < 0 else z1
+    bm.to_mesh(mesh)
+    bm.free()
+    ob = bpy.data.objects.new(name, mesh)
+    ob.data.materials.append(mat)
+    bpy.context.scene.collection.objects.link(ob)
+    return ob
+
+
+def quad(name, corners, mat):
+    """A flat quad through four corners, in order."""
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(corners, [], [(0, 1, 2, 3)])
+    ob = bpy.data.objects.new(name, mesh)
+    ob.data.materials.append(mat)
+    bpy.context.scene.collection.objects.link(ob)
+    return ob
+
+
+def quad_xz(name, y, x0, x1, z0, z1, mat):
+    """A plane facing the camera (normal -Y) at planar depth y."""
+    return quad(name, [(x0, y, z0), (x0, y, z1), (x1, y, z1), (x1, y, z0)], mat)
+
+
+def quad_xy(name, z, x0, x1, y0, y1, mat):
+    """A horizontal plane at height z."""
+    return quad(name, [(x0, y0, z), (x1, y0, z), (x1, y1, z), (x0, y1, z)], mat)
+
+
+def sphere(name, centre, radius, mat):
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=24, ring_count=12, radius=radius, location=centre)
+    ob = bpy.context.active_object
+    ob.name = name
+    ob.data.materials.append(mat)
+    bpy.ops.object.shade_smooth()
+    # Seen by the camera only: a highlight in the picture, not a lamp that lights the walls (whose
+    # glow would be slow to converge and is not what an all-in-focus input's highlights are).
+    ob.visible_diffuse = False
+    ob.visible_glossy = False
+    ob.visible_transmission = False
+    ob.visible_volume_scatter = False
+    ob.visible_shadow = False
+    return ob
+
+
+def build_scene(args):
+    scene = bpy.context.scene
+    for ob in list(bpy.data.objects):
+        bpy.data.objects.remove(ob, do_unlink=True)
+
+    # Dusk sky (no texture: a constant world colour), which also lights the scene softly.
+    world = bpy.data.worlds.new("dusk")
+    world.use_nodes = True
+    bg = world.node_tree.nodes["Background"]
+    bg.inputs["Color"].default_value = (0.06, 0.09, 0.22, 1)
+    bg.inputs["Strength"].default_value = 1.0
+    scene.world = world
+
+    # A low sun from behind the camera, up and to the left: the post casts a shadow on the wall.
+    sun_data = bpy.data.lights.new("sun", type="SUN")
+    sun_data.energy = 2.5
+    sun_data.angle = math.radians(2.0)
+    sun_data.color = (1.0, 0.85, 0.7)
+    sun = bpy.data.objects.new("sun", sun_data)
+    sun.rotation_euler = (math.radians(60.0), 0.0, math.radians(-20.0))  # light travels +x, +y, -z
+    scene.collection.objects.link(sun)
+
+    wall = diffuse("bricks", brick_colour)
+    quad_xz("wall_3m", WALL_Y, -2.0, 2.0, GROUND_Z, WALL_TOP_Z, wall)
+    ground = diffuse("ground", checker_colour(8.0, (0.25, 0.24, 0.2), (0.08, 0.08, 0.07)))
+    quad_xy("ground", GROUND_Z, -3.0, 3.0, 0.3, WALL_Y, ground)
+    far = diffuse("far", noise_colour(1.5, (0.02, 0.03, 0.05), (0.12, 0.10, 0.08)))
+    quad_xz("far_20m", FAR_Y, -15.0, 15.0, GROUND_Z, FAR_TOP_Z, far)
+
+    # Foreground occluders at 1.2 m: a dark square post (front face at y = 1.2) and a round sign.
+    post = diffuse("post", noise_colour(40.0, (0.02, 0.015, 0.01), (0.06, 0.045, 0.03)))
+    box("post", -0.30, -0.22, OCCLUDER_Y, OCCLUDER_Y + 0.08, GROUND_Z, 1.5, post)
+    sign = diffuse("sign", flat_colour((0.5, 0.05, 0.03)))
+    bpy.ops.mesh.primitive_cylinder_add(vertices=128, radius=0.1, depth=0.01,
+                                        location=(0.3, OCCLUDER_Y + 0.005, -0.12),
+                                        rotation=(math.radians(90.0), 0.0, 0.0))
+    disc = bpy.context.active_object
+    disc.name = "sign_disc"
+    disc.data.materials.append(sign)
+    box("sign_pole", 0.29, 0.31, OCCLUDER_Y + 0.01, OCCLUDER_Y + 0.03, GROUND_Z, -0.2, post)
+
+    # Emissive spheres (radiance = strength x colour), ~2 px radius at 960 px width wherever they are.
+    lights = []
+    colours = [(1.0, 0.7, 0.35), (1.0, 0.15, 0.1), (0.2, 1.0, 0.25), (0.2, 0.35, 1.0), (1.0, 0.8, 0.3)]
+    for i in range(11):
+        x = -5.0 + i
+        z = 1.55 + 0.35 * (x / 5.0) ** 2
+        lights.append(("string_%d" % i, (x, FAR_Y - 0.2, z), 0.03, colours[i % 5], 120.0))
+    lights += [("wall_a", (0.25, WALL_Y - 0.01, -0.05), 0.004, (1.0, 1.0, 0.95), 100.0),
+               ("wall_b", (-0.12, WALL_Y - 0.01, 0.02), 0.004, (1.0, 0.2, 0.15), 150.0),
+               ("wall_c", (0.80, WALL_Y - 0.01, 0.05), 0.004, (0.25, 0.5, 1.0), 150.0),
+               ("wall_d", (-0.50, WALL_Y - 0.01, -0.30), 0.004, (1.0, 0.75, 0.4), 80.0),
+               ("post_bolt", (-0.26, OCCLUDER_Y - 0.002, 0.05), 0.0017, (1.0, 0.95, 0.9), 100.0),
+               ("post_led", (-0.26, OCCLUDER_Y - 0.002, -0.20), 0.0017, (0.1, 1.0, 0.9), 120.0),
+               ("sign_glint", (0.26, OCCLUDER_Y - 0.002, -0.08), 0.0017, (1.0, 1.0, 1.0), 60.0)]
+    for name, centre, radius, rgb, strength in lights:
+        sphere(name, centre, radius, emission("em_" + name, rgb, strength))
+
+    cam_data = bpy.data.cameras.new("camera")
+    cam_data.lens = FOCAL_LENGTH_MM
+    cam_data.sensor_width = SENSOR_WIDTH_MM
+    cam_data.sensor_fit = "HORIZONTAL"
+    cam_data.clip_start = 0.05
+    cam_data.clip_end = 1000.0
+    cam = bpy.data.objects.new("camera", cam_data)
+    cam.location = (0.0, 0.0, 0.0)
+    cam.rotation_euler = (math.radians(90.0), 0.0, 0.0)  # look along +Y, up +Z
+    scene.collection.objects.link(cam)
+    scene.camera = cam
+    return cam, lights
+
+
+def configure_render(args):
+    scene = bpy.context.scene
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.cycles.samples = args.spp
+    scene.cycles.use_adaptive_sampling = False
+    scene.cycles.use_denoising = False
+    scene.cycles.seed = args.seed
+    scene.cycles.use_animated_seed = False
+    scene.cycles.pixel_filter_type = "BOX"
+    scene.cycles.filter_width = 1.0
+    scene.cycles.sample_clamp_direct = 0.0
+    scene.cycles.sample_clamp_indirect = 0.0
+    scene.cycles.max_bounces = 4
+    scene.cycles.diffuse_bounces = 3
+    scene.cycles.glossy_bounces = 0
+    scene.cycles.transmission_bounces = 0
+    scene.cycles.transparent_max_bounces = 0
+    scene.cycles.caustics_reflective = False
+    scene.cycles.caustics_refractive = False
+    scene.render.resolution_x = args.width
+    scene.render.resolution_y = args.height
+    scene.render.resolution_percentage = 100
+    scene.render.pixel_aspect_x = scene.render.pixel_aspect_y = 1.0
+    scene.render.film_transparent = False
+    scene.render.use_compositing = False
+    scene.render.use_sequencer = False
+    if args.threads > 0:
+        scene.render.threads_mode = "FIXED"
+        scene.render.threads = args.threads
+    scene.view_settings.view_transform = "Standard"
+    scene.view_settings.look = "None"
+    scene.view_settings.exposure = 0.0
+    scene.view_settings.gamma = 1.0
+    bpy.context.view_layer.use_pass_z = True
+    s = scene.render.image_settings
+    s.file_format = "OPEN_EXR"
+    s.color_mode = "RGB"
+    s.color_depth = "32"
+    s.exr_codec = "ZIP"
+
+
+def render_to(path, with_z):
+    scene = bpy.context.scene
+    scene.render.image_settings.use_zbuffer = with_z
+    scene.render.filepath = path
+    start = time.perf_counter()
+    bpy.ops.render.render(write_still=False)
+    seconds = time.perf_counter() - start
+    bpy.data.images["Render Result"].save_render(filepath=path, scene=scene)
+    print("rendered %s in %.1f s" % (path, seconds), flush=True)
+    return seconds
+
+
+def main():
+    args = parse_args()
+    os.makedirs(args.out, exist_ok=True)
+    cam, lights = build_scene(args)
+    configure_render(args)
+    scene = bpy.context.scene
+    focal_px = args.width * FOCAL_LENGTH_MM / SENSOR_WIDTH_MM
+
+    def pixel_of(p):
+        x, y, z = p
+        return [args.width / 2 + x / y * focal_px, args.height / 2 - z / y * focal_px]
+
+    times = {}
+    if not args.skip_pinhole:
+        cam.data.dof.use_dof = False
+        times["pinhole_seconds"] = render_to(os.path.join(args.out, "pinhole.exr"), True)
+    cam.data.dof.use_dof = True
+    cam.data.dof.aperture_fstop = args.fstop
+    cam.data.dof.focus_distance = args.focus
+    cam.data.dof.aperture_blades = 0
+    cam.data.dof.aperture_rotation = 0.0
+    cam.data.dof.aperture_ratio = 1.0
+    times["reference_seconds"] = render_to(os.path.join(args.out, "reference.exr"), False)
+
+    info = {
+        "generator": "bench/blender/make_reference.py",
+        "blender_version": bpy.app.version_string,
+        "width_px": args.width,
+        "height_px": args.height,
+        "camera": {
+            "model": "Cycles perspective camera; thin lens for reference.exr",
+            "focal_length_mm": FOCAL_LENGTH_MM,
+            "sensor_width_mm": SENSOR_WIDTH_MM,
+            "sensor_fit": "HORIZONTAL",
+            "focal_length_px": focal_px,
+            "horizontal_fov_deg": math.degrees(2 * math.atan(SENSOR_WIDTH_MM / 2 / FOCAL_LENGTH_MM)),
+            "f_number": args.fstop,
+            "aperture_radius_m": FOCAL_LENGTH_MM / 1000.0 / (2 * args.fstop),
+            "focus_distance_m": args.focus,
+            "focus_is_planar": True,
+            "aperture_blades": 0,
+            "position_m": [0, 0, 0],
+            "looks_along": "+Y (planar depth = world Y), up +Z",
+        },
+        "render": {
+            "engine": "CYCLES", "device": "CPU", "spp": args.spp, "seed": args.seed,
+            "adaptive_sampling": False, "denoiser": "off", "clamping": "off",
+            "pixel_filter": "BOX", "filter_width_px": 1.0,
+            "max_bounces": 4, "diffuse_bounces": 3,
+            "threads": scene.render.threads if args.threads > 0 else "auto",
+        },
+        "files": {
+            "pinhole.exr": "DoF off; R, G, B linear float32 + Z (Cycles depth pass, planar metres; 1e10 = sky)",
+            "reference.exr": "thin lens, same samples and seed; R, G, B linear float32",
+        },
+        "depth_pass": "planar distance along the view axis (see README for the check)",
+        "scene_depths_m": {
+            "occluders_front_face": OCCLUDER_Y, "wall": WALL_Y, "far_plane": FAR_Y, "sky": "1e10 (escaped rays)",
+            "ground": "z = %.2f m, visible from about %.2f to %.1f m" % (
+                GROUND_Z, -GROUND_Z / math.tan(math.atan(args.height / 2 / focal_px)), WALL_Y),
+            "wall_top_z_m": WALL_TOP_Z, "far_top_z_m": FAR_TOP_Z,
+        },
+        "highlights": [
+            {"name": n, "centre_m": list(c), "radius_m": r, "planar_depth_of_front_m": c[1] - r,
+             "radiance_rgb": [s * v for v in rgb], "pixel_xy": pixel_of(c)}
+            for n, c, r, rgb, s in lights],
+        "timings_s": times,
+    }
+    with open(os.path.join(args.out, "scene.json"), "w") as f:
+        json.dump(info, f, indent=2)
+    print("wrote", os.path.join(args.out, "scene.json"), flush=True)
+
+
+main()
