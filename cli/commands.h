@@ -147,7 +147,7 @@ struct BokehCommandOptions {
   int spectral_samples = 16;                 // --spectral-samples
   double highlight_gain = 1.0;               // --highlight-gain (8-bit inputs)
   double highlight_threshold = 0.98;         // --highlight-threshold
-  double layer_spacing_px = 1.0;             // --layer-spacing
+  double layer_spacing_px = 2.0;             // --layer-spacing
   int subrows = 4;                           // --subrows
   double max_blur_px = 1000.0;               // --max-blur
   int threads = 0;                           // --threads (0 = all)

@@ -190,7 +190,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1.0, 1.0e6));
   bokeh_cmd->add_option("--highlight-threshold", bokeh.highlight_threshold, "Encoded value from which a channel counts as clipped (default 0.98)")
       ->check(CLI::Range(0.5, 1.0));
-  bokeh_cmd->add_option("--layer-spacing", bokeh.layer_spacing_px, "Depth-layer step in signed blur diameter, px (default 1)")
+  bokeh_cmd->add_option("--layer-spacing", bokeh.layer_spacing_px, "Depth-layer step in signed blur diameter, px (default 2)")
       ->check(CLI::Range(0.1, 1000.0));
   bokeh_cmd->add_option("--subrows", bokeh.subrows, "Sub-rows per pixel of the scatter (1-16, default 4)")->check(CLI::Range(1, 16));
   bokeh_cmd->add_option("--max-blur", bokeh.max_blur_px, "Largest blur diameter, px; nearer points are clamped (default 1000)")

@@ -532,6 +532,7 @@ Image Renderer::run(BokehStatistics& stats) {
   std::vector<Source> sources(static_cast<std::size_t>(w) * h);
   std::size_t clamped = 0;
   double coc_min = kInfinity, coc_max = -kInfinity;
+#pragma omp parallel for num_threads(threads_) schedule(static) reduction(+ : clamped) reduction(min : coc_min) reduction(max : coc_max)
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       const double z = depth_.at(x, y);

@@ -45,7 +45,7 @@ HiddenSurfaces parse_hidden_surfaces(std::string_view text);  // "extend" | "str
 struct BokehOptions {
   int threads = 0;                       // 0 = all hardware threads
   SplatOptions splat;                    // sub-rows per pixel row of the scatter
-  double layer_spacing_px = 1.0;         // signed circle-of-confusion step between depth layers (> 0)
+  double layer_spacing_px = 2.0;         // signed circle-of-confusion step between depth layers (> 0)
   int max_layers = 64;                   // cap; the spacing grows when the blur range needs more (1..1024)
   HiddenSurfaces hidden = HiddenSurfaces::Extend;
   bool spectral = true;                  // false: every ray at the reference wavelength, RGB as given
