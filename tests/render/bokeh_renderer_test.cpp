@@ -278,3 +278,16 @@ TEST_CASE("A grey plane at the focus distance stays grey through the spectral pa
   const Image out = render_bokeh(grey, DepthMap(w, h, 2.0f), *model, Aperture::circular());
   for (std::size_t i = 0; i < out.data.size(); ++i) REQUIRE(out.data[i] == Approx(0.18).epsilon(1e-4));
 }
+
+TEST_CASE("An aperture picture shapes the bokeh: a fully open square mask makes a square 4/pi the disc's area",
+          "[render]") {
+  const int w = 200, h = 200;
+  const Camera cam = Camera::thin_lens(100.0, camera_options(1.0, 1.4), w, h);
+  const auto model = make_ray_model(RayModelKind::Thin, cam);
+  const Scene scene = highlight_scene(w, h, 0.4, 1.0, w / 2, h / 2);  // a 60 px disc
+  const Image disc = render_bokeh(scene.image, scene.depth, *model, Aperture::circular());
+  const Image square = render_bokeh(scene.image, scene.depth, *model, Aperture::mask(8, 8, std::vector<float>(64, 1.0f)));
+  const double ratio = std::pow(disc_diameter_px(square) / disc_diameter_px(disc), 2.0);
+  CHECK(ratio == Approx(4.0 / kPi).epsilon(0.03));
+  CHECK(total(square, 1) == Approx(1000.0).epsilon(1e-3));
+}

@@ -193,7 +193,8 @@ class Renderer {
   Source make_source(int x, int y, double inverse_depth_per_mm, const std::array<float, 3>& rgb, BokehStatistics& stats) const;
   double clamp_inverse_depth(double w, std::size_t& clamped) const;
   Plan plan(const Source& s, std::vector<PupilPoint>& pupil, std::vector<SensorHit>& hits) const;
-  void scatter(const Source& s, const Plan& p, SplatBuffer& buffer, std::vector<SensorHit>& hits,
+  // `buffer` takes footprint-sized polygons, `fine` the small triangles of a mesh (all sub-rows).
+  void scatter(const Source& s, const Plan& p, SplatBuffer& buffer, SplatBuffer& fine, std::vector<SensorHit>& hits,
                std::vector<Point2f>& points, std::size_t& triangles) const;
   std::vector<Source> extend_layer(const std::vector<int>& layer_of, int layer, double reach_px) const;
   bool deposit_rings(const PupilMesh& mesh, const std::vector<SensorHit>& hits, const std::vector<Point2f>& points,
@@ -358,7 +359,8 @@ Plan Renderer::plan(const Source& s, std::vector<PupilPoint>& pupil, std::vector
   p.y_min = static_cast<float>(y_min - margin);
   p.y_max = static_cast<float>(y_max + margin);
   const int sector_step = step_index(kSectorSteps, sectors_for(size));
-  if (near_affine && size < kPointFootprintPx) {
+  const bool all_pass = std::all_of(ok[0].begin(), ok[0].end(), [](bool b) { return b; });
+  if (size < kPointFootprintPx && all_pass) {
     p.outline = kPointPath;
   } else if (near_affine) {
     p.outline = sector_step;
@@ -371,7 +373,7 @@ Plan Renderer::plan(const Source& s, std::vector<PupilPoint>& pupil, std::vector
   return p;
 }
 
-void Renderer::scatter(const Source& s, const Plan& p, SplatBuffer& buffer, std::vector<SensorHit>& hits,
+void Renderer::scatter(const Source& s, const Plan& p, SplatBuffer& buffer, SplatBuffer& fine, std::vector<SensorHit>& hits,
                        std::vector<Point2f>& points, std::size_t& triangles) const {
   const Tangents t = camera_.frame().tangents_at({s.x + 0.5, s.y + 0.5});
   const ScenePoint point{t.x, t.y, s.inverse_depth_per_mm};
@@ -433,7 +435,7 @@ void Renderer::scatter(const Source& s, const Plan& p, SplatBuffer& buffer, std:
       const double fraction = passing(tri);
       if (fraction == 0.0) continue;
       const auto w = static_cast<float>(tri.weight * fraction);
-      buffer.add_triangle(points[tri.a], points[tri.b], points[tri.c],
+      fine.add_triangle(points[tri.a], points[tri.b], points[tri.c],
                           {value[0] * w, value[1] * w, value[2] * w, static_cast<float>(value[3] * tri.weight * fraction / passed)});
       ++triangles;
     }
@@ -618,7 +620,9 @@ Image Renderer::run(BokehStatistics& stats) {
           const int kind = height < kMediumFootprintPx ? 0 : height < kTallFootprintPx ? 1 : 2;
           std::optional<SplatBuffer>& buffer = buffers[static_cast<std::size_t>(kind)];
           if (!buffer) buffer.emplace(w, row_begin, row_end, subrow_options(1 << kind));
-          scatter(layer[i], plans[i], *buffer, hits, points, local_triangles);
+          std::optional<SplatBuffer>& fine = buffers[0];
+          if (plans[i].mesh >= 0 && !fine) fine.emplace(w, row_begin, row_end, subrow_options(1));
+          scatter(layer[i], plans[i], *buffer, plans[i].mesh >= 0 ? *fine : *buffer, hits, points, local_triangles);
           local_footprints += static_cast<std::size_t>(plans[i].groups);
         }
         float* rows = layer_rgba.data() + static_cast<std::size_t>(row_begin) * w * 4;
