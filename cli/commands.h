@@ -26,6 +26,7 @@ inline constexpr int kExitUsage = 2;         // bad command line
 inline constexpr int kExitInput = 3;         // a lens file, glass or option value is wrong
 inline constexpr int kExitComputation = 4;   // the lens has no answer (e.g. afocal: no focal length)
 inline constexpr int kExitIo = 5;            // a file could not be read or written
+inline constexpr int kExitThreshold = 6;     // lensmith validate: a declared threshold was missed
 inline constexpr int kExitInternal = 70;     // a bug: please report it
 
 struct GlobalOptions {
@@ -153,6 +154,20 @@ struct BokehCommandOptions {
   int threads = 0;                           // --threads (0 = all)
 };
 int run_bokeh(const BokehCommandOptions& options, const GlobalOptions& global);
+
+struct ValidateCommandOptions {
+  std::string lens;
+  std::optional<double> f_number;                 // --fstop; default the lens's own
+  double focus_m = 3.0;                           // --focus, metres
+  std::string out = "validation";                 // --out DIR: report.md and psf.png
+  std::vector<std::string> models{"paraxial", "seidel"};  // --models
+  int width_px = 1920;                            // --width/--height: the frame the fields refer to
+  int height_px = 1080;
+  int pupil_samples = 96;                         // --pupil-samples per axis
+  std::optional<double> min_overlap;              // --min-overlap: fail (exit 6) below it
+  std::optional<double> max_centroid_offset_um;   // --max-centroid-offset: fail above it
+};
+int run_validate(const ValidateCommandOptions& options, const GlobalOptions& global);
 
 // Prints the reader's warnings to stderr unless quiet.
 void print_diagnostics(const Diagnostics& diagnostics, const GlobalOptions& global);

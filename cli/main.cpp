@@ -197,6 +197,25 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1.0, 1.0e6));
   bokeh_cmd->add_option("--threads", bokeh.threads, "Threads (default 0 = all cores)")->check(CLI::Range(0, 4096));
 
+  ValidateCommandOptions validate;
+  CLI::App* validate_cmd = app.add_subcommand(
+      "validate", "How close the paraxial and Seidel models come to the exact tracer: PSF metrics, pictures, a report");
+  validate_cmd->add_option("lens", validate.lens, "Lens file or shipped lens name")->required();
+  validate_cmd->add_option("--fstop", validate.f_number, "f-number (default: the lens's own; 0.5-512)")->check(CLI::Range(0.5, 512.0));
+  validate_cmd->add_option("--focus", validate.focus_m, "Focus distance, metres (default 3)")->check(CLI::PositiveNumber);
+  validate_cmd->add_option("--out", validate.out, "Directory for report.md and psf.png (default ./validation)");
+  validate_cmd->add_option("--models", validate.models, "Models to compare with exact (default paraxial seidel)")
+      ->check(CLI::IsMember({"paraxial", "seidel"}));
+  validate_cmd->add_option("--width", validate.width_px, "Frame width the fields refer to, px (default 1920)")->check(CLI::Range(16, 65536));
+  validate_cmd->add_option("--height", validate.height_px, "Frame height, px (default 1080)")->check(CLI::Range(16, 65536));
+  validate_cmd->add_option("--pupil-samples", validate.pupil_samples, "Pupil grid per axis for each PSF (default 96; 2-512)")
+      ->check(CLI::Range(2, 512));
+  validate_cmd->add_option("--min-overlap", validate.min_overlap, "Fail (exit 6) when a model's worst PSF overlap is below this (0-1)")
+      ->check(CLI::Range(0.0, 1.0));
+  validate_cmd->add_option("--max-centroid-offset", validate.max_centroid_offset_um,
+                           "Fail (exit 6) when a model's largest centroid offset exceeds this, um")
+      ->check(CLI::PositiveNumber);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -220,6 +239,7 @@ int main(int argc, char** argv) {
     if (*fan_cmd) return run_fan(fan, global);
     if (*analyze_cmd) return run_analyze(analyze, global);
     if (*bokeh_cmd) return run_bokeh(bokeh, global);
+    if (*validate_cmd) return run_validate(validate, global);
   } catch (const lensmith::ComputationError& e) {
     std::cerr << "lensmith: " << e.what() << "\n";
     return kExitComputation;

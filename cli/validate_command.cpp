@@ -1,0 +1,75 @@
+// `lensmith validate`: how close the fast ray models come to the exact tracer, in numbers and
+// pictures (docs/validation.md). Today: the PSF level; the image level needs ground-truth renders
+// through the lens (`lensmith scene`, not implemented yet) and is reported as such.
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "commands.h"
+#include "lensmith/core/errors.h"
+#include "lensmith/core/text_file.h"
+#include "lensmith/render/image_io.h"
+#include "lensmith/validate/psf_validation.h"
+
+namespace lensmith::cli {
+
+int run_validate(const ValidateCommandOptions& o, const GlobalOptions& global) {
+  const Prescription lens = load_lens(o.lens, global);
+  CameraOptions camera_options;
+  camera_options.focus_distance_m = o.focus_m;
+  camera_options.f_number = o.f_number;
+  const Camera camera = Camera::from_lens(lens, camera_options, o.width_px, o.height_px);
+  std::vector<RayModelKind> models;
+  for (const std::string& m : o.models) models.push_back(parse_ray_model_kind(m));
+  PsfValidationOptions psf;
+  psf.pupil_samples_per_axis = o.pupil_samples;
+  RayModelOptions model_options;
+  model_options.nearest_depth_m = std::max(0.05, 0.4 * o.focus_m);
+  const PsfValidation result = validate_point_spreads(camera, models, Aperture::circular(), psf, model_options);
+
+  const std::filesystem::path dir = o.out;
+  std::filesystem::create_directories(dir);
+  OutputMetadata meta;
+  meta.lens = lens.name;
+  meta.f_number = camera.f_number();
+  meta.focus_m = o.focus_m;
+  meta.model = "exact | model | difference";
+  write_output_image(dir / "psf.png", psf_grid_picture(camera, models, Aperture::circular(), psf, model_options), meta);
+
+  std::ostringstream report;
+  report << "# lensmith validate: " << lens.name << "\n\n"
+         << "f/" << camera.f_number() << ", focused at " << o.focus_m << " m (sensor at z = " << std::fixed
+         << std::setprecision(4) << camera.z_sensor_mm() << " mm), frame " << o.width_px << " x " << o.height_px
+         << " px on a 36 mm sensor.\n\n"
+         << "## PSF level: each model against exact forward tracing\n\n"
+         << "Fields are fractions of the frame's half-width; PSFs from a " << psf.pupil_samples_per_axis << " x "
+         << psf.pupil_samples_per_axis << " pupil grid, compared on " << psf.bins << " x " << psf.bins
+         << " bins over a window at least " << psf.min_half_width_px
+         << " output pixels either side of the exact centroid (overlap = 1 - L1/2 of the normalised PSFs).\n\n"
+         << result.to_markdown() << "\n![PSFs: exact | model | difference, per model](psf.png)\n\n"
+         << "## Image level\n\nNot implemented yet: it needs ground-truth renders of analytic scenes through the "
+            "lens (`lensmith scene render --lens`, issue 6, in progress).\n";
+  const std::string text = report.str();
+  write_file_atomically((dir / "report.md").string(), text);
+
+  std::cout << result.to_markdown().substr(0, result.to_markdown().find("\n\n")) << "\n"
+            << "wrote " << (dir / "report.md").string() << " and " << (dir / "psf.png").string() << "\n";
+  bool failed = false;
+  for (const PsfModelSummary& s : result.summaries) {
+    if (o.min_overlap && s.worst_overlap < *o.min_overlap) {
+      std::cerr << "lensmith validate: " << to_string(s.model) << " worst PSF overlap " << s.worst_overlap
+                << " is below --min-overlap " << *o.min_overlap << "\n";
+      failed = true;
+    }
+    if (o.max_centroid_offset_um && s.max_centroid_offset_um > *o.max_centroid_offset_um) {
+      std::cerr << "lensmith validate: " << to_string(s.model) << " centroid offset " << s.max_centroid_offset_um
+                << " um exceeds --max-centroid-offset " << *o.max_centroid_offset_um << "\n";
+      failed = true;
+    }
+  }
+  return failed ? kExitThreshold : kExitOk;
+}
+
+}  // namespace lensmith::cli

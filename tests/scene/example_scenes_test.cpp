@@ -1,0 +1,99 @@
+// The scenes shipped in examples/scenes/ load, render at 64 x 36 through the framing they are
+// designed for (36 mm sensor, 50 mm pinhole: hfov 39.6 deg), and show the depths they promise.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <string>
+
+#include "lensmith/core/units.h"
+#include "lensmith/scene/pinhole_render.h"
+#include "lensmith/scene/scene_json.h"
+
+using Catch::Matchers::WithinRel;
+using namespace lensmith;
+
+namespace {
+
+const std::string kScenes = std::string(LENSMITH_SOURCE_DIR) + "/examples/scenes/";
+
+PinholeRender render_example(const std::string& file) {
+  const Scene scene = load_scene(kScenes + file);
+  PinholeFrameOptions framing;
+  framing.sensor_width_mm = 36.0;
+  framing.focal_length_mm = 50.0;
+  return render_pinhole(scene, PinholeFrame::from_options(64, 36, framing, 50.0));
+}
+
+// Every colour finite and >= 0, every depth > 0 (inf allowed, NaN not).
+void check_valid(const PinholeRender& out) {
+  for (float v : out.rgb.data) REQUIRE((std::isfinite(v) && v >= 0.0f));
+  for (float z : out.depth.z_m) REQUIRE(z > 0.0f);
+}
+
+// The depths (rounded to 1 mm) that cover at least `min_pixels` pixels.
+std::set<double> main_depths(const DepthMap& depth, int min_pixels) {
+  std::map<double, int> count;
+  for (float z : depth.z_m) ++count[std::isinf(z) ? static_cast<double>(z) : m_from_mm(std::round(mm_from_m(z)))];
+  std::set<double> out;
+  for (const auto& [z, n] : count) {
+    if (n >= min_pixels) out.insert(z);
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("the highlight field renders with its far wall at 30 m behind every highlight", "[scene][examples]") {
+  const PinholeRender out = render_example("highlight-field.json");
+  check_valid(out);
+  CHECK(main_depths(out.depth, 100) == std::set<double>{30.0});
+  CHECK(*std::min_element(out.depth.z_m.begin(), out.depth.z_m.end()) >= 1.0f - 0.002f);
+}
+
+TEST_CASE("the occluder scene shows a disc at 1 m and a bar at 1.2 m over the wall at 3 m", "[scene][examples]") {
+  const PinholeRender out = render_example("occluder.json");
+  check_valid(out);
+  const std::set<double> depths = main_depths(out.depth, 10);
+  CHECK(depths.count(1.0) == 1);
+  CHECK(depths.count(1.2) == 1);
+  CHECK(depths.count(3.0) == 1);
+  CHECK(std::none_of(out.depth.z_m.begin(), out.depth.z_m.end(), [](float z) { return std::isinf(z); }));
+}
+
+TEST_CASE("the tilted plane fills the frame with depth varying continuously from about 1.8 to 9 m", "[scene][examples]") {
+  const PinholeRender out = render_example("tilted-plane.json");
+  check_valid(out);
+  const auto [lo, hi] = std::minmax_element(out.depth.z_m.begin(), out.depth.z_m.end());
+  CHECK(*lo > 1.7f);
+  CHECK(*lo < 2.0f);
+  CHECK(*hi > 8.0f);
+  CHECK(std::isfinite(*hi));
+  // Continuous: neighbouring pixels of the floor differ by a few per cent at most (the top rows,
+  // near 9 m, change fastest: about 5 % per row).
+  for (int y = 0; y + 1 < out.depth.height; ++y) {
+    for (int x = 0; x + 1 < out.depth.width; ++x) {
+      const double z = out.depth.at(x, y);
+      INFO("pixel (" << x << ", " << y << ")");
+      // Lamps on the floor are nearer than the floor around them; skip their pixels.
+      if (out.rgb.at(x, y, 1) > 1.0f || out.rgb.at(x + 1, y, 1) > 1.0f || out.rgb.at(x, y + 1, 1) > 1.0f) continue;
+      REQUIRE_THAT(out.depth.at(x + 1, y), WithinRel(z, 0.1));
+      REQUIRE_THAT(out.depth.at(x, y + 1), WithinRel(z, 0.1));
+    }
+  }
+}
+
+TEST_CASE("the depth staircase shows its five steps side by side from left to right", "[scene][examples]") {
+  const PinholeRender out = render_example("depth-staircase.json");
+  check_valid(out);
+  const double steps[] = {1.0, 1.5, 2.2, 3.3, 5.0};
+  // Strip k of the 64 columns spans x in [12.8 k, 12.8 (k + 1)); sample the middle row's strip centres.
+  for (int k = 0; k < 5; ++k) {
+    const int x = static_cast<int>(12.8 * k + 6.4);
+    INFO("step " << k + 1 << ", column " << x);
+    CHECK(out.depth.at(x, 25) == static_cast<float>(steps[k]));
+  }
+  CHECK(main_depths(out.depth, 50) == std::set<double>{1.0, 1.5, 2.2, 3.3, 5.0});
+}
