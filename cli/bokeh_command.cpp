@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "commands.h"
+#include "progress_bar.h"
 #include "lensmith/core/errors.h"
 #include "lensmith/core/units.h"
 #include "lensmith/paraxial/paraxial_system.h"
@@ -19,30 +20,6 @@ namespace lensmith::cli {
 
 namespace {
 
-// A one-line progress bar on stderr, drawn only on a terminal and without --quiet.
-class ProgressBar {
- public:
-  ProgressBar(std::string label, bool enabled) : label_(std::move(label)), enabled_(enabled && isatty(STDERR_FILENO)) {}
-  void update(double fraction) {
-    if (!enabled_) return;
-    const int percent = static_cast<int>(std::lround(100.0 * fraction));
-    if (percent == last_) return;
-    last_ = percent;
-    const int filled = percent * kWidth / 100;
-    std::cerr << "\r" << label_ << " [" << std::string(static_cast<std::size_t>(filled), '#')
-              << std::string(static_cast<std::size_t>(kWidth - filled), ' ') << "] " << std::setw(3) << percent << "%"
-              << std::flush;
-  }
-  void finish() {
-    if (enabled_ && last_ >= 0) std::cerr << "\n";
-  }
-
- private:
-  static constexpr int kWidth = 40;
-  std::string label_;
-  bool enabled_;
-  int last_ = -1;
-};
 
 Aperture make_aperture(const BokehCommandOptions& o) {
   if (!o.aperture_image.empty()) {

@@ -166,8 +166,39 @@ struct ValidateCommandOptions {
   int pupil_samples = 96;                         // --pupil-samples per axis
   std::optional<double> min_overlap;              // --min-overlap: fail (exit 6) below it
   std::optional<double> max_centroid_offset_um;   // --max-centroid-offset: fail above it
+  std::vector<std::string> scenes;                // --scene FILE (repeatable): image-level validation
+  int image_width_px = 320;                       // --image-width/--image-height of those renders
+  int image_height_px = 180;
+  int image_spp = 64;                             // --image-spp: ground-truth samples per pixel
+  std::optional<double> min_edge_psnr_db;         // --min-edge-psnr: fail when a model's edge-band PSNR is lower
 };
 int run_validate(const ValidateCommandOptions& options, const GlobalOptions& global);
+
+// `lensmith scene render`: an analytic scene through a pinhole (all-in-focus picture and depth) or,
+// as ground truth, through a lens (docs/cli.md, docs/scene-format.md).
+struct SceneRenderOptions {
+  std::string scene;                              // SCENE: a lensmith-scene JSON file
+  std::string output;                             // -o: .exr (float + metadata) or .png/.jpg/.tif (sRGB)
+  std::string depth;                              // --depth: planar depth EXR (channel Z, metres); --pinhole only
+  bool pinhole = false;                           // --pinhole: the all-in-focus picture
+  std::string lens;                               // --lens: file or shipped name; exact tracing
+  bool thin_lens = false;                         // --thin-lens: an ideal thin lens
+  std::optional<double> focal_length_mm;          // --focal-length (thin lens), mm
+  std::optional<double> f_number;                 // --fstop; default the lens's own (a thin lens needs one)
+  std::optional<double> focus_m;                  // --focus, metres from the entrance pupil; required through a lens
+  int spp = 64;                                   // --spp: samples per pixel (of the first pass)
+  std::optional<double> noise_target;             // --noise-target: double spp until the relative error is below
+  std::optional<int> max_spp;                     // --max-spp: bound of --noise-target; default max(4096, spp)
+  int width_px = 640;                             // --width
+  int height_px = 360;                            // --height
+  double sensor_width_mm = 36.0;                  // --sensor-width of the pinhole framing, mm
+  std::optional<double> pinhole_focal_length_mm;  // --pinhole-focal-length; default the lens EFL (--pinhole: 50 mm)
+  bool no_spectral = false;                       // --no-spectral
+  int spectral_samples = 16;                      // --spectral-samples
+  std::uint64_t seed = 1;                         // --seed
+  int threads = 0;                                // --threads (0 = all)
+};
+int run_scene_render(const SceneRenderOptions& options, const GlobalOptions& global);
 
 // Prints the reader's warnings to stderr unless quiet.
 void print_diagnostics(const Diagnostics& diagnostics, const GlobalOptions& global);

@@ -21,6 +21,16 @@ Prescription load_lens(const std::string& lens, const GlobalOptions& global) {
   return std::move(result.prescription);
 }
 
+// A focus distance: metres > 0, or inf (CLI11's PositiveNumber refuses infinity).
+CLI::Validator focus_distance_check() {
+  return CLI::Validator(
+      [](std::string& text) {
+        double v = 0.0;
+        return CLI::detail::lexical_cast(text, v) && v > 0.0 ? std::string() : "must be > 0 or inf, got " + text;
+      },
+      "M > 0 or inf", "focus distance");
+}
+
 }  // namespace lensmith::cli
 
 int main(int argc, char** argv) {
@@ -166,7 +176,7 @@ int main(int argc, char** argv) {
   bokeh_cmd->add_option("--focal-length", bokeh.focal_length_mm, "Thin-lens focal length, mm (> 0)")->check(CLI::PositiveNumber)->needs(bokeh_thin);
   bokeh_cmd->add_option("--fstop", bokeh.f_number, "f-number (default: the lens's own; 0.5-512)")->check(CLI::Range(0.5, 512.0));
   bokeh_cmd->add_option("--focus", bokeh.focus_m, "Focus distance, metres from the camera (> 0; inf for infinity)")->required()
-      ->check(CLI::PositiveNumber);
+      ->check(focus_distance_check());
   bokeh_cmd->add_option("--sensor-width", bokeh.sensor_width_mm, "Sensor width of the input image's pinhole camera, mm (default 36)")
       ->check(CLI::PositiveNumber);
   CLI::Option* bokeh_pf = bokeh_cmd->add_option("--pinhole-focal-length", bokeh.pinhole_focal_length_mm,
@@ -202,7 +212,7 @@ int main(int argc, char** argv) {
       "validate", "How close the paraxial and Seidel models come to the exact tracer: PSF metrics, pictures, a report");
   validate_cmd->add_option("lens", validate.lens, "Lens file or shipped lens name")->required();
   validate_cmd->add_option("--fstop", validate.f_number, "f-number (default: the lens's own; 0.5-512)")->check(CLI::Range(0.5, 512.0));
-  validate_cmd->add_option("--focus", validate.focus_m, "Focus distance, metres (default 3)")->check(CLI::PositiveNumber);
+  validate_cmd->add_option("--focus", validate.focus_m, "Focus distance, metres (default 3; inf allowed)")->check(focus_distance_check());
   validate_cmd->add_option("--out", validate.out, "Directory for report.md and psf.png (default ./validation)");
   validate_cmd->add_option("--models", validate.models, "Models to compare with exact (default paraxial seidel)")
       ->check(CLI::IsMember({"paraxial", "seidel"}));
@@ -212,9 +222,61 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(2, 512));
   validate_cmd->add_option("--min-overlap", validate.min_overlap, "Fail (exit 6) when a model's worst PSF overlap is below this (0-1)")
       ->check(CLI::Range(0.0, 1.0));
+  validate_cmd->add_option("--scene", validate.scenes, "Analytic scene (JSON) for the image-level comparison; repeatable")
+      ->check(CLI::ExistingFile);
+  validate_cmd->add_option("--image-width", validate.image_width_px, "Width of the image-level renders, px (default 320)")
+      ->check(CLI::Range(16, 8192));
+  validate_cmd->add_option("--image-height", validate.image_height_px, "Height of the image-level renders, px (default 180)")
+      ->check(CLI::Range(16, 8192));
+  validate_cmd->add_option("--image-spp", validate.image_spp, "Samples per pixel of the ground truth (default 64)")
+      ->check(CLI::Range(1, 1 << 20));
+  validate_cmd->add_option("--min-edge-psnr", validate.min_edge_psnr_db, "Fail (exit 6) when a model's depth-edge PSNR is below this, dB");
   validate_cmd->add_option("--max-centroid-offset", validate.max_centroid_offset_um,
                            "Fail (exit 6) when a model's largest centroid offset exceeds this, um")
       ->check(CLI::PositiveNumber);
+
+  SceneRenderOptions scene_render;
+  CLI::App* scene_cmd = app.add_subcommand("scene", "Analytic scenes (docs/scene-format.md): render them through a pinhole or a lens");
+  scene_cmd->require_subcommand(1);
+  CLI::App* scene_render_cmd = scene_cmd->add_subcommand(
+      "render", "All-in-focus picture and depth (--pinhole), or the ground truth through a lens (--lens, --thin-lens)");
+  scene_render_cmd->add_option("scene", scene_render.scene, "Scene file (lensmith-scene JSON)")->required()->check(CLI::ExistingFile);
+  scene_render_cmd->add_option("-o,--output", scene_render.output, "Output: .exr (float, with metadata) or .png/.jpg/.tif (sRGB)")
+      ->required();
+  CLI::Option* scene_pinhole = scene_render_cmd->add_flag("--pinhole", scene_render.pinhole, "Render through a pinhole (all in focus)");
+  CLI::Option* scene_lens = scene_render_cmd->add_option("--lens", scene_render.lens, "Render through this lens: file or shipped name (exact tracing)");
+  CLI::Option* scene_thin = scene_render_cmd->add_flag("--thin-lens", scene_render.thin_lens, "Render through an ideal thin lens (needs --focal-length, --fstop)");
+  scene_pinhole->excludes(scene_lens)->excludes(scene_thin);
+  scene_lens->excludes(scene_thin);
+  scene_render_cmd->add_option("--depth", scene_render.depth, "With --pinhole: also write the planar depth, float EXR channel Z, metres")
+      ->needs(scene_pinhole);
+  scene_render_cmd->add_option("--focal-length", scene_render.focal_length_mm, "Thin-lens focal length, mm (> 0)")
+      ->check(CLI::PositiveNumber)->needs(scene_thin);
+  // Options of renders through a lens: meaningless for a pinhole.
+  const std::vector<CLI::Option*> lens_only{
+      scene_render_cmd->add_option("--fstop", scene_render.f_number, "f-number (default: the lens's own; 0.5-512)")
+          ->check(CLI::Range(0.5, 512.0)),
+      scene_render_cmd->add_option("--focus", scene_render.focus_m, "Focus distance, metres from the entrance pupil (> 0; inf)")
+          ->check(focus_distance_check()),
+      scene_render_cmd->add_option("--spp", scene_render.spp, "Samples per pixel (default 64; 1-1048576)")->check(CLI::Range(1, 1 << 20)),
+      scene_render_cmd->add_option("--noise-target", scene_render.noise_target,
+                                   "Double the samples until the estimated mean relative error is below this (> 0)")
+          ->check(CLI::PositiveNumber),
+      scene_render_cmd->add_option("--max-spp", scene_render.max_spp, "Most samples per pixel with --noise-target (>= --spp; default 4096 or --spp if larger)")
+          ->check(CLI::Range(1, 1 << 20)),
+      scene_render_cmd->add_option("--seed", scene_render.seed, "Random seed (default 1; the same seed gives the same image)"),
+      scene_render_cmd->add_flag("--no-spectral", scene_render.no_spectral, "Trace every ray at 587.6 nm and keep RGB as it is"),
+      scene_render_cmd->add_option("--spectral-samples", scene_render.spectral_samples, "Wavelengths of the spectral quadrature (3-64, default 16)")
+          ->check(CLI::Range(3, 64))};
+  for (CLI::Option* option : lens_only) option->excludes(scene_pinhole);
+  scene_render_cmd->add_option("--width", scene_render.width_px, "Image width, px (default 640)")->check(CLI::Range(1, 65536));
+  scene_render_cmd->add_option("--height", scene_render.height_px, "Image height, px (default 360)")->check(CLI::Range(1, 65536));
+  scene_render_cmd->add_option("--sensor-width", scene_render.sensor_width_mm, "Sensor width of the pinhole framing, mm (default 36)")
+      ->check(CLI::PositiveNumber);
+  scene_render_cmd->add_option("--pinhole-focal-length", scene_render.pinhole_focal_length_mm,
+                               "Pinhole focal length of the framing, mm (default: the lens EFL, the thin lens's focal length; 50 with --pinhole)")
+      ->check(CLI::PositiveNumber);
+  scene_render_cmd->add_option("--threads", scene_render.threads, "Threads (default 0 = all cores)")->check(CLI::Range(0, 4096));
 
   try {
     app.parse(argc, argv);
@@ -240,6 +302,7 @@ int main(int argc, char** argv) {
     if (*analyze_cmd) return run_analyze(analyze, global);
     if (*bokeh_cmd) return run_bokeh(bokeh, global);
     if (*validate_cmd) return run_validate(validate, global);
+    if (*scene_render_cmd) return run_scene_render(scene_render, global);
   } catch (const lensmith::ComputationError& e) {
     std::cerr << "lensmith: " << e.what() << "\n";
     return kExitComputation;

@@ -1,6 +1,6 @@
 // `lensmith validate`: how close the fast ray models come to the exact tracer, in numbers and
-// pictures (docs/validation.md). Today: the PSF level; the image level needs ground-truth renders
-// through the lens (`lensmith scene`, not implemented yet) and is reported as such.
+// pictures (docs/validation.md): PSFs against exact forward tracing, and with --scene whole pictures
+// of `lensmith bokeh` against analytic scenes rendered through the lens.
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
@@ -11,6 +11,7 @@
 #include "lensmith/core/errors.h"
 #include "lensmith/core/text_file.h"
 #include "lensmith/render/image_io.h"
+#include "lensmith/validate/image_validation.h"
 #include "lensmith/validate/psf_validation.h"
 
 namespace lensmith::cli {
@@ -26,7 +27,7 @@ int run_validate(const ValidateCommandOptions& o, const GlobalOptions& global) {
   PsfValidationOptions psf;
   psf.pupil_samples_per_axis = o.pupil_samples;
   RayModelOptions model_options;
-  model_options.nearest_depth_m = std::max(0.05, 0.4 * o.focus_m);
+  model_options.nearest_depth_m = std::isinf(o.focus_m) ? 1.0 : std::max(0.05, 0.4 * o.focus_m);
   const PsfValidation result = validate_point_spreads(camera, models, Aperture::circular(), psf, model_options);
 
   const std::filesystem::path dir = o.out;
@@ -49,12 +50,32 @@ int run_validate(const ValidateCommandOptions& o, const GlobalOptions& global) {
          << " bins over a window at least " << psf.min_half_width_px
          << " output pixels either side of the exact centroid (overlap = 1 - L1/2 of the normalised PSFs).\n\n"
          << result.to_markdown() << "\n![PSFs: exact | model | difference, per model](psf.png)\n\n"
-         << "## Image level\n\nNot implemented yet: it needs ground-truth renders of analytic scenes through the "
-            "lens (`lensmith scene render --lens`, issue 6, in progress).\n";
+         << "## Image level\n\n";
+  ImageValidation images;
+  if (o.scenes.empty()) {
+    report << "No scene given (`--scene FILE`, e.g. examples/scenes/*.json): skipped.\n";
+  } else {
+    ImageValidationOptions image_options;
+    for (const std::string& s : o.scenes) image_options.scenes.emplace_back(s);
+    image_options.models = models;
+    image_options.width_px = o.image_width_px;
+    image_options.height_px = o.image_height_px;
+    image_options.spp = o.image_spp;
+    image_options.picture_dir = dir;
+    images = validate_images(lens, camera_options, image_options);
+    report << "`lensmith bokeh` with each model on the pinhole render of each scene, against the scene rendered "
+              "through the lens by the exact tracer (" << o.image_spp << " samples per pixel), "
+           << o.image_width_px << " x " << o.image_height_px << " px; PSNR and SSIM on x/(1+x) values, "
+           << "over the frame and within " << image_options.band_radius_px << " px of depth edges. Pictures: "
+           << "`<scene>-truth.png`, `<scene>-<model>.png`, `<scene>-<model>-error.png`.\n\n"
+           << images.to_markdown();
+  }
   const std::string text = report.str();
   write_file_atomically((dir / "report.md").string(), text);
 
-  std::cout << result.to_markdown().substr(0, result.to_markdown().find("\n\n")) << "\n"
+  std::cout << result.to_markdown().substr(0, result.to_markdown().find("\n\n")) << "\n";
+  if (!images.entries.empty()) std::cout << "\n" << images.to_markdown();
+  std::cout
             << "wrote " << (dir / "report.md").string() << " and " << (dir / "psf.png").string() << "\n";
   bool failed = false;
   for (const PsfModelSummary& s : result.summaries) {
@@ -66,6 +87,13 @@ int run_validate(const ValidateCommandOptions& o, const GlobalOptions& global) {
     if (o.max_centroid_offset_um && s.max_centroid_offset_um > *o.max_centroid_offset_um) {
       std::cerr << "lensmith validate: " << to_string(s.model) << " centroid offset " << s.max_centroid_offset_um
                 << " um exceeds --max-centroid-offset " << *o.max_centroid_offset_um << "\n";
+      failed = true;
+    }
+  }
+  for (const ImageValidationEntry& e : images.entries) {
+    if (o.min_edge_psnr_db && e.comparison.edge_psnr_db < *o.min_edge_psnr_db) {
+      std::cerr << "lensmith validate: " << to_string(e.model) << " on " << e.scene << ": edge PSNR "
+                << e.comparison.edge_psnr_db << " dB is below --min-edge-psnr " << *o.min_edge_psnr_db << "\n";
       failed = true;
     }
   }

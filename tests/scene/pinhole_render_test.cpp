@@ -12,10 +12,13 @@
 #include "lensmith/core/errors.h"
 #include "lensmith/scene/scene_intersection.h"
 
+#include "brightest_pixel.h"
+
 using Catch::Matchers::Contains;
 using Catch::Matchers::WithinAbs;
 using Catch::Matchers::WithinRel;
 using namespace lensmith;
+using lensmith::testing::brightest;
 
 namespace {
 
@@ -43,21 +46,6 @@ Rectangle box_at(double z_m, double x0, double x1, double y0, double y1) {
   r.half_u_m = {0.5 * (x1 - x0), 0.0, 0.0};
   r.half_v_m = {0.0, 0.5 * (y1 - y0), 0.0};
   return r;
-}
-
-// The brightest pixel of channel 1.
-PixelPoint brightest(const Image& image) {
-  PixelPoint best;
-  float level = -1.0f;
-  for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) {
-      if (image.at(x, y, 1) > level) {
-        level = image.at(x, y, 1);
-        best = {x + 0.5, y + 0.5};
-      }
-    }
-  }
-  return best;
 }
 
 }  // namespace

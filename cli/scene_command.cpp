@@ -1,0 +1,143 @@
+// `lensmith scene render`: an analytic scene (docs/scene-format.md) through a pinhole (the
+// all-in-focus picture and planar depth that `lensmith bokeh` takes) or, as ground truth, through
+// the exact prescription or an ideal thin lens with the framing `lensmith bokeh` uses.
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "commands.h"
+#include "progress_bar.h"
+#include "lensmith/camera/camera.h"
+#include "lensmith/core/errors.h"
+#include "lensmith/core/number_parsing.h"
+#include "lensmith/paraxial/paraxial_system.h"
+#include "lensmith/render/image_io.h"
+#include "lensmith/scene/lens_render.h"
+#include "lensmith/scene/pinhole_render.h"
+#include "lensmith/scene/scene_json.h"
+
+namespace lensmith::cli {
+
+namespace {
+
+// The framing of `--pinhole` without --pinhole-focal-length: the examples' 50 mm (examples/scenes).
+constexpr double kDefaultPinholeFocalMm = 50.0;
+
+
+void write_depth(const std::filesystem::path& path, const DepthMap& depth) {
+  Image z(depth.width, depth.height, 1);
+  z.data = depth.z_m;
+  write_float_exr(path, z, {"Z"});
+}
+
+}  // namespace
+
+int run_scene_render(const SceneRenderOptions& o, const GlobalOptions& global) {
+  const auto started = std::chrono::steady_clock::now();
+  const int modes = (o.pinhole ? 1 : 0) + (o.lens.empty() ? 0 : 1) + (o.thin_lens ? 1 : 0);
+  if (modes != 1) {
+    throw OptionsError("give exactly one of --pinhole, --lens LENS or --thin-lens --focal-length MM");
+  }
+  const std::filesystem::path output = o.output;
+  ensure_not_an_input(output, {o.scene});
+  if (!o.depth.empty()) {
+    ensure_not_an_input(o.depth, {o.scene});
+    if (std::filesystem::absolute(o.depth).lexically_normal() == std::filesystem::absolute(output).lexically_normal()) {
+      throw OptionsError("--depth " + o.depth + " is the output image: give the depth another file");
+    }
+  }
+  const Scene scene = load_scene(o.scene);
+
+  OutputMetadata meta;
+  meta.lensmith_version = LENSMITH_VERSION;
+  meta.extra = {{"scene", o.scene}};
+  Image rgb;
+  std::string summary;
+  if (o.pinhole) {
+    PinholeFrameOptions framing;
+    framing.sensor_width_mm = o.sensor_width_mm;
+    const PinholeFrame frame =
+        PinholeFrame::from_options(o.width_px, o.height_px, framing, o.pinhole_focal_length_mm.value_or(kDefaultPinholeFocalMm));
+    PinholeRenderOptions options;
+    options.threads = o.threads;
+    PinholeRender out = render_pinhole(scene, frame, options);
+    meta.model = "pinhole";
+    meta.extra.push_back({"frame", frame.to_string()});
+    rgb = std::move(out.rgb);
+    if (!o.depth.empty()) write_depth(o.depth, out.depth);
+    summary = "pinhole, " + frame.to_string();
+  } else {
+    if (!o.focus_m) throw OptionsError("rendering through a lens needs --focus M (metres from the entrance pupil)");
+    CameraOptions camera_options;
+    camera_options.focus_distance_m = *o.focus_m;
+    camera_options.f_number = o.f_number;
+    camera_options.framing.sensor_width_mm = o.sensor_width_mm;
+    camera_options.framing.focal_length_mm = o.pinhole_focal_length_mm;
+    LensRenderOptions options;
+    options.spp = o.spp;
+    options.noise_target = o.noise_target;
+    options.max_spp = o.max_spp.value_or(std::max(options.max_spp, o.spp));
+    options.threads = o.threads;
+    options.spectral = !o.no_spectral;
+    options.spectral_samples = o.spectral_samples;
+    options.seed = o.seed;
+    options.validate();
+    ProgressBar bar("scene", !global.quiet);
+    options.progress = [&bar](double f) { bar.update(f); };
+    std::optional<Camera> camera;
+    LensRender out;
+    if (o.thin_lens) {
+      if (!o.focal_length_mm) throw OptionsError("--thin-lens needs --focal-length MM");
+      camera = Camera::thin_lens(*o.focal_length_mm, camera_options, o.width_px, o.height_px);
+      meta.lens = "thin lens f = " + format_number(*o.focal_length_mm) + " mm";
+      meta.model = "thin lens ground truth";
+      out = render_through_thin_lens(scene, *camera, options);
+    } else {
+      const Prescription lens = load_lens(o.lens, global);
+      meta.lens = lens.name.empty() ? o.lens : lens.name;
+      meta.model = "exact trace ground truth";
+      camera = Camera::from_lens(lens, camera_options, o.width_px, o.height_px);
+      out = render_through_lens(scene, *camera, options);
+    }
+    bar.finish();
+    // The spectral estimator is unbiased but a single wavelength's RGB has negative components, so a
+    // noisy pixel can fall below 0; files hold radiance (>= 0, as read_radiance_image requires).
+    std::size_t clamped = 0;
+    for (float& v : out.rgb.data) {
+      if (v < 0.0f) {
+        v = 0.0f;
+        ++clamped;
+      }
+    }
+    meta.f_number = camera->f_number();
+    meta.focus_m = *o.focus_m;
+    meta.extra.push_back({"spp", std::to_string(out.spp_used)});
+    meta.extra.push_back({"estimated_relative_error", format_number(out.estimated_relative_error)});
+    meta.extra.push_back({"seed", std::to_string(o.seed)});
+    meta.extra.push_back(
+        {"spectral", options.spectral && !o.thin_lens ? std::to_string(options.spectral_samples) + " nodes" : "off"});
+    meta.extra.push_back({"rays", out.rays.to_string()});
+    meta.extra.push_back({"negative_values_clamped", std::to_string(clamped)});
+    meta.extra.push_back({"frame", camera->frame().to_string()});
+    std::ostringstream s;
+    s << meta.lens << ", f/" << std::setprecision(3) << camera->f_number() << ", focus " << *o.focus_m << " m, "
+      << out.spp_used << " spp, estimated relative error " << std::setprecision(3) << out.estimated_relative_error
+      << "\n  rays: " << out.rays.to_string();
+    if (clamped > 0) s << "\n  " << clamped << " negative channel values (spectral noise) clamped to 0: raise --spp";
+    summary = s.str();
+    rgb = std::move(out.rgb);
+  }
+  write_output_image(output, rgb, meta);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  std::cout << "wrote " << output.string() << (o.depth.empty() ? std::string() : " and " + o.depth) << " ("
+            << rgb.width << " x " << rgb.height << ") in " << std::fixed << std::setprecision(2) << seconds << " s\n"
+            << "  " << summary << "\n";
+  return kExitOk;
+}
+
+}  // namespace lensmith::cli

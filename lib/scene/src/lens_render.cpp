@@ -1,0 +1,333 @@
+// Monte-Carlo ground truth through the exact prescription or an ideal thin lens (lens_render.h).
+// Sampling follows pbrt-v4's RealisticCamera (sensor point, a point on the rear pupil, trace out
+// through the lens) with the paraxial exit pupil as the sampling disc, and PerspectiveCamera's thin
+// lens; random numbers from PCG32 (O'Neill, "PCG: a family of simple fast space-efficient
+// statistically good algorithms for random number generation", 2014) seeded by SplitMix64.
+#include "lensmith/scene/lens_render.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <vector>
+
+#include <omp.h>
+
+#include "lensmith/color/spectral_quadrature.h"
+#include "lensmith/core/errors.h"
+#include "lensmith/core/number_parsing.h"
+#include "lensmith/core/units.h"
+#include "lensmith/scene/scene_intersection.h"
+#include "lensmith/trace/sequential_tracer.h"
+
+namespace lensmith {
+
+namespace {
+
+constexpr int kMaxSpp = 1 << 20;
+// Radius factor of the sampled exit-pupil disc over the paraxial one: the real pupil of the
+// shipped lenses at their f-numbers lies within a few percent of the paraxial disc.
+constexpr double kPupilEnlargement = 1.15;
+// Floor of the denominator of a pixel's relative error, as a fraction of the image's mean, so that
+// near-black pixels do not dominate the mean relative error.
+constexpr double kRelativeErrorFloor = 0.01;
+constexpr double kMinWavelengthNm = 380.0;  // the bokeh renderer's quadrature range
+constexpr double kMaxWavelengthNm = 780.0;
+
+std::uint64_t splitmix64(std::uint64_t& state) {
+  std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+// PCG32 (XSH RR), one stream per (seed, pixel, pass).
+class Pcg32 {
+ public:
+  Pcg32(std::uint64_t seed, std::uint64_t pixel, std::uint64_t pass) {
+    std::uint64_t mix = seed ^ (pixel * 0xd1b54a32d192ed03ULL) ^ (pass * 0x8cb92ba72f3d8dd7ULL);
+    inc_ = (splitmix64(mix) << 1u) | 1u;
+    state_ = splitmix64(mix) + inc_;
+    next();
+  }
+  std::uint32_t next() {
+    const std::uint64_t old = state_;
+    state_ = old * 6364136223846793005ULL + inc_;
+    const auto shifted = static_cast<std::uint32_t>(((old >> 18u) ^ old) >> 27u);
+    const auto rot = static_cast<std::uint32_t>(old >> 59u);
+    return (shifted >> rot) | (shifted << ((32u - rot) & 31u));
+  }
+  // Uniform in [0, 1).
+  double uniform() { return next() * 0x1p-32; }
+
+ private:
+  std::uint64_t state_ = 0;
+  std::uint64_t inc_ = 0;
+};
+
+// What one sample sends to its pixel.
+enum class SampleFate : std::uint8_t { ReachedScene, Vignetted, Failed };
+struct SampleResult {
+  Rgb value;
+  SampleFate fate = SampleFate::ReachedScene;
+};
+
+// Per-pixel sums of the progressive estimator.
+struct PixelSums {
+  double rgb[3] = {0.0, 0.0, 0.0};
+  double luminance = 0.0;
+  double luminance_squared = 0.0;
+};
+
+struct PerThreadCounts {
+  std::uint64_t reached = 0, vignetted = 0, failed = 0;
+};
+
+// Runs the passes of options over the camera frame; sample(x_px, y_px, node_u, rng) gives one
+// sample of the pixel whose continuous position is (x_px, y_px), node_u in [0, 1) choosing the
+// wavelength stratum.
+template <typename Sampler>
+LensRender render_progressive(const Camera& camera, const LensRenderOptions& options, const Sampler& sample) {
+  const int width = camera.frame().width_px();
+  const int height = camera.frame().height_px();
+  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  std::vector<PixelSums> sums(static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
+  LensRender out;
+  const int planned = options.noise_target ? options.max_spp : options.spp;
+  int total = 0;
+  int pass_spp = options.spp;
+  std::vector<PerThreadCounts> counts(static_cast<std::size_t>(threads));
+
+  for (std::uint64_t pass = 0;; ++pass) {
+    std::atomic<int> rows_done{0};
+    const int done_before = total;
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
+    for (int y = 0; y < height; ++y) {
+      PerThreadCounts& mine = counts[static_cast<std::size_t>(omp_get_thread_num())];
+      for (int x = 0; x < width; ++x) {
+        const std::size_t index = static_cast<std::size_t>(y) * width + x;
+        Pcg32 rng(options.seed, index, pass);
+        // Stratified wavelength: sample k takes stratum (offset + k) mod spp of [0, 1).
+        const double offset = rng.uniform();
+        PixelSums& s = sums[index];
+        for (int k = 0; k < pass_spp; ++k) {
+          double node_u = (offset * pass_spp + k) / pass_spp;
+          if (node_u >= 1.0) node_u -= 1.0;
+          const SampleResult r = sample(x + rng.uniform(), y + rng.uniform(), node_u, rng);
+          switch (r.fate) {
+            case SampleFate::ReachedScene: ++mine.reached; break;
+            case SampleFate::Vignetted: ++mine.vignetted; break;
+            case SampleFate::Failed: ++mine.failed; break;
+          }
+          for (int c = 0; c < 3; ++c) s.rgb[c] += r.value[c];
+          const double l = (r.value.r + r.value.g + r.value.b) / 3.0;
+          s.luminance += l;
+          s.luminance_squared += l * l;
+        }
+      }
+      const int finished = ++rows_done;
+      if (options.progress && omp_get_thread_num() == 0) {
+        options.progress((done_before + static_cast<double>(pass_spp) * finished / height) / planned);
+      }
+    }
+    total += pass_spp;
+
+    // Mean relative standard error of the pixels' luminance.
+    double image_mean = 0.0;
+    for (const PixelSums& s : sums) image_mean += s.luminance / total;
+    image_mean /= static_cast<double>(sums.size());
+    const double floor = std::max(kRelativeErrorFloor * std::abs(image_mean), std::numeric_limits<double>::min());
+    double error = 0.0;
+    if (total < 2) {
+      error = kInfinity;  // one sample says nothing about its spread
+    } else {
+      for (const PixelSums& s : sums) {
+        const double mean = s.luminance / total;
+        const double variance = std::max(0.0, (s.luminance_squared / total - mean * mean) * total / (total - 1.0));
+        error += std::sqrt(variance / total) / std::max(std::abs(mean), floor);
+      }
+      error /= static_cast<double>(sums.size());
+    }
+    out.estimated_relative_error = error;
+    if (!options.noise_target || error <= *options.noise_target || total >= options.max_spp) break;
+    pass_spp = std::min(total, options.max_spp - total);
+  }
+  if (options.progress) options.progress(1.0);
+
+  out.spp_used = total;
+  out.rgb = Image(width, height, 3, 0.0f);
+  for (std::size_t i = 0; i < sums.size(); ++i) {
+    for (int c = 0; c < 3; ++c) out.rgb.data[3 * i + c] = static_cast<float>(sums[i].rgb[c] / total);
+  }
+  for (const PerThreadCounts& c : counts) {
+    out.rays.reached_scene += c.reached;
+    out.rays.vignetted += c.vignetted;
+    out.rays.failed += c.failed;
+  }
+  out.rays.traced = out.rays.reached_scene + out.rays.vignetted + out.rays.failed;
+  return out;
+}
+
+// One wavelength node of the lens render: where to aim and what a unit spectral value is worth.
+struct Node {
+  double wavelength_nm = 0.0;
+  double z_exit_pupil_mm = 0.0;
+  double sampled_radius_mm = 0.0;  // enlarged exit-pupil radius
+  Rgb rgb_weight{1.0, 1.0, 1.0};   // spectral: rgb_weights(i) / probability
+};
+
+}  // namespace
+
+void LensRenderOptions::validate() const {
+  if (spp < 1 || spp > kMaxSpp) {
+    throw OptionsError("LensRenderOptions::spp = " + std::to_string(spp) + ": must be in 1..1048576");
+  }
+  if (max_spp < spp || max_spp > kMaxSpp) {
+    throw OptionsError("LensRenderOptions::max_spp = " + std::to_string(max_spp) + ": must be in spp (" +
+                       std::to_string(spp) + ")..1048576");
+  }
+  if (noise_target && !(std::isfinite(*noise_target) && *noise_target > 0.0)) {
+    throw OptionsError("LensRenderOptions::noise_target = " + format_number(*noise_target) + ": must be finite and > 0");
+  }
+  if (threads < 0) {
+    throw OptionsError("LensRenderOptions::threads = " + std::to_string(threads) + ": must be >= 0 (0 = all hardware threads)");
+  }
+  if (spectral_samples < 3 || spectral_samples > 64) {
+    throw OptionsError("LensRenderOptions::spectral_samples = " + std::to_string(spectral_samples) + ": must be in 3..64");
+  }
+}
+
+std::string LensRenderOptions::to_string() const {
+  std::ostringstream os;
+  os << "LensRenderOptions(spp " << spp << ", noise_target " << (noise_target ? format_number(*noise_target) : "none")
+     << ", max_spp " << max_spp << ", threads " << threads << ", spectral "
+     << (spectral ? std::to_string(spectral_samples) + " nodes" : std::string("off")) << ", seed " << seed << ")";
+  return os.str();
+}
+
+std::string LensRayCounts::to_string() const {
+  return std::to_string(traced) + " traced, " + std::to_string(reached_scene) + " reached the scene, " +
+         std::to_string(vignetted) + " vignetted, " + std::to_string(failed) + " failed";
+}
+
+std::string LensRender::to_string() const {
+  return "LensRender(" + rgb.to_string() + ", " + std::to_string(spp_used) + " spp, relative error " +
+         format_number(estimated_relative_error) + ", " + rays.to_string() + ")";
+}
+
+LensRender render_through_lens(const Scene& scene, const Camera& camera, const LensRenderOptions& options) {
+  options.validate();
+  scene.validate();
+  if (camera.is_thin_lens()) {
+    throw OptionsError("render_through_lens needs a camera made from a prescription; use render_through_thin_lens");
+  }
+  const Prescription& lens = *camera.lens();
+  TracerOptions tracer_options;
+  tracer_options.image_distance_mm = camera.z_sensor_mm() - lens.last_vertex_z_mm();
+  const SequentialTracer tracer(lens, tracer_options);
+
+  std::vector<Node> nodes;
+  std::optional<SpectralQuadrature> quadrature;
+  auto node_at = [&camera](double wavelength_nm) {
+    const FirstOrderSample fo = camera.first_order(wavelength_nm);
+    Node n;
+    n.wavelength_nm = wavelength_nm;
+    n.z_exit_pupil_mm = fo.z_exit_pupil_mm;
+    n.sampled_radius_mm = kPupilEnlargement * fo.exit_pupil_radius_mm;
+    return n;
+  };
+  if (options.spectral) {
+    SpectralQuadratureOptions q;
+    q.sample_count = options.spectral_samples;
+    q.min_wavelength_nm = kMinWavelengthNm;
+    q.max_wavelength_nm = kMaxWavelengthNm;
+    quadrature.emplace(q);
+    for (std::size_t i = 0; i < quadrature->size(); ++i) {
+      const WavelengthSample w = quadrature->sample_at(i);
+      Node n = node_at(w.wavelength_nm);
+      n.rgb_weight = w.rgb_weight;
+      nodes.push_back(n);
+    }
+  } else {
+    nodes.push_back(node_at(camera.reference_wavelength_nm()));
+  }
+  // Each sample stands for the enlarged disc's area over the nominal pupil's.
+  const double area_ratio = kPupilEnlargement * kPupilEnlargement;
+
+  const CameraBasis basis = scene.camera.basis();
+  const Eigen::Vector3d position_m = scene.camera.position_m;
+  const double half_width = 0.5 * camera.frame().width_px();
+  const double half_height = 0.5 * camera.frame().height_px();
+  const double px_per_mm = camera.px_per_sensor_mm();
+  const double z_sensor = camera.z_sensor_mm();
+  const double z_persp = camera.z_perspective_mm();
+  const SpectralBasis* spectrum = quadrature ? &quadrature->basis() : nullptr;
+
+  auto sample = [&](double x_px, double y_px, double node_u, Pcg32& rng) -> SampleResult {
+    const Node& node = nodes[std::min(nodes.size() - 1, static_cast<std::size_t>(node_u * static_cast<double>(nodes.size())))];
+    // The inverse of Camera::output_pixel.
+    const Eigen::Vector3d on_sensor((x_px - half_width) / px_per_mm, (half_height - y_px) / px_per_mm, z_sensor);
+    const double r = node.sampled_radius_mm * std::sqrt(rng.uniform());
+    const double phi = 2.0 * kPi * rng.uniform();
+    Eigen::Vector3d towards = Eigen::Vector3d(r * std::cos(phi), r * std::sin(phi), node.z_exit_pupil_mm) - on_sensor;
+    // A virtual exit pupil behind the sensor: the ray still leaves the sensor towards -z.
+    if (towards.z() > 0.0) towards = -towards;
+    if (!(towards.z() < 0.0)) return {Rgb{}, SampleFate::Failed};
+    Ray ray;
+    ray.position_mm = on_sensor;
+    ray.direction = towards.normalized();
+    ray.wavelength_nm = node.wavelength_nm;
+    const TraceResult traced = tracer.trace_backward(ray);
+    if (!traced.ok()) {
+      return {Rgb{}, traced.status == RayStatus::Vignetted ? SampleFate::Vignetted : SampleFate::Failed};
+    }
+    // Lens frame -> camera frame (file comment of lens_render.h) -> world.
+    const Eigen::Vector3d& p = traced.ray.position_mm;
+    const Eigen::Vector3d& d = traced.ray.direction;
+    const Eigen::Vector3d origin_m = position_m + m_from_mm(p.x()) * basis.right + m_from_mm(p.y()) * basis.up +
+                                     m_from_mm(z_persp - p.z()) * basis.forward;
+    const Eigen::Vector3d direction = (d.x() * basis.right + d.y() * basis.up - d.z() * basis.forward).normalized();
+    const std::optional<SceneHit> hit = intersect(scene, SceneRay{origin_m, direction});
+    const Rgb radiance = hit ? hit->radiance : scene.background;
+    if (!spectrum) return {area_ratio * radiance, SampleFate::ReachedScene};
+    return {(area_ratio * spectrum->spectrum_value(radiance, node.wavelength_nm)) * node.rgb_weight,
+            SampleFate::ReachedScene};
+  };
+  return render_progressive(camera, options, sample);
+}
+
+LensRender render_through_thin_lens(const Scene& scene, const Camera& camera, const LensRenderOptions& options) {
+  options.validate();
+  scene.validate();
+  if (!camera.is_thin_lens()) {
+    throw OptionsError("render_through_thin_lens needs a Camera::thin_lens camera; use render_through_lens for a prescription");
+  }
+  const double lens_radius_mm = camera.first_order(camera.reference_wavelength_nm()).entrance_pupil_radius_mm;
+  const double image_distance_mm = camera.z_sensor_mm();  // the thin lens sits at z = 0
+  const double focus_mm = camera.focus_distance_mm();
+  const CameraBasis basis = scene.camera.basis();
+  const Eigen::Vector3d position_m = scene.camera.position_m;
+  const double half_width = 0.5 * camera.frame().width_px();
+  const double half_height = 0.5 * camera.frame().height_px();
+  const double px_per_mm = camera.px_per_sensor_mm();
+
+  auto sample = [&](double x_px, double y_px, double /*node_u*/, Pcg32& rng) -> SampleResult {
+    // The sensor point and the tangents of its chief ray through the lens centre: the point it
+    // images to on the focus plane.
+    const double x_mm = (x_px - half_width) / px_per_mm, y_mm = (half_height - y_px) / px_per_mm;
+    const double tan_x = -x_mm / image_distance_mm, tan_y = -y_mm / image_distance_mm;
+    const double r = lens_radius_mm * std::sqrt(rng.uniform());
+    const double phi = 2.0 * kPi * rng.uniform();
+    const Eigen::Vector3d on_lens_mm(r * std::cos(phi), r * std::sin(phi), 0.0);
+    const Eigen::Vector3d towards = std::isinf(focus_mm) ? Eigen::Vector3d(tan_x, tan_y, 1.0)
+                                                         : Eigen::Vector3d(tan_x * focus_mm, tan_y * focus_mm, focus_mm) - on_lens_mm;
+    const Eigen::Vector3d origin_m = position_m + m_from_mm(on_lens_mm.x()) * basis.right + m_from_mm(on_lens_mm.y()) * basis.up;
+    const Eigen::Vector3d direction = (towards.x() * basis.right + towards.y() * basis.up + towards.z() * basis.forward).normalized();
+    const std::optional<SceneHit> hit = intersect(scene, SceneRay{origin_m, direction});
+    return {hit ? hit->radiance : scene.background, SampleFate::ReachedScene};
+  };
+  return render_progressive(camera, options, sample);
+}
+
+}  // namespace lensmith

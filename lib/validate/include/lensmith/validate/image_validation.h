@@ -1,0 +1,43 @@
+// Image-level validation: `lensmith bokeh` with each fast ray model, run on the pinhole render of
+// an analytic scene, against the same scene rendered through the real lens by the exact tracer
+// (which sees what a single image cannot: the hidden background). PSNR and SSIM on x/(1+x) values,
+// over the frame and over a band around depth edges, with error maps (docs/validation.md).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "lensmith/camera/ray_model.h"
+#include "lensmith/render/image_metrics.h"
+
+namespace lensmith {
+
+struct ImageValidationOptions {
+  std::vector<std::filesystem::path> scenes;  // lensmith-scene JSON files
+  std::vector<RayModelKind> models{RayModelKind::Paraxial, RayModelKind::Seidel};
+  int width_px = 320;
+  int height_px = 180;
+  int spp = 64;                 // samples per pixel of the ground truth
+  double band_radius_px = 4.0;  // depth-edge band
+  int threads = 0;
+  std::filesystem::path picture_dir;  // when set: <scene>-truth.png, <scene>-<model>.png, <scene>-<model>-error.png
+  void validate() const;              // throws OptionsError
+};
+
+struct ImageValidationEntry {
+  std::string scene;
+  RayModelKind model = RayModelKind::Seidel;
+  ImageComparison comparison;
+};
+
+struct ImageValidation {
+  std::vector<ImageValidationEntry> entries;
+  std::vector<ImageComparison> unblurred;  // the pinhole image itself against the truth, per scene
+  std::vector<std::string> scenes;
+  std::string to_markdown() const;
+};
+
+ImageValidation validate_images(const Prescription& lens, const CameraOptions& camera, const ImageValidationOptions& options);
+
+}  // namespace lensmith
