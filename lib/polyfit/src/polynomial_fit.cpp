@@ -1,0 +1,257 @@
+// Greedy term selection by order-recursive matching pursuit, then the coefficients by Ceres.
+// Selection: with Q an orthonormal basis of the chosen columns and r = t - Q Q^T t the least-squares
+// residual, adding column a_j lowers |r|^2 by <r, a_j>^2 / |a_j - Q Q^T a_j|^2 (r is orthogonal to
+// Q). The denominators are updated by one dot product per step, so a step costs O(pool * samples).
+#include "lensmith/polyfit/polynomial_fit.h"
+
+#include <ceres/ceres.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <sstream>
+#include <string>
+
+namespace lensmith {
+namespace {
+
+// A column whose part outside the span of the chosen ones is below 1e-5 of its norm is numerically
+// dependent on them: choosing it would only make the coefficient solve ill-conditioned.
+constexpr double kDependentColumn = 1e-10;
+
+// Powers of every variable of every sample: pw[(i * 5 + k) * (D + 1) + e] = inputs[i][k]^e.
+class PowerTable {
+ public:
+  PowerTable(const std::vector<PolyPoint>& inputs, int max_degree)
+      : stride_(max_degree + 1), values_(inputs.size() * kPolyVariables * static_cast<std::size_t>(stride_)) {
+    for (std::size_t i = 0; i < inputs.size(); ++i) {
+      for (int k = 0; k < kPolyVariables; ++k) {
+        double* row = &values_[(i * kPolyVariables + k) * stride_];
+        row[0] = 1.0;
+        for (int e = 1; e < stride_; ++e) row[e] = row[e - 1] * inputs[i][k];
+      }
+    }
+  }
+  double monomial(std::size_t i, const Monomial& m) const {
+    const double* p = &values_[i * kPolyVariables * stride_];
+    return p[m.exponents[0]] * p[stride_ + m.exponents[1]] * p[2 * stride_ + m.exponents[2]] *
+           p[3 * stride_ + m.exponents[3]] * p[4 * stride_ + m.exponents[4]];
+  }
+  void column(const Monomial& m, std::vector<double>& out) const {
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = monomial(i, m);
+  }
+
+ private:
+  int stride_;
+  std::vector<double> values_;
+};
+
+double dot(const std::vector<double>& a, const std::vector<double>& b) {
+  double s = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) s += a[i] * b[i];
+  return s;
+}
+
+// Greedy selection; returns indices into pool in selection order and the LS RMS after each step.
+std::vector<std::size_t> select_terms(const PowerTable& powers, const std::vector<double>& targets,
+                                      const std::vector<Monomial>& pool, const FitOptions& options,
+                                      std::vector<double>& selection_rms) {
+  const std::size_t n = targets.size();
+  const std::size_t p = pool.size();
+  std::vector<double> column(n);
+  std::vector<double> norm2(p), outside2(p);
+  std::vector<bool> candidate(p);
+  for (std::size_t j = 0; j < p; ++j) {
+    powers.column(pool[j], column);
+    norm2[j] = outside2[j] = dot(column, column);
+    candidate[j] = norm2[j] > 0.0;
+  }
+  std::vector<double> r = targets;
+  const double target_norm = std::sqrt(dot(targets, targets));
+  std::vector<std::vector<double>> basis;
+  std::vector<std::size_t> chosen;
+  while (chosen.size() < static_cast<std::size_t>(options.max_terms)) {
+    if (std::sqrt(dot(r, r)) <= options.relative_residual_tolerance * target_norm) break;
+    std::size_t best = p;
+    double best_gain = 0.0;
+    for (std::size_t j = 0; j < p; ++j) {
+      if (!candidate[j]) continue;
+      powers.column(pool[j], column);
+      if (!basis.empty()) {
+        const double c = dot(column, basis.back());
+        outside2[j] -= c * c;
+        if (outside2[j] <= kDependentColumn * norm2[j]) {
+          candidate[j] = false;
+          continue;
+        }
+      }
+      const double cr = dot(column, r);
+      const double gain = cr * cr / outside2[j];
+      if (gain > best_gain) {  // strict: ties go to the earlier (lower-degree) term
+        best_gain = gain;
+        best = j;
+      }
+    }
+    if (best == p) break;  // no remaining column lowers the residual
+    // Orthogonalise the chosen column twice against the basis (Gram-Schmidt, then once more for
+    // the rounding of the first pass: "twice is enough", Giraud et al. 2005).
+    std::vector<double> q(n);
+    powers.column(pool[best], q);
+    for (int pass = 0; pass < 2; ++pass) {
+      for (const auto& b : basis) {
+        const double c = dot(q, b);
+        for (std::size_t i = 0; i < n; ++i) q[i] -= c * b[i];
+      }
+    }
+    const double qn = std::sqrt(dot(q, q));
+    for (double& v : q) v /= qn;
+    const double cr = dot(q, r);
+    for (std::size_t i = 0; i < n; ++i) r[i] -= cr * q[i];
+    basis.push_back(std::move(q));
+    candidate[best] = false;
+    chosen.push_back(best);
+    selection_rms.push_back(std::sqrt(dot(r, r) / static_cast<double>(n)));
+  }
+  return chosen;
+}
+
+// One residual per sample: r = sum_j row[j] c[j] - target. Linear, so the Jacobian is the row.
+class SampleResidual final : public ceres::CostFunction {
+ public:
+  SampleResidual(const double* row, int num_terms, double target) : row_(row), num_terms_(num_terms), target_(target) {
+    set_num_residuals(1);
+    mutable_parameter_block_sizes()->push_back(num_terms);
+  }
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const double* c = parameters[0];
+    double s = -target_;
+    for (int j = 0; j < num_terms_; ++j) s += row_[j] * c[j];
+    residuals[0] = s;
+    if (jacobians != nullptr && jacobians[0] != nullptr) std::copy(row_, row_ + num_terms_, jacobians[0]);
+    return true;
+  }
+
+ private:
+  const double* row_;
+  int num_terms_;
+  double target_;
+};
+
+// Solves for the coefficients in place (starting from their current values); returns iterations.
+int solve_coefficients(const std::vector<double>& design, const std::vector<double>& targets, int num_terms,
+                       ceres::LossFunction* loss, std::vector<double>& coefficients) {
+  ceres::Problem::Options problem_options;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  for (std::size_t i = 0; i < targets.size(); ++i) {
+    problem.AddResidualBlock(new SampleResidual(&design[i * num_terms], num_terms, targets[i]), loss,
+                             coefficients.data());
+  }
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;  // QR: the normal equations would square the condition number
+  solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  // The problem is linear: a vanishing LM damping makes the first step the Gauss-Newton solution.
+  solver_options.initial_trust_region_radius = 1e16;
+  solver_options.max_trust_region_radius = 1e32;
+  solver_options.function_tolerance = 1e-15;
+  solver_options.parameter_tolerance = 1e-14;
+  solver_options.gradient_tolerance = 1e-20;
+  solver_options.max_num_iterations = 100;
+  solver_options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem, &summary);
+  if (!summary.IsSolutionUsable()) throw FitError("fit_polynomial: Ceres failed: " + summary.BriefReport());
+  return static_cast<int>(summary.iterations.size());
+}
+
+}  // namespace
+
+void FitOptions::validate() const {
+  if (max_degree < 1 || max_degree > kMaxPolyDegree) {
+    throw OptionsError("FitOptions::max_degree = " + std::to_string(max_degree) + ": must be in 1.." +
+                       std::to_string(kMaxPolyDegree));
+  }
+  if (max_terms < 1) throw OptionsError("FitOptions::max_terms = " + std::to_string(max_terms) + ": must be >= 1");
+  if (!(relative_residual_tolerance >= 0.0 && relative_residual_tolerance < 1.0)) {
+    throw OptionsError("FitOptions::relative_residual_tolerance = " + std::to_string(relative_residual_tolerance) +
+                       ": must be in [0, 1)");
+  }
+  if (huber_scale && !(*huber_scale > 0.0 && std::isfinite(*huber_scale))) {
+    throw OptionsError("FitOptions::huber_scale = " + std::to_string(*huber_scale) + ": must be finite and > 0");
+  }
+}
+
+std::string FitResult::to_string() const {
+  std::ostringstream os;
+  os << "FitResult{terms=" << polynomial.size() << ", degree=" << polynomial.degree() << ", train_rms=" << train_rms
+     << ", train_max_abs=" << train_max_abs << ", solver_iterations=" << solver_iterations
+     << ", polynomial=" << polynomial.to_string() << "}";
+  return os.str();
+}
+
+FitResult fit_polynomial(const std::vector<PolyPoint>& inputs, const std::vector<double>& targets,
+                         const std::vector<Monomial>& pool, const FitOptions& options) {
+  options.validate();
+  if (inputs.empty() || inputs.size() != targets.size()) {
+    throw FitError("fit_polynomial: " + std::to_string(inputs.size()) + " inputs and " +
+                   std::to_string(targets.size()) + " targets: need the same non-zero number");
+  }
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    bool finite = std::isfinite(targets[i]);
+    for (const double v : inputs[i]) finite = finite && std::isfinite(v);
+    if (!finite) throw FitError("fit_polynomial: sample " + std::to_string(i) + " is not finite");
+  }
+  std::vector<Monomial> usable;
+  for (const Monomial& m : pool) {
+    if (m.total_degree() <= options.max_degree) usable.push_back(m);
+  }
+  if (usable.empty()) {
+    throw FitError("fit_polynomial: no pool term has total degree <= FitOptions::max_degree = " +
+                   std::to_string(options.max_degree));
+  }
+  {
+    std::vector<Monomial> sorted = usable;
+    std::sort(sorted.begin(), sorted.end());
+    const auto dup = std::adjacent_find(sorted.begin(), sorted.end());
+    if (dup != sorted.end()) throw FitError("fit_polynomial: the pool holds " + dup->to_string() + " twice");
+  }
+  int degree = 0;
+  for (const Monomial& m : usable) degree = std::max(degree, m.total_degree());
+  const PowerTable powers(inputs, degree);
+
+  FitResult result;
+  std::vector<Monomial> terms;
+  if (usable.size() <= static_cast<std::size_t>(options.max_terms)) {
+    terms = usable;
+  } else {
+    for (const std::size_t j : select_terms(powers, targets, usable, options, result.selection_rms)) {
+      terms.push_back(usable[j]);
+    }
+  }
+
+  const int k = static_cast<int>(terms.size());
+  std::vector<double> coefficients(terms.size(), 0.0);
+  if (k > 0) {
+    std::vector<double> design(inputs.size() * terms.size());
+    for (std::size_t i = 0; i < inputs.size(); ++i) {
+      for (std::size_t j = 0; j < terms.size(); ++j) design[i * terms.size() + j] = powers.monomial(i, terms[j]);
+    }
+    result.solver_iterations = solve_coefficients(design, targets, k, nullptr, coefficients);
+    if (options.huber_scale) {
+      // Start the robust solve at the least-squares optimum, where Huber's weights are meaningful.
+      const auto huber = std::make_unique<ceres::HuberLoss>(*options.huber_scale);
+      result.solver_iterations += solve_coefficients(design, targets, k, huber.get(), coefficients);
+    }
+  }
+  result.polynomial = SparsePolynomial(std::move(terms), std::move(coefficients));
+  double sum2 = 0.0;
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const double e = result.polynomial.evaluate(inputs[i]) - targets[i];
+    sum2 += e * e;
+    result.train_max_abs = std::max(result.train_max_abs, std::abs(e));
+  }
+  result.train_rms = std::sqrt(sum2 / static_cast<double>(inputs.size()));
+  return result;
+}
+
+}  // namespace lensmith
