@@ -42,8 +42,9 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   // Inputs.
   const std::filesystem::path output = o.output;
   const DepthSource depth_source = DepthSource::parse(o.depth.empty() ? o.image : o.depth);
-  ensure_not_an_input(output, {o.image, depth_source.file});
-  if (!o.aperture_image.empty()) ensure_not_an_input(output, {o.aperture_image});
+  std::vector<std::filesystem::path> inputs{o.image, depth_source.file};
+  if (!o.aperture_image.empty()) inputs.emplace_back(o.aperture_image);
+  ensure_not_an_input(output, inputs);
   RadianceReadOptions read;
   read.highlight_gain = o.highlight_gain;
   read.highlight_threshold = o.highlight_threshold;

@@ -29,6 +29,7 @@ int run_validate(const ValidateCommandOptions& o, const GlobalOptions& global) {
   RayModelOptions model_options;
   model_options.nearest_depth_m = std::isinf(o.focus_m) ? 1.0 : std::max(0.05, 0.4 * o.focus_m);
   const PsfValidation result = validate_point_spreads(camera, models, Aperture::circular(), psf, model_options);
+  const std::string psf_tables = result.to_markdown();
 
   const std::filesystem::path dir = o.out;
   std::filesystem::create_directories(dir);
@@ -49,7 +50,7 @@ int run_validate(const ValidateCommandOptions& o, const GlobalOptions& global) {
          << psf.pupil_samples_per_axis << " pupil grid, compared on " << psf.bins << " x " << psf.bins
          << " bins over a window at least " << psf.min_half_width_px
          << " output pixels either side of the exact centroid (overlap = 1 - L1/2 of the normalised PSFs).\n\n"
-         << result.to_markdown() << "\n![PSFs: exact | model | difference, per model](psf.png)\n\n"
+         << psf_tables << "\n![PSFs: exact | model | difference, per model](psf.png)\n\n"
          << "## Image level\n\n";
   ImageValidation images;
   if (o.scenes.empty()) {
@@ -73,7 +74,7 @@ int run_validate(const ValidateCommandOptions& o, const GlobalOptions& global) {
   const std::string text = report.str();
   write_file_atomically((dir / "report.md").string(), text);
 
-  std::cout << result.to_markdown().substr(0, result.to_markdown().find("\n\n")) << "\n";
+  std::cout << psf_tables.substr(0, psf_tables.find("\n\n")) << "\n";
   if (!images.entries.empty()) std::cout << "\n" << images.to_markdown();
   std::cout
             << "wrote " << (dir / "report.md").string() << " and " << (dir / "psf.png").string() << "\n";

@@ -17,17 +17,17 @@ constexpr double kMinWavelengthNm = 380.0;
 constexpr double kMaxWavelengthNm = 780.0;
 constexpr int kWavelengthSamples = 64;  // as Asberg's method tabulates its lens parameters
 
-FirstOrderSample blend(const FirstOrderSample& a, const FirstOrderSample& b, double t) {
-  auto mix = [t](double x, double y) { return x + t * (y - x); };
+// The renderer's view of a paraxial sample: pupil radii instead of diameters.
+FirstOrderSample first_order_from(const ParaxialSample& p) {
   FirstOrderSample s;
-  s.wavelength_nm = mix(a.wavelength_nm, b.wavelength_nm);
-  s.efl_mm = mix(a.efl_mm, b.efl_mm);
-  s.z_front_principal_mm = mix(a.z_front_principal_mm, b.z_front_principal_mm);
-  s.z_rear_principal_mm = mix(a.z_rear_principal_mm, b.z_rear_principal_mm);
-  s.z_entrance_pupil_mm = mix(a.z_entrance_pupil_mm, b.z_entrance_pupil_mm);
-  s.z_exit_pupil_mm = mix(a.z_exit_pupil_mm, b.z_exit_pupil_mm);
-  s.entrance_pupil_radius_mm = mix(a.entrance_pupil_radius_mm, b.entrance_pupil_radius_mm);
-  s.exit_pupil_radius_mm = mix(a.exit_pupil_radius_mm, b.exit_pupil_radius_mm);
+  s.wavelength_nm = p.wavelength_nm;
+  s.efl_mm = p.efl_mm;
+  s.z_front_principal_mm = p.z_front_principal_mm;
+  s.z_rear_principal_mm = p.z_rear_principal_mm;
+  s.z_entrance_pupil_mm = p.z_entrance_pupil_mm;
+  s.z_exit_pupil_mm = p.z_exit_pupil_mm;
+  s.entrance_pupil_radius_mm = 0.5 * p.entrance_pupil_diameter_mm;
+  s.exit_pupil_radius_mm = 0.5 * p.exit_pupil_diameter_mm;
   return s;
 }
 
@@ -83,10 +83,10 @@ Camera Camera::thin_lens(double focal_length_mm, const CameraOptions& options, i
   c.options_ = options;
   c.f_number_ = *options.f_number;
   c.reference_nm_ = options.reference_wavelength_nm;
-  FirstOrderSample s;
+  ParaxialSample s;
   s.wavelength_nm = options.reference_wavelength_nm;
   s.efl_mm = focal_length_mm;
-  s.entrance_pupil_radius_mm = s.exit_pupil_radius_mm = focal_length_mm / (2.0 * c.f_number_);
+  s.entrance_pupil_diameter_mm = s.exit_pupil_diameter_mm = focal_length_mm / c.f_number_;
   c.samples_ = {s};
   c.finish();
   return c;
@@ -118,19 +118,7 @@ Camera Camera::from_lens(const Prescription& lens, const CameraOptions& options,
   table_options.max_wavelength_nm = kMaxWavelengthNm;
   table_options.samples = kWavelengthSamples;
   table_options.object_distance_mm = kInfinity;
-  const ParaxialSpectralTable table(*at_f_number, table_options);
-  for (const ParaxialSample& p : table.samples()) {
-    FirstOrderSample s;
-    s.wavelength_nm = p.wavelength_nm;
-    s.efl_mm = p.efl_mm;
-    s.z_front_principal_mm = p.z_front_principal_mm;
-    s.z_rear_principal_mm = p.z_rear_principal_mm;
-    s.z_entrance_pupil_mm = p.z_entrance_pupil_mm;
-    s.z_exit_pupil_mm = p.z_exit_pupil_mm;
-    s.entrance_pupil_radius_mm = 0.5 * p.entrance_pupil_diameter_mm;
-    s.exit_pupil_radius_mm = 0.5 * p.exit_pupil_diameter_mm;
-    c.samples_.push_back(s);
-  }
+  c.samples_ = ParaxialSpectralTable(*at_f_number, table_options).samples();
   c.lens_ = std::move(at_f_number);
   c.finish();
   return c;
@@ -141,14 +129,14 @@ double Camera::max_wavelength_nm() const { return samples_.back().wavelength_nm;
 
 FirstOrderSample Camera::first_order(double wavelength_nm) const {
   if (samples_.size() == 1) {
-    FirstOrderSample s = samples_.front();
+    FirstOrderSample s = first_order_from(samples_.front());
     s.wavelength_nm = wavelength_nm;
     return s;
   }
   const double lo = samples_.front().wavelength_nm, hi = samples_.back().wavelength_nm;
   const double u = std::clamp((wavelength_nm - lo) / (hi - lo), 0.0, 1.0) * static_cast<double>(samples_.size() - 1);
   const std::size_t i = std::min(static_cast<std::size_t>(u), samples_.size() - 2);
-  return blend(samples_[i], samples_[i + 1], u - static_cast<double>(i));
+  return first_order_from(interpolate(samples_[i], samples_[i + 1], u - static_cast<double>(i)));
 }
 
 GaussianImage Camera::gaussian_image(const ScenePoint& p, const FirstOrderSample& s) const {

@@ -19,6 +19,7 @@
 
 #include "lensmith/camera/pinhole_frame.h"
 #include "lensmith/core/units.h"
+#include "lensmith/paraxial/paraxial_spectral_table.h"
 #include "lensmith/prescription/prescription.h"
 
 namespace lensmith {
@@ -112,7 +113,7 @@ class Camera {
   double f_number_ = 0.0;
   double focus_mm_ = 0.0;
   double reference_nm_ = kWavelengthD_nm;
-  std::vector<FirstOrderSample> samples_;  // evenly spaced in wavelength (one for a thin lens)
+  std::vector<ParaxialSample> samples_;  // evenly spaced in wavelength (one for a thin lens)
   double z_sensor_mm_ = 0.0;
   double z_perspective_mm_ = 0.0;
   double pupil_orientation_ = 1.0;
