@@ -90,6 +90,8 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   for (float z : depth.z_m) nearest_m = std::min(nearest_m, z);
   RayModelOptions model_options;
   model_options.nearest_depth_m = std::isfinite(nearest_m) ? std::max(0.01, static_cast<double>(nearest_m)) : 1.0;
+  if (!o.thin_lens) model_options.fit = fit_for_models({kind}, *cam->lens(), cam->f_number(), o.fit, global);
+  else if (!o.fit.empty()) throw OptionsError("--fit is for --model poly with --lens");
   const auto model = make_ray_model(kind, *cam, model_options);
   const Aperture aperture = make_aperture(o);
 

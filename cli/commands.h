@@ -3,10 +3,12 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "lensmith/camera/ray_model.h"
 #include "lensmith/core/diagnostic.h"
 #include "lensmith/prescription/prescription.h"
 
@@ -125,6 +127,7 @@ struct AnalyzeCommandOptions {
 int run_analyze(const AnalyzeCommandOptions& options, const GlobalOptions& global);
 
 struct BokehCommandOptions {
+  std::string fit;                           // --fit FILE: the poly model's fit (default: fitted in the run)
   std::string image;                         // --image: all-in-focus picture (EXR/HDR linear; 8-bit sRGB)
   std::string depth;                         // --depth FILE[:CHANNEL]; empty = the image file's Z channel
   std::string depth_kind = "z";              // z | distance | inverse
@@ -171,8 +174,31 @@ struct ValidateCommandOptions {
   int image_height_px = 180;
   int image_spp = 64;                             // --image-spp: ground-truth samples per pixel
   std::optional<double> min_edge_psnr_db;         // --min-edge-psnr: fail when a model's edge-band PSNR is lower
+  std::string fit;                                // --fit FILE: the poly model's fit (default: fitted in the run)
 };
 int run_validate(const ValidateCommandOptions& options, const GlobalOptions& global);
+
+// `lensmith fit`: a polynomial fit of a lens's ray mapping (polynomial optics), its held-out errors
+// and its speed against exact tracing, optionally saved as a lensmith-fit JSON file (docs/cli.md).
+struct FitCommandOptions {
+  std::string lens;                      // LENS: file or shipped name
+  int degree = 7;                        // --degree: highest total degree of a term (1-11)
+  int terms = 40;                        // --terms: term budget per output
+  int training_rays = 30000;             // --training-rays
+  int test_rays = 10000;                 // --test-rays
+  std::uint64_t seed = 2016;             // --seed of the training rays (the test rays use another stream)
+  std::optional<double> image_radius_mm; // --image-radius: radius on the sensor plane the fit covers, mm
+  std::optional<double> f_number;        // --fstop: widest f-number the fit serves (default: the lens's own)
+  std::string output;                    // -o: fit file to write (atomically; never the lens file)
+  bool json = false;                     // --json: one JSON object on stdout
+};
+int run_fit(const FitCommandOptions& options, const GlobalOptions& global);
+
+// The fit for --model poly: read from `fit_file` (and checked against `lens`), or made now with the
+// default options at `f_number` (the camera's), with a progress bar unless quiet. Null when no model
+// in `models` is poly.
+std::shared_ptr<const LensFit> fit_for_models(const std::vector<RayModelKind>& models, const Prescription& lens,
+                                              double f_number, const std::string& fit_file, const GlobalOptions& global);
 
 // `lensmith scene render`: an analytic scene through a pinhole (all-in-focus picture and depth) or,
 // as ground truth, through a lens (docs/cli.md, docs/scene-format.md).

@@ -189,8 +189,10 @@ int main(int argc, char** argv) {
   bokeh_cmd->add_option("--blade-rotation", bokeh.blade_rotation_deg, "Rotation of the blade polygon, degrees")->needs(bokeh_blades);
   bokeh_cmd->add_option("--aperture-image", bokeh.aperture_image, "Aperture transmission from a picture over the pupil square")
       ->excludes(bokeh_blades);
-  bokeh_cmd->add_option("--model", bokeh.model, "thin | paraxial | seidel (default) | exact")
-      ->check(CLI::IsMember({"thin", "paraxial", "seidel", "exact"}));
+  bokeh_cmd->add_option("--model", bokeh.model, "thin | paraxial | seidel (default) | poly | exact")
+      ->check(CLI::IsMember({"thin", "paraxial", "seidel", "poly", "exact"}));
+  bokeh_cmd->add_option("--fit", bokeh.fit, "Fit file for --model poly (lensmith fit -o); default: fit the lens in this run")
+      ->check(CLI::ExistingFile);
   bokeh_cmd->add_option("--hidden", bokeh.hidden, "Background hidden behind foreground edges: extend (default) | stretch")
       ->check(CLI::IsMember({"extend", "stretch"}));
   bokeh_cmd->add_flag("--no-spectral", bokeh.no_spectral, "Trace every ray at 587.6 nm and keep RGB as it is (no colour fringes)");
@@ -214,8 +216,10 @@ int main(int argc, char** argv) {
   validate_cmd->add_option("--fstop", validate.f_number, "f-number (default: the lens's own; 0.5-512)")->check(CLI::Range(0.5, 512.0));
   validate_cmd->add_option("--focus", validate.focus_m, "Focus distance, metres (default 3; inf allowed)")->check(focus_distance_check());
   validate_cmd->add_option("--out", validate.out, "Directory for report.md and psf.png (default ./validation)");
-  validate_cmd->add_option("--models", validate.models, "Models to compare with exact (default paraxial seidel)")
-      ->check(CLI::IsMember({"paraxial", "seidel"}));
+  validate_cmd->add_option("--models", validate.models, "Models to compare with exact (default paraxial seidel; also poly)")
+      ->check(CLI::IsMember({"paraxial", "seidel", "poly"}));
+  validate_cmd->add_option("--fit", validate.fit, "Fit file for the poly model (lensmith fit -o); default: fit the lens in this run")
+      ->check(CLI::ExistingFile);
   validate_cmd->add_option("--width", validate.width_px, "Frame width the fields refer to, px (default 1920)")->check(CLI::Range(16, 65536));
   validate_cmd->add_option("--height", validate.height_px, "Frame height, px (default 1080)")->check(CLI::Range(16, 65536));
   validate_cmd->add_option("--pupil-samples", validate.pupil_samples, "Pupil grid per axis for each PSF (default 96; 2-512)")
@@ -234,6 +238,25 @@ int main(int argc, char** argv) {
   validate_cmd->add_option("--max-centroid-offset", validate.max_centroid_offset_um,
                            "Fail (exit 6) when a model's largest centroid offset exceeds this, um")
       ->check(CLI::PositiveNumber);
+
+  FitCommandOptions fit;
+  CLI::App* fit_cmd = app.add_subcommand(
+      "fit", "Fit the lens's ray mapping with polynomials (polynomial optics): held-out errors, speed, a fit file");
+  fit_cmd->add_option("lens", fit.lens, "Lens file or shipped lens name")->required();
+  fit_cmd->add_option("--degree", fit.degree, "Highest total degree of a term (1-11, default 7)")->check(CLI::Range(1, 11));
+  fit_cmd->add_option("--terms", fit.terms, "Term budget per output (1-1000, default 40)")->check(CLI::Range(1, 1000));
+  fit_cmd->add_option("--training-rays", fit.training_rays, "Rays the fit is made from (200-10000000, default 30000)")
+      ->check(CLI::Range(200, 10000000));
+  fit_cmd->add_option("--test-rays", fit.test_rays, "Held-out rays the errors are measured on (100-10000000, default 10000)")
+      ->check(CLI::Range(100, 10000000));
+  fit_cmd->add_option("--seed", fit.seed, "Seed of the training rays (default 2016; test rays use another stream)");
+  fit_cmd->add_option("--image-radius", fit.image_radius_mm,
+                      "Radius on the sensor plane the fit covers, mm (default 24.9: a 36 x 24 frame plus 15 %)")
+      ->check(CLI::PositiveNumber);
+  fit_cmd->add_option("--fstop", fit.f_number, "Widest f-number the fit serves (default: the lens's own; 0.5-512)")
+      ->check(CLI::Range(0.5, 512.0));
+  fit_cmd->add_option("-o,--output", fit.output, "Write the fit here (lensmith-fit JSON; docs/fit-format.md)");
+  fit_cmd->add_flag("--json", fit.json, "Print one JSON object (schema: docs/cli.md)");
 
   SceneRenderOptions scene_render;
   CLI::App* scene_cmd = app.add_subcommand("scene", "Analytic scenes (docs/scene-format.md): render them through a pinhole or a lens");
@@ -303,6 +326,7 @@ int main(int argc, char** argv) {
     if (*bokeh_cmd) return run_bokeh(bokeh, global);
     if (*validate_cmd) return run_validate(validate, global);
     if (*scene_render_cmd) return run_scene_render(scene_render, global);
+    if (*fit_cmd) return run_fit(fit, global);
   } catch (const lensmith::ComputationError& e) {
     std::cerr << "lensmith: " << e.what() << "\n";
     return kExitComputation;

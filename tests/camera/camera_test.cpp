@@ -75,7 +75,7 @@ TEST_CASE("On the focus plane the Seidel model displaces rays by Born & Wolf's a
   const Prescription lens = LensLibrary::load("sasian-triplet").prescription;
   const Camera cam = Camera::from_lens(lens, options(5.0, 4.0), 640, 480);
   const auto paraxial = make_ray_model(RayModelKind::Paraxial, cam);
-  const auto seidel = make_ray_model(RayModelKind::Seidel, cam, {1.0, 12});
+  const auto seidel = make_ray_model(RayModelKind::Seidel, cam, {1.0, 12, {}});
   const double w = 1.0 / cam.focus_distance_mm();
   const ScenePoint on_axis{0.0, 0.0, w};
   const auto p = hits(*paraxial, on_axis, cam.reference_wavelength_nm(), kPupil);
@@ -104,7 +104,7 @@ TEST_CASE("Seidel converges to paraxial as the aperture closes: the aberrated sp
   for (const double n : {2.8, 5.6, 11.0, 22.0}) {
     const Camera cam = Camera::from_lens(lens, options(2.0, n), 640, 480);
     const auto paraxial = make_ray_model(RayModelKind::Paraxial, cam);
-    const auto seidel = make_ray_model(RayModelKind::Seidel, cam, {1.0, 12});
+    const auto seidel = make_ray_model(RayModelKind::Seidel, cam, {1.0, 12, {}});
     const ScenePoint point{0.15, -0.1, 1.0 / 1500.0};
     const auto a = hits(*paraxial, point, 550.0, kPupil);
     const auto b = hits(*seidel, point, 550.0, kPupil);
@@ -127,7 +127,7 @@ TEST_CASE("Seidel agrees with the exact tracer on the Sasian triplet at f/8 to w
   const Prescription lens = LensLibrary::load("sasian-triplet").prescription;
   const Camera cam = Camera::from_lens(lens, options(3.0, 8.0), 640, 480);
   const auto paraxial = make_ray_model(RayModelKind::Paraxial, cam);
-  const auto seidel = make_ray_model(RayModelKind::Seidel, cam, {1.0, 12});
+  const auto seidel = make_ray_model(RayModelKind::Seidel, cam, {1.0, 12, {}});
   const auto exact = make_ray_model(RayModelKind::Exact, cam);
   double worst_seidel = 0.0, worst_paraxial = 0.0, sum_seidel = 0.0, sum_paraxial = 0.0;
   for (const ScenePoint& point : {ScenePoint{0.0, 0.0, 1.0 / 3000.0}, ScenePoint{0.1, 0.05, 1.0 / 2000.0}, ScenePoint{-0.15, 0.2, 0.0}}) {

@@ -1,6 +1,7 @@
 // Hexapolar and seeded random patterns on the unit pupil (OpticStudio User Guide, "Hexapolar Rings").
 #include "lensmith/analysis/pupil_sampling.h"
 
+#include "lensmith/core/split_mix.h"
 #include <cmath>
 
 #include "lensmith/core/errors.h"
@@ -9,20 +10,6 @@
 namespace lensmith {
 
 namespace {
-
-// SplitMix64 (Steele, Lea & Flood, OOPSLA 2014): a tiny generator whose output is fixed by the
-// algorithm, unlike std::uniform_real_distribution whose results differ between libraries.
-struct SplitMix64 {
-  std::uint64_t state;
-  std::uint64_t next() {
-    std::uint64_t z = (state += 0x9E3779B97F4A7C15ULL);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-    return z ^ (z >> 31);
-  }
-  // Uniform in [0, 1) with 53 random bits.
-  double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
-};
 
 }  // namespace
 

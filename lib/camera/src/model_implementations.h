@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "lensmith/camera/ray_model.h"
+#include "lensmith/polyfit/lens_fit.h"
 #include "lensmith/seidel/aberration_table.h"
 #include "lensmith/trace/sequential_tracer.h"
 
@@ -41,6 +42,23 @@ class ExactModel final : public RayModel {
   int stop_surface_ = 0;                             // 1-based
   double stop_radius_mm_ = 0.0;
   double z_stop_mm_ = 0.0;
+};
+
+// poly: a polynomial fit of the lens (lens_fit.h). Each pupil point is aimed by Newton steps on the
+// fit's outer -> stop map from the scene point, then carried to the sensor by the outer -> sensor map
+// and a straight line from the fit's sensor plane to the camera's; clipping by the fitted positions on
+// the clear apertures and the stop at the camera's f-number.
+class PolyModel final : public RayModel {
+ public:
+  PolyModel(const Camera& camera, std::shared_ptr<const LensFit> fit);
+  RayModelKind kind() const override { return RayModelKind::Poly; }
+  bool affine_in_pupil() const override { return false; }
+  void map(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
+           std::span<SensorHit> hits) const override;
+
+ private:
+  std::shared_ptr<const LensFit> fit_;
+  double stop_radius_mm_ = 0.0;
 };
 
 }  // namespace lensmith::camera_detail

@@ -13,16 +13,18 @@ std::string_view to_string(RayModelKind kind) {
     case RayModelKind::Thin: return "thin";
     case RayModelKind::Paraxial: return "paraxial";
     case RayModelKind::Seidel: return "seidel";
+    case RayModelKind::Poly: return "poly";
     case RayModelKind::Exact: return "exact";
   }
   return "unknown";
 }
 
 RayModelKind parse_ray_model_kind(std::string_view text) {
-  for (RayModelKind k : {RayModelKind::Thin, RayModelKind::Paraxial, RayModelKind::Seidel, RayModelKind::Exact}) {
+  for (RayModelKind k :
+       {RayModelKind::Thin, RayModelKind::Paraxial, RayModelKind::Seidel, RayModelKind::Poly, RayModelKind::Exact}) {
     if (text == to_string(k)) return k;
   }
-  throw OptionsError("unknown ray model '" + std::string(text) + "': expected thin, paraxial, seidel or exact");
+  throw OptionsError("unknown ray model '" + std::string(text) + "': expected thin, paraxial, seidel, poly or exact");
 }
 
 std::string RayModel::to_string() const {
@@ -48,6 +50,10 @@ std::unique_ptr<RayModel> make_ray_model(RayModelKind kind, const Camera& camera
     throw OptionsError("the " + std::string(to_string(kind)) + " model needs a lens prescription, not a thin lens");
   }
   if (kind == RayModelKind::Exact) return std::make_unique<camera_detail::ExactModel>(camera);
+  if (kind == RayModelKind::Poly) {
+    auto fit = options.fit ? options.fit : std::make_shared<const LensFit>(LensFit::fit(*camera.lens()));
+    return std::make_unique<camera_detail::PolyModel>(camera, std::move(fit));
+  }
   return std::make_unique<camera_detail::ReferenceSphereModel>(kind, camera, options);
 }
 

@@ -4,6 +4,8 @@
 // Q). The denominators are updated by one dot product per step, so a step costs O(pool * samples).
 #include "lensmith/polyfit/polynomial_fit.h"
 
+#include "least_squares.h"
+
 #include <ceres/ceres.h>
 
 #include <algorithm>
@@ -52,43 +54,77 @@ double dot(const std::vector<double>& a, const std::vector<double>& b) {
   return s;
 }
 
-// Greedy selection; returns indices into pool in selection order and the LS RMS after each step.
-std::vector<std::size_t> select_terms(const PowerTable& powers, const std::vector<double>& targets,
-                                      const std::vector<Monomial>& pool, const FitOptions& options,
-                                      std::vector<double>& selection_rms) {
-  const std::size_t n = targets.size();
-  const std::size_t p = pool.size();
-  std::vector<double> column(n);
-  std::vector<double> norm2(p), outside2(p);
-  std::vector<bool> candidate(p);
-  for (std::size_t j = 0; j < p; ++j) {
-    powers.column(pool[j], column);
-    norm2[j] = outside2[j] = dot(column, column);
-    candidate[j] = norm2[j] > 0.0;
+// Greedy selection for one or several targets sharing the chosen terms (simultaneous orthogonal
+// matching pursuit: Tropp, Gilbert & Strauss 2006). A candidate's gain is the sum over targets of the
+// fraction of that target's remaining squared residual it would remove, so outputs in different units
+// (mm, direction cosines) count alike. Returns indices into pool in selection order and, per target,
+// the least-squares RMS after each step. Candidates are scored in parallel; the choice does not
+// depend on the thread count (ties go to the earlier, lower-degree term).
+}  // namespace
+
+std::vector<std::size_t> select_columns(std::size_t p, const ColumnFunction& column_of,
+                                        const std::vector<std::vector<double>>& targets, const FitOptions& options,
+                                        std::vector<std::vector<double>>& selection_rms) {
+  const std::size_t n = targets.front().size();
+  const std::size_t outputs = targets.size();
+  std::vector<double> norm2(p), outside2(p), gain(p);
+  std::vector<char> candidate(p);
+#pragma omp parallel
+  {
+    std::vector<double> column(n);
+#pragma omp for schedule(static)
+    for (std::size_t j = 0; j < p; ++j) {
+      column_of(j, column);
+      norm2[j] = outside2[j] = dot(column, column);
+      candidate[j] = norm2[j] > 0.0;
+    }
   }
-  std::vector<double> r = targets;
-  const double target_norm = std::sqrt(dot(targets, targets));
+  std::vector<std::vector<double>> r = targets;
+  std::vector<double> target_norm(outputs);
+  for (std::size_t k = 0; k < outputs; ++k) target_norm[k] = std::sqrt(dot(targets[k], targets[k]));
+  selection_rms.assign(outputs, {});
   std::vector<std::vector<double>> basis;
   std::vector<std::size_t> chosen;
+  std::vector<double> weight(outputs);
   while (chosen.size() < static_cast<std::size_t>(options.max_terms)) {
-    if (std::sqrt(dot(r, r)) <= options.relative_residual_tolerance * target_norm) break;
+    bool explained = true;
+    for (std::size_t k = 0; k < outputs; ++k) {
+      const double rn2 = dot(r[k], r[k]);
+      const bool done = std::sqrt(rn2) <= options.relative_residual_tolerance * target_norm[k];
+      weight[k] = done ? 0.0 : 1.0 / rn2;
+      explained = explained && done;
+    }
+    if (explained) break;
+#pragma omp parallel
+    {
+      std::vector<double> column(n);
+#pragma omp for schedule(dynamic, 4)
+      for (std::size_t j = 0; j < p; ++j) {
+        gain[j] = 0.0;
+        if (!candidate[j]) continue;
+        column_of(j, column);
+        if (!basis.empty()) {
+          const double c = dot(column, basis.back());
+          outside2[j] -= c * c;
+          if (outside2[j] <= kDependentColumn * norm2[j]) {
+            candidate[j] = false;
+            continue;
+          }
+        }
+        double g = 0.0;
+        for (std::size_t k = 0; k < outputs; ++k) {
+          if (weight[k] == 0.0) continue;
+          const double cr = dot(column, r[k]);
+          g += weight[k] * cr * cr;
+        }
+        gain[j] = g / outside2[j];
+      }
+    }
     std::size_t best = p;
     double best_gain = 0.0;
     for (std::size_t j = 0; j < p; ++j) {
-      if (!candidate[j]) continue;
-      powers.column(pool[j], column);
-      if (!basis.empty()) {
-        const double c = dot(column, basis.back());
-        outside2[j] -= c * c;
-        if (outside2[j] <= kDependentColumn * norm2[j]) {
-          candidate[j] = false;
-          continue;
-        }
-      }
-      const double cr = dot(column, r);
-      const double gain = cr * cr / outside2[j];
-      if (gain > best_gain) {  // strict: ties go to the earlier (lower-degree) term
-        best_gain = gain;
+      if (candidate[j] && gain[j] > best_gain) {  // strict: ties go to the earlier (lower-degree) term
+        best_gain = gain[j];
         best = j;
       }
     }
@@ -96,7 +132,7 @@ std::vector<std::size_t> select_terms(const PowerTable& powers, const std::vecto
     // Orthogonalise the chosen column twice against the basis (Gram-Schmidt, then once more for
     // the rounding of the first pass: "twice is enough", Giraud et al. 2005).
     std::vector<double> q(n);
-    powers.column(pool[best], q);
+    column_of(best, q);
     for (int pass = 0; pass < 2; ++pass) {
       for (const auto& b : basis) {
         const double c = dot(q, b);
@@ -105,15 +141,19 @@ std::vector<std::size_t> select_terms(const PowerTable& powers, const std::vecto
     }
     const double qn = std::sqrt(dot(q, q));
     for (double& v : q) v /= qn;
-    const double cr = dot(q, r);
-    for (std::size_t i = 0; i < n; ++i) r[i] -= cr * q[i];
+    for (std::size_t k = 0; k < outputs; ++k) {
+      const double cr = dot(q, r[k]);
+      for (std::size_t i = 0; i < n; ++i) r[k][i] -= cr * q[i];
+      selection_rms[k].push_back(std::sqrt(dot(r[k], r[k]) / static_cast<double>(n)));
+    }
     basis.push_back(std::move(q));
     candidate[best] = false;
     chosen.push_back(best);
-    selection_rms.push_back(std::sqrt(dot(r, r) / static_cast<double>(n)));
   }
   return chosen;
 }
+
+namespace {
 
 // One residual per sample: r = sum_j row[j] c[j] - target. Linear, so the Jacobian is the row.
 class SampleResidual final : public ceres::CostFunction {
@@ -137,15 +177,50 @@ class SampleResidual final : public ceres::CostFunction {
   double target_;
 };
 
-// Solves for the coefficients in place (starting from their current values); returns iterations.
+// All samples as one block of residuals r_i = sum_j design[i][j] c[j] - target_i: without a robust
+// loss the residuals need no separate blocks, and one block lets Ceres fill its dense Jacobian with a
+// single copy of the design matrix instead of a virtual call per sample.
+class AllSamplesResidual final : public ceres::CostFunction {
+ public:
+  AllSamplesResidual(const std::vector<double>& design, const std::vector<double>& targets, int num_terms)
+      : design_(design), targets_(targets), num_terms_(num_terms) {
+    set_num_residuals(static_cast<int>(targets.size()));
+    mutable_parameter_block_sizes()->push_back(num_terms);
+  }
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const double* c = parameters[0];
+    const std::size_t k = static_cast<std::size_t>(num_terms_);
+    for (std::size_t i = 0; i < targets_.size(); ++i) {
+      const double* row = &design_[i * k];
+      double s = -targets_[i];
+      for (std::size_t j = 0; j < k; ++j) s += row[j] * c[j];
+      residuals[i] = s;
+    }
+    if (jacobians != nullptr && jacobians[0] != nullptr) std::copy(design_.begin(), design_.end(), jacobians[0]);
+    return true;
+  }
+
+ private:
+  const std::vector<double>& design_;
+  const std::vector<double>& targets_;
+  int num_terms_;
+};
+
+}  // namespace
+
 int solve_coefficients(const std::vector<double>& design, const std::vector<double>& targets, int num_terms,
                        ceres::LossFunction* loss, std::vector<double>& coefficients) {
   ceres::Problem::Options problem_options;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
-  for (std::size_t i = 0; i < targets.size(); ++i) {
-    problem.AddResidualBlock(new SampleResidual(&design[i * num_terms], num_terms, targets[i]), loss,
-                             coefficients.data());
+  if (loss == nullptr) {
+    problem.AddResidualBlock(new AllSamplesResidual(design, targets, num_terms), nullptr, coefficients.data());
+  } else {
+    // A robust loss acts on each residual block's squared norm: one block per sample.
+    for (std::size_t i = 0; i < targets.size(); ++i) {
+      problem.AddResidualBlock(new SampleResidual(&design[i * num_terms], num_terms, targets[i]), loss,
+                               coefficients.data());
+    }
   }
   ceres::Solver::Options solver_options;
   solver_options.linear_solver_type = ceres::DENSE_QR;  // QR: the normal equations would square the condition number
@@ -153,8 +228,10 @@ int solve_coefficients(const std::vector<double>& design, const std::vector<doub
   // The problem is linear: a vanishing LM damping makes the first step the Gauss-Newton solution.
   solver_options.initial_trust_region_radius = 1e16;
   solver_options.max_trust_region_radius = 1e32;
-  solver_options.function_tolerance = 1e-15;
-  solver_options.parameter_tolerance = 1e-14;
+  // The first step is the exact least-squares solution; later steps only move by rounding, which these
+  // tolerances recognise (tighter ones made Ceres repeat QR factorisations for nothing).
+  solver_options.function_tolerance = 1e-12;
+  solver_options.parameter_tolerance = 1e-12;
   solver_options.gradient_tolerance = 1e-20;
   solver_options.max_num_iterations = 100;
   solver_options.logging_type = ceres::SILENT;
@@ -164,14 +241,15 @@ int solve_coefficients(const std::vector<double>& design, const std::vector<doub
   return static_cast<int>(summary.iterations.size());
 }
 
-}  // namespace
-
 void FitOptions::validate() const {
   if (max_degree < 1 || max_degree > kMaxPolyDegree) {
     throw OptionsError("FitOptions::max_degree = " + std::to_string(max_degree) + ": must be in 1.." +
                        std::to_string(kMaxPolyDegree));
   }
   if (max_terms < 1) throw OptionsError("FitOptions::max_terms = " + std::to_string(max_terms) + ": must be >= 1");
+  if (max_selection_samples < 0) {
+    throw OptionsError("FitOptions::max_selection_samples = " + std::to_string(max_selection_samples) + ": must be >= 0");
+  }
   if (!(relative_residual_tolerance >= 0.0 && relative_residual_tolerance < 1.0)) {
     throw OptionsError("FitOptions::relative_residual_tolerance = " + std::to_string(relative_residual_tolerance) +
                        ": must be in [0, 1)");
@@ -224,23 +302,32 @@ FitResult fit_polynomial(const std::vector<PolyPoint>& inputs, const std::vector
   if (usable.size() <= static_cast<std::size_t>(options.max_terms)) {
     terms = usable;
   } else {
-    for (const std::size_t j : select_terms(powers, targets, usable, options, result.selection_rms)) {
-      terms.push_back(usable[j]);
-    }
+    const std::size_t m = options.max_selection_samples > 0
+                              ? std::min(inputs.size(), static_cast<std::size_t>(options.max_selection_samples))
+                              : inputs.size();
+    const std::vector<PolyPoint> subset(inputs.begin(), inputs.begin() + static_cast<std::ptrdiff_t>(m));
+    const PowerTable subset_powers(subset, degree);
+    std::vector<std::vector<double>> selection_rms;
+    const auto chosen = select_columns(
+        usable.size(), [&](std::size_t j, std::vector<double>& c) { subset_powers.column(usable[j], c); },
+        {std::vector<double>(targets.begin(), targets.begin() + static_cast<std::ptrdiff_t>(m))}, options,
+        selection_rms);
+    for (const std::size_t j : chosen) terms.push_back(usable[j]);
+    result.selection_rms = std::move(selection_rms.front());
   }
 
-  const int k = static_cast<int>(terms.size());
-  std::vector<double> coefficients(terms.size(), 0.0);
+  const std::size_t k = terms.size();
+  std::vector<double> coefficients(k, 0.0);
   if (k > 0) {
-    std::vector<double> design(inputs.size() * terms.size());
+    std::vector<double> design(inputs.size() * k);
     for (std::size_t i = 0; i < inputs.size(); ++i) {
-      for (std::size_t j = 0; j < terms.size(); ++j) design[i * terms.size() + j] = powers.monomial(i, terms[j]);
+      for (std::size_t j = 0; j < k; ++j) design[i * k + j] = powers.monomial(i, terms[j]);
     }
-    result.solver_iterations = solve_coefficients(design, targets, k, nullptr, coefficients);
+    result.solver_iterations = solve_coefficients(design, targets, static_cast<int>(k), nullptr, coefficients);
     if (options.huber_scale) {
       // Start the robust solve at the least-squares optimum, where Huber's weights are meaningful.
       const auto huber = std::make_unique<ceres::HuberLoss>(*options.huber_scale);
-      result.solver_iterations += solve_coefficients(design, targets, k, huber.get(), coefficients);
+      result.solver_iterations += solve_coefficients(design, targets, static_cast<int>(k), huber.get(), coefficients);
     }
   }
   result.polynomial = SparsePolynomial(std::move(terms), std::move(coefficients));

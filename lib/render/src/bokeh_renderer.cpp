@@ -367,7 +367,10 @@ Plan Renderer::plan(const Source& s, std::vector<PupilPoint>& pupil, std::vector
   } else if (aperture_.kind() == Aperture::Kind::Mask) {
     p.mesh = step_index(kGridSteps, size / 1.5);
   } else {
-    const double rings = model_.kind() == RayModelKind::Exact ? std::max(4.0, size / 6.0) : size / 16.0;
+    // Models that clip at the real clear apertures (exact, poly) need rings fine enough for the edges
+    // of a vignetted beam.
+    const bool clips = model_.kind() == RayModelKind::Exact || model_.kind() == RayModelKind::Poly;
+    const double rings = clips ? std::max(4.0, size / 6.0) : size / 16.0;
     p.mesh = step_index(kRingSteps, rings) * static_cast<int>(kSectorSteps.size()) + sector_step;
   }
   return p;

@@ -5,6 +5,8 @@
 // statistically good algorithms for random number generation", 2014) seeded by SplitMix64.
 #include "lensmith/scene/lens_render.h"
 
+#include "lensmith/core/split_mix.h"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -34,13 +36,6 @@ constexpr double kPupilEnlargement = 1.15;
 constexpr double kRelativeErrorFloor = 0.01;
 constexpr double kMinWavelengthNm = 380.0;  // the bokeh renderer's quadrature range
 constexpr double kMaxWavelengthNm = 780.0;
-
-std::uint64_t splitmix64(std::uint64_t& state) {
-  std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
 
 // PCG32 (XSH RR), one stream per (seed, pixel, pass).
 class Pcg32 {

@@ -18,7 +18,7 @@ void ImageValidationOptions::validate() const {
   if (!(band_radius_px > 0.0)) throw OptionsError("the depth-edge band radius must be > 0 px");
   for (RayModelKind k : models) {
     if (k == RayModelKind::Exact || k == RayModelKind::Thin) {
-      throw OptionsError("image validation scores paraxial or seidel, not " + std::string(to_string(k)));
+      throw OptionsError("image validation scores paraxial, seidel or poly, not " + std::string(to_string(k)));
     }
   }
 }
@@ -42,6 +42,7 @@ ImageValidation validate_images(const Prescription& lens, const CameraOptions& c
     float nearest_m = std::numeric_limits<float>::infinity();
     for (float z : pinhole.depth.z_m) nearest_m = std::min(nearest_m, z);
     RayModelOptions model_options;
+    model_options.fit = options.fit;
     model_options.nearest_depth_m = std::isfinite(nearest_m) ? std::max(0.01, static_cast<double>(nearest_m)) : 1.0;
     OutputMetadata meta;
     meta.lens = lens.name;

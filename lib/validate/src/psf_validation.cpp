@@ -59,7 +59,7 @@ PsfValidation validate_point_spreads(const Camera& camera, const std::vector<Ray
   std::vector<std::unique_ptr<RayModel>> fast;
   for (RayModelKind k : models) {
     if (k == RayModelKind::Exact || k == RayModelKind::Thin) {
-      throw OptionsError("PSF validation compares paraxial or seidel with exact, not " + std::string(to_string(k)));
+      throw OptionsError("PSF validation compares paraxial, seidel or poly with exact, not " + std::string(to_string(k)));
     }
     fast.push_back(make_ray_model(k, camera, model_options));
   }

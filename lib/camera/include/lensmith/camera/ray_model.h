@@ -7,6 +7,9 @@
 //             length; rays from the exit pupil through the Gaussian image point (no aberrations)
 //   seidel    Asberg's method (Marsicano 2023, sec. 3.10): the Gaussian image point plus Born &
 //             Wolf's third-order aberration vector, the ray leaving the Gaussian reference sphere
+//   poly      a polynomial fit of the lens (polynomial optics, lensmith fit): Newton-aimed at the
+//             stop point from the scene point, then mapped to the sensor; clipped by the fitted
+//             positions on the clear apertures
 //   exact     each ray traced through the prescription from the scene point, aimed so it crosses
 //             the aperture stop at the requested point: slow, the reference
 #pragma once
@@ -19,12 +22,13 @@
 
 #include "lensmith/camera/aperture.h"
 #include "lensmith/camera/camera.h"
+#include "lensmith/polyfit/lens_fit.h"
 
 namespace lensmith {
 
-enum class RayModelKind { Thin, Paraxial, Seidel, Exact };
+enum class RayModelKind { Thin, Paraxial, Seidel, Poly, Exact };
 
-// "thin", "paraxial", "seidel", "exact" (the --model spelling).
+// "thin", "paraxial", "seidel", "poly", "exact" (the --model spelling).
 std::string_view to_string(RayModelKind kind);
 // Throws OptionsError listing the choices.
 RayModelKind parse_ray_model_kind(std::string_view text);
@@ -65,11 +69,15 @@ struct RayModelOptions {
   // to infinity, evenly in inverse distance.
   double nearest_depth_m = 0.5;
   int seidel_distance_samples = 12;  // >= 2
+  // poly: a fit of the camera's lens (LensFit::fit or LensFit::read); empty: fitted when the model is
+  // made, with LensFitOptions{} (several seconds).
+  std::shared_ptr<const LensFit> fit;
   void validate() const;             // throws OptionsError
 };
 
 // Thin needs a thin-lens camera; the others a camera made from a prescription. Throws OptionsError
-// for a mismatch and what the Seidel analysis throws.
+// for a mismatch (poly: a fit of another lens, a stop wider than the fit's, a frame or wavelength
+// range beyond it) and what the Seidel analysis or the fit throws.
 std::unique_ptr<RayModel> make_ray_model(RayModelKind kind, const Camera& camera, const RayModelOptions& options = {});
 
 }  // namespace lensmith

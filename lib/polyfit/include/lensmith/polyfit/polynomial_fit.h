@@ -21,6 +21,9 @@ struct FitOptions {
   // Selection stops early once the residual 2-norm falls to this fraction of the target 2-norm
   // (the data are then explained to rounding). In [0, 1).
   double relative_residual_tolerance = 1e-12;
+  // Term selection scores candidates on at most this many samples (the first ones; 0 = all); the
+  // coefficients are always solved on every sample. >= 0.
+  int max_selection_samples = 0;
   // Huber loss scale, in the units of the targets, for the final coefficient solve; nullopt for
   // plain least squares. > 0. Selection always uses the least-squares residual.
   std::optional<double> huber_scale;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,7 @@ namespace lensmith {
 struct ImageValidationOptions {
   std::vector<std::filesystem::path> scenes;  // lensmith-scene JSON files
   std::vector<RayModelKind> models{RayModelKind::Paraxial, RayModelKind::Seidel};
+  std::shared_ptr<const LensFit> fit;  // for the poly model; empty: fitted when needed
   int width_px = 320;
   int height_px = 180;
   int spp = 64;                 // samples per pixel of the ground truth

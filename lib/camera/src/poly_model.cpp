@@ -1,0 +1,98 @@
+// The poly model: the renderer's forward path (from a scene point through a chosen stop point) on a
+// polynomial fit of the lens. Hanika & Dachsbacher (2014, sec. 4) solve the same problem by Newton
+// iteration on their fitted polynomials; here the unknown is the ray's crossing of the outer plane,
+// its direction following from the scene point, and the residual is the fitted stop position.
+#include <cmath>
+#include <sstream>
+
+#include "lensmith/core/errors.h"
+#include "lensmith/core/number_parsing.h"
+#include "model_implementations.h"
+
+namespace lensmith::camera_detail {
+
+PolyModel::PolyModel(const Camera& camera, std::shared_ptr<const LensFit> fit) : RayModel(camera), fit_(std::move(fit)) {
+  const Prescription& lens = *camera.lens();
+  fit_->check_matches(lens);
+  const ParaxialSystem p(lens);
+  stop_radius_mm_ = lens.surfaces[static_cast<std::size_t>(p.stop_surface() - 1)].semi_diameter_mm.value_or(0.0);
+  if (p.stop_surface() != fit_->stop_surface()) {
+    throw OptionsError("the fit's stop is surface " + std::to_string(fit_->stop_surface()) + ", the camera's surface " +
+                       std::to_string(p.stop_surface()));
+  }
+  if (stop_radius_mm_ > fit_->stop_radius_mm() * (1.0 + 1e-9)) {
+    throw OptionsError("f/" + format_number(camera.f_number()) + " opens the stop to " + format_number(stop_radius_mm_) +
+                       " mm, wider than the " + format_number(fit_->stop_radius_mm()) + " mm the fit covers");
+  }
+  // The frame's corner on the fit's sensor plane (the camera's sensor sits elsewhere when it focuses
+  // closer; the margin of the default image radius covers that).
+  const double half_diagonal_mm = 0.5 * std::hypot(camera.frame().width_px(), camera.frame().height_px()) /
+                                  std::abs(camera.px_per_sensor_mm());
+  if (half_diagonal_mm > fit_->image_radius_mm()) {
+    throw OptionsError("the fit covers the sensor out to " + format_number(fit_->image_radius_mm()) +
+                       " mm from the axis; this frame reaches " + format_number(half_diagonal_mm) +
+                       " mm: fit again with a larger --image-radius");
+  }
+  if (camera.min_wavelength_nm() < fit_->options().min_wavelength_nm - 1e-9 ||
+      camera.max_wavelength_nm() > fit_->options().max_wavelength_nm + 1e-9) {
+    throw OptionsError("the fit covers " + format_number(fit_->options().min_wavelength_nm) + "-" +
+                       format_number(fit_->options().max_wavelength_nm) + " nm, the renderer needs " +
+                       format_number(camera.min_wavelength_nm()) + "-" + format_number(camera.max_wavelength_nm()) + " nm");
+  }
+}
+
+void PolyModel::map(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
+                    std::span<SensorHit> hits) const {
+  const ObjectPoint object{point.tan_x, point.tan_y, point.inverse_depth_per_mm, camera_.z_perspective_mm()};
+  const double dz_sensor = camera_.z_sensor_mm() - fit_->sensor_plane_z_mm();
+  // Newton for the beam's centre gives the Jacobian of stop position in outer position; every pupil
+  // point then iterates with that fixed Jacobian (the chord method, as the exact model does with its
+  // affine map), starting from the centre solution moved by the Jacobian's inverse: the stop map is
+  // nearly affine across one beam, so a few cheap evaluations replace a Jacobian per step.
+  const double tolerance_mm = 1e-4 * stop_radius_mm_;
+  const FitAim centre = fit_->aim_from_object(object, 0.0, 0.0, wavelength_nm, std::nullopt, {tolerance_mm, 20});
+  const auto& j = centre.jacobian;
+  const double det = j[0] * j[3] - j[1] * j[2];
+  if (!centre.converged || !(std::abs(det) > 0.0)) {
+    for (auto& hit : hits) hit = {};
+    return;
+  }
+  const std::array<double, 4> inverse{j[3] / det, -j[1] / det, -j[2] / det, j[0] / det};
+  constexpr int kMaxChordSteps = 12;
+  for (std::size_t i = 0; i < pupil.size(); ++i) {
+    const double sx = pupil[i].x * stop_radius_mm_, sy = pupil[i].y * stop_radius_mm_;
+    double x = centre.ray.x_mm + inverse[0] * sx + inverse[1] * sy;
+    double y = centre.ray.y_mm + inverse[2] * sx + inverse[3] * sy;
+    bool aimed = false;
+    for (int step = 0; step < kMaxChordSteps; ++step) {
+      const auto at = fit_->stop_from_object(object, x, y, wavelength_nm);
+      if (!at) break;
+      const double ex = (*at)[0] - sx, ey = (*at)[1] - sy;
+      if (ex * ex + ey * ey <= tolerance_mm * tolerance_mm) {
+        aimed = true;
+        break;
+      }
+      x -= inverse[0] * ex + inverse[1] * ey;
+      y -= inverse[2] * ex + inverse[3] * ey;
+    }
+    if (!aimed) {
+      // Far from the centre the chord method may stall: full Newton from here.
+      const FitAim aim = fit_->aim_from_object(object, sx, sy, wavelength_nm, std::array<double, 2>{x, y},
+                                               {tolerance_mm, 20});
+      if (!aim.converged) {
+        hits[i] = {};
+        continue;
+      }
+      x = aim.ray.x_mm;
+      y = aim.ray.y_mm;
+    }
+    const double w = object.inverse_depth_per_mm;
+    const double ux = w * x - object.tan_x, uy = w * y - object.tan_y, uz = 1.0 - w * object.origin_z_mm;
+    const double len = std::sqrt(ux * ux + uy * uy + uz * uz);
+    const FitTrace t = fit_->from_outer(PlaneRay{x, y, ux / len, uy / len}, wavelength_nm, stop_radius_mm_);
+    const double dz = std::sqrt(std::max(1e-12, 1.0 - t.ray.dx * t.ray.dx - t.ray.dy * t.ray.dy));
+    hits[i] = SensorHit{t.ray.x_mm + t.ray.dx / dz * dz_sensor, t.ray.y_mm + t.ray.dy / dz * dz_sensor, t.passes, true};
+  }
+}
+
+}  // namespace lensmith::camera_detail

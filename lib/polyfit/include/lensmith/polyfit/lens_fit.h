@@ -1,0 +1,261 @@
+// A polynomial fit of a real lens ("polynomial optics": Hullin, Hanika & Heidrich 2012; Hanika &
+// Dachsbacher 2014; Schrade, Hanika & Dachsbacher 2016), fitted to rays of the exact tracer.
+//
+// Two reference planes, both in air:
+//   sensor plane  z = sensor_plane_z_mm(), the paraxial focus of the lens (primary wavelength, the
+//                 prescription's object distance); a camera that focuses elsewhere moves its sensor
+//                 and carries the rays there in a straight line, which is exact in air;
+//   outer plane   z = 0, the tangent plane at the vertex of surface 1 (the "outer pupil").
+// A ray on a plane is PlaneRay: where it crosses the plane (mm) and the x, y components of its unit
+// direction taken along the light's travel toward the image (+z), so the same four numbers describe
+// the line whichever way it is traced.
+//
+// Maps, each a rotation-invariant polynomial (rotational_map.h: out = A p + B d with A, B polynomials
+// in |p|^2, p.d, |d|^2 and the wavelength) with its own greedily chosen term set:
+//   sensor -> outer:  position and direction on the outer plane;
+//   sensor -> clip:   position on every clipping surface (the stop first), from the sensor ray;
+//   outer -> sensor:  position and direction on the sensor plane;
+//   outer -> clip:    position on the same clipping surfaces, from the outer ray;
+//   transmittance:    the uncoated Fresnel transmittance of the sensor ray (a scalar map).
+// The ray maps and the clipping maps have separate term sets so the hot path (a ray from one plane
+// to the other) pays only for its own outputs.
+// Clipping surfaces are the stop and every surface whose clear aperture cuts rays of the sampled
+// beam; at run time a ray passes when its fitted position on each lies within the semi-diameter, so
+// vignetting comes from the prescription's clear apertures, not from the polynomial's values.
+//
+// Inputs are normalised to about [-1, 1] (positions by the largest training position, directions by
+// the largest training direction, wavelength by the fitted range); the scales are part of the fit.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <ostream>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "lensmith/polyfit/polynomial.h"
+#include "lensmith/polyfit/rotational_map.h"
+#include "lensmith/prescription/prescription.h"
+
+namespace lensmith {
+
+struct LensFitOptions {
+  int degree = 7;              // highest total degree of a term, 1..kMaxPolyDegree
+  int terms = 40;              // term budget per output (shared by the outputs of a map), >= 1
+  int training_rays = 30000;   // rays the coefficients are fitted to, >= 200
+  int test_rays = 10000;       // held-out rays (a different random stream) the errors are measured on, >= 100
+  std::uint64_t seed = 2016;   // training stream; the test stream is derived from it
+  double min_wavelength_nm = 380.0;
+  double max_wavelength_nm = 780.0;
+  // Radius (mm) on the sensor plane the fit covers. Empty: 1.15 x the half-diagonal of a 36 x 24 mm
+  // frame (24.9 mm), enough for a full-frame sensor refocused to about f^2 / 10 mm behind the plane.
+  std::optional<double> image_radius_mm;
+  // Widest f-number the fit serves (a camera's iris opened beyond the prescription's stop); empty:
+  // the lens's own. The fitted beam fills the stop at the wider of the two.
+  std::optional<double> f_number;
+  double pupil_margin = 1.15;     // sampled exit-pupil disc over the paraxial one (the real pupil is larger off axis)
+  double aperture_margin = 1.05;  // training rays may pass clear apertures enlarged by this factor (a fit is
+                                  // then good up to the edges the renderer clips at)
+  void validate() const;          // throws OptionsError naming the option
+  std::string to_string() const;
+};
+
+struct PlaneRay {
+  double x_mm = 0.0;
+  double y_mm = 0.0;
+  double dx = 0.0;  // x component of the unit direction of travel (toward +z)
+  double dy = 0.0;
+  std::string to_string() const;
+  friend std::ostream& operator<<(std::ostream& os, const PlaneRay& r) { return os << r.to_string(); }
+};
+
+// A surface whose clear aperture clips rays of the fitted beam.
+struct ClipSurface {
+  int surface = 0;               // 1-based
+  double semi_diameter_mm = 0.0; // the prescription's (for the stop: its wide-open radius)
+  friend bool operator==(const ClipSurface&, const ClipSurface&) = default;
+};
+
+// Held-out errors of a fit, measured against the exact tracer on the test rays that pass the lens.
+// Position and direction errors are lengths of the 2-D error vectors (not per component).
+struct LensFitErrors {
+  int test_rays = 0;                   // passing test rays the errors are taken over
+  double position_rms_um = 0.0;        // sensor -> outer: position on the outer plane
+  double position_p99_um = 0.0;
+  double direction_rms_mrad = 0.0;     // sensor -> outer: direction (1e-3 of a unit direction component)
+  double stop_rms_um = 0.0;            // sensor -> outer: position on the stop
+  double transmittance_rms = 0.0;      // absolute, transmittance in [0, 1]
+  double sensor_position_rms_um = 0.0; // outer -> sensor: position on the sensor plane
+  double sensor_position_p99_um = 0.0;
+  double sensor_direction_rms_mrad = 0.0;
+  // Fraction of held-out rays (passing or clipped within the sampled beam) whose pass / clip verdict
+  // from the fitted clipping positions differs from the exact tracer's.
+  double vignetting_mismatch = 0.0;
+  std::string to_string() const;
+  friend std::ostream& operator<<(std::ostream& os, const LensFitErrors& e) { return os << e.to_string(); }
+};
+
+// Times measured when the fit was made, on one thread, for the same held-out rays from the sensor to
+// the outer plane: the exact tracer's batch path (unclipped) and the fit's batch evaluation of all
+// sensor -> outer ray (no clipping). Median of 5 runs.
+struct LensFitTiming {
+  double fit_seconds = 0.0;  // sampling, term selection and coefficients, all threads
+  double exact_ns_per_ray = 0.0;
+  double poly_ns_per_ray = 0.0;
+};
+
+// Where a fitted ray goes: the ray on the far plane, where it crosses the stop, and whether every
+// clipping surface lets it through.
+struct FitTrace {
+  PlaneRay ray;
+  double stop_x_mm = 0.0;
+  double stop_y_mm = 0.0;
+  bool passes = false;
+};
+
+// A point of the scene for aiming from the object side: the direction tangents from an on-axis
+// origin at z = origin_z_mm (lens frame) and the inverse of its planar depth from there (1/mm; 0 =
+// infinitely far). The point is (tan_x / w, tan_y / w, origin_z_mm - 1 / w).
+struct ObjectPoint {
+  double tan_x = 0.0;
+  double tan_y = 0.0;
+  double inverse_depth_per_mm = 0.0;
+  double origin_z_mm = 0.0;
+};
+
+struct FitAimOptions {
+  double tolerance_mm = 1e-6;  // accepted miss on the stop, mm (> 0)
+  int max_iterations = 20;     // Newton steps (>= 1)
+  void validate() const;       // throws OptionsError
+};
+
+// The result of a Newton aim: the ray that the fit sends through the requested stop point, the
+// iterations used and the remaining miss on the stop. converged = false when the miss stayed above the
+// tolerance (the ray is then the best found, for reference only) or the iteration left the fit's domain.
+struct FitAim {
+  PlaneRay ray;
+  // d(stop x, stop y) / d(unknown 1, unknown 2) at `ray`, row-major: the unknowns are the direction
+  // (dx, dy) for aim_from_sensor and the outer-plane position (x, y, mm) for aim_from_object.
+  std::array<double, 4> jacobian{};
+  bool converged = false;
+  int iterations = 0;
+  double miss_mm = 0.0;
+};
+
+class LensFit {
+ public:
+  // Traces training and test rays through `lens` (materials resolved) and fits every map. Reports
+  // progress in [0, 1] when given. Throws OptionsError, FitError (too few rays pass the lens) and what
+  // the tracer throws.
+  static LensFit fit(const Prescription& lens, const LensFitOptions& options = {},
+                     const std::function<void(double)>& progress = {});
+
+  // Versioned JSON ("lensmith-fit", version 1). read() throws LensFileError with file:line:col for
+  // malformed files; write() goes through a temporary file and a rename.
+  static LensFit parse(std::string_view text, const std::string& file_name);
+  static LensFit read(const std::string& path);
+  std::string to_json() const;
+  void write(const std::string& path) const;
+
+  // 16 hex digits identifying what the rays see of a prescription: every surface's shape, spacing,
+  // clear aperture (the stop's excepted: an f-number changes it) and index at 380, 587.56 and 780 nm.
+  static std::string prescription_hash(const Prescription& lens);
+  // Throws OptionsError when `lens` is not the prescription this fit was made from.
+  void check_matches(const Prescription& lens) const;
+
+  const std::string& lens_name() const { return lens_name_; }
+  const std::string& lens_hash() const { return lens_hash_; }
+  const LensFitOptions& options() const { return options_; }
+  double sensor_plane_z_mm() const { return sensor_z_mm_; }
+  double image_radius_mm() const { return image_radius_mm_; }
+  int stop_surface() const { return clip_.front().surface; }
+  double stop_radius_mm() const { return clip_.front().semi_diameter_mm; }  // wide open
+  const std::vector<ClipSurface>& clip_surfaces() const { return clip_; }
+  const LensFitErrors& errors() const { return errors_; }
+  const LensFitTiming& timing() const { return timing_; }
+  const RotationalMap& sensor_to_outer() const { return sensor_to_outer_; }
+  const RotationalMap& sensor_to_clip() const { return sensor_clip_; }
+  const RotationalMap& outer_to_sensor() const { return outer_to_sensor_; }
+  const RotationalMap& outer_to_clip() const { return outer_clip_; }
+  const RotationalMap& transmittance_map() const { return transmittance_; }
+
+  // Evaluation. `stop_radius_mm` is the stop's radius to clip at (a camera's f-number), at most the
+  // fit's; empty: stop_radius_mm(). Thread-safe, allocation-free.
+  FitTrace from_sensor(const PlaneRay& sensor, double wavelength_nm, std::optional<double> stop_radius_mm = {}) const;
+  FitTrace from_outer(const PlaneRay& outer, double wavelength_nm, std::optional<double> stop_radius_mm = {}) const;
+  double transmittance(const PlaneRay& sensor, double wavelength_nm) const;
+  // Batch, structure of arrays, sensor -> outer ray only (no clipping): the fast path that
+  // LensFitTiming measures. All spans the same size.
+  void outer_rays(std::span<const double> x_mm, std::span<const double> y_mm, std::span<const double> dx,
+                  std::span<const double> dy, std::span<const double> wavelength_nm, std::span<double> out_x_mm,
+                  std::span<double> out_y_mm, std::span<double> out_dx, std::span<double> out_dy) const;
+
+  // Newton on the sensor -> outer map: the direction from sensor point (x, y) whose fitted ray crosses
+  // the stop at (stop_x, stop_y) (mm). The first guess aims at the paraxial exit-pupil image of the stop point.
+  FitAim aim_from_sensor(double x_mm, double y_mm, double stop_x_mm, double stop_y_mm, double wavelength_nm,
+                         const FitAimOptions& options = {}) const;
+  // Newton on the outer -> sensor map: the outer-plane ray from `object` whose fitted path crosses the
+  // stop at (stop_x, stop_y). `guess` is a first outer-plane position (x, y in mm); empty: the paraxial
+  // entrance-pupil image of the stop point.
+  FitAim aim_from_object(const ObjectPoint& object, double stop_x_mm, double stop_y_mm, double wavelength_nm,
+                         std::optional<std::array<double, 2>> guess = {}, const FitAimOptions& options = {}) const;
+  // Where the fitted outer-plane ray through (x, y) (mm) from `object` crosses the stop (mm); empty
+  // when that ray lies outside the fit's domain. The residual of aim_from_object, for callers that
+  // iterate with a Jacobian of their own (a chord method across a pupil).
+  std::optional<std::array<double, 2>> stop_from_object(const ObjectPoint& object, double x_mm, double y_mm,
+                                                        double wavelength_nm) const;
+  // The outer-plane position (x, y, mm) of the paraxial ray from `object` through the entrance-pupil
+  // image of a stop point, at the primary wavelength: the first guess of aim_from_object.
+  std::array<double, 2> paraxial_outer_position(const ObjectPoint& object, double stop_x_mm, double stop_y_mm) const;
+
+  std::string to_string() const;
+  friend std::ostream& operator<<(std::ostream& os, const LensFit& f) { return os << f.to_string(); }
+
+  // Normalisation of the polynomial inputs (part of the fit and its file).
+  struct Scales {
+    double sensor_position_mm = 1.0;
+    double sensor_direction = 1.0;
+    double outer_position_mm = 1.0;
+    double outer_direction = 1.0;
+    double wavelength_centre_nm = 580.0;
+    double wavelength_half_range_nm = 200.0;
+    friend bool operator==(const Scales&, const Scales&) = default;
+  };
+  // First-order data at the primary wavelength, for first guesses.
+  struct Pupils {
+    double z_entrance_pupil_mm = 0.0;
+    double entrance_per_stop = 1.0;  // entrance-pupil radius over stop radius, signed (< 0: inverted image)
+    double z_exit_pupil_mm = 0.0;
+    double exit_per_stop = 1.0;
+    friend bool operator==(const Pupils&, const Pupils&) = default;
+  };
+  const Scales& scales() const { return scales_; }
+  const Pupils& pupils() const { return pupils_; }
+
+ private:
+  LensFit() = default;
+  FitTrace evaluate(const RotationalMap& map, const RotationalMap& clip, double position_scale, double direction_scale,
+                    const PlaneRay& in, double wavelength_nm, std::optional<double> stop_radius_mm) const;
+
+  std::string lens_name_;
+  std::string lens_hash_;
+  LensFitOptions options_;
+  double sensor_z_mm_ = 0.0;
+  double image_radius_mm_ = 0.0;
+  std::vector<ClipSurface> clip_;
+  Scales scales_;
+  Pupils pupils_;
+  RotationalMap sensor_to_outer_;  // outputs: position, direction on the outer plane
+  RotationalMap sensor_clip_;      // outputs: position on each clip surface
+  RotationalMap outer_to_sensor_;  // outputs: position, direction on the sensor plane
+  RotationalMap outer_clip_;       // outputs: position on each clip surface
+  RotationalMap transmittance_;    // one scalar output
+  LensFitErrors errors_;
+  LensFitTiming timing_;
+};
+
+}  // namespace lensmith

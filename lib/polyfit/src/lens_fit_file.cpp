@@ -1,0 +1,323 @@
+// The lensmith-fit JSON file (docs/fit-format.md): written with every double in shortest round-trip
+// form (nlohmann's dump), so a reloaded fit evaluates bit for bit like the one written; read strictly
+// (unknown keys, wrong types, non-finite numbers and inconsistent sizes are errors with file:line:col).
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "lensmith/core/errors.h"
+#include "lensmith/core/located_json.h"
+#include "lensmith/core/text_file.h"
+#include "lensmith/polyfit/lens_fit.h"
+
+namespace lensmith {
+namespace {
+
+using nlohmann::json;
+
+constexpr const char* kFormat = "lensmith-fit";
+constexpr int kVersion = 1;
+
+constexpr std::array<const char*, 3> kFactorNames{"p", "d", "1"};
+
+json map_to_json(const RotationalMap& map, const std::vector<std::string>& outputs) {
+  json terms = json::array(), coefficients = json::array();
+  for (std::size_t t = 0; t < map.size(); ++t) {
+    json e = json::array();
+    for (const auto x : map.terms()[t].exponents) e.push_back(static_cast<int>(x));
+    e.push_back(kFactorNames[static_cast<std::size_t>(map.terms()[t].factor)]);
+    terms.push_back(e);
+    json c = json::array();
+    for (int k = 0; k < map.outputs(); ++k) c.push_back(map.coefficient(t, k));
+    coefficients.push_back(c);
+  }
+  return json{{"outputs", outputs}, {"terms", terms}, {"coefficients", coefficients}};
+}
+
+std::vector<std::string> clip_names(const std::vector<ClipSurface>& clip) {
+  std::vector<std::string> names;
+  for (std::size_t q = 0; q < clip.size(); ++q) {
+    names.push_back("position on surface " + std::to_string(clip[q].surface) + (q == 0 ? " (stop), mm" : ", mm"));
+  }
+  return names;
+}
+
+class FitReader {
+ public:
+  explicit FitReader(const LocatedJson& doc) : doc_(doc) {}
+
+  [[noreturn]] void fail(const std::string& pointer, const std::string& path, const std::string& message) const {
+    throw LensFileError(doc_.where(pointer), path + ": " + message);
+  }
+  const json& at(const std::string& pointer) const { return doc_.root().at(json::json_pointer(pointer)); }
+  double number(const std::string& pointer, const std::string& path) const {
+    const json& v = at(pointer);
+    if (!v.is_number()) fail(pointer, path, "expected a number, got " + json_type_phrase(v));
+    const double x = v.get<double>();
+    if (!std::isfinite(x)) fail(pointer, path, "must be finite");
+    return x;
+  }
+  int integer(JsonObjectReader& r, const std::string& key, int min, int max) const {
+    const double v = r.get_number(key);
+    if (v != std::floor(v) || v < min || v > max) {
+      r.fail(key, "expected a whole number in " + std::to_string(min) + ".." + std::to_string(max));
+    }
+    return static_cast<int>(v);
+  }
+  double positive(JsonObjectReader& r, const std::string& key) const {
+    const double v = r.get_number(key);
+    if (!(std::isfinite(v) && v > 0.0)) r.fail(key, "expected a finite number > 0");
+    return v;
+  }
+  double finite(JsonObjectReader& r, const std::string& key) const {
+    const double v = r.get_number(key);
+    if (!std::isfinite(v)) r.fail(key, "expected a finite number");
+    return v;
+  }
+
+  // The object at `key` of `parent` (consumed); an error when it is missing.
+  JsonObjectReader object(JsonObjectReader& parent, const std::string& key) const {
+    if (parent.get(key) == nullptr) parent.fail(key, "missing: expected an object");
+    return JsonObjectReader(doc_, parent.child_pointer(key), parent.child_path(key));
+  }
+
+  RotationalMap map(JsonObjectReader& parent, const std::string& key, int outputs, bool vector) const {
+    JsonObjectReader r = object(parent, key);
+    const std::size_t names = r.get_array_size("outputs");
+    if (names != static_cast<std::size_t>(outputs)) {
+      r.fail("outputs", "expected " + std::to_string(outputs) + " outputs, got " + std::to_string(names));
+    }
+    const std::size_t count = r.get_array_size("terms");
+    if (r.get_array_size("coefficients") != count) {
+      r.fail("coefficients", "expected one row per term (" + std::to_string(count) + ")");
+    }
+    std::vector<InvariantTerm> terms(count);
+    std::vector<double> coefficients;
+    for (std::size_t t = 0; t < count; ++t) {
+      const std::string tp = r.child_pointer("terms") + "/" + std::to_string(t);
+      const std::string tpath = r.child_path("terms") + "[" + std::to_string(t) + "]";
+      const json& e = at(tp);
+      if (!e.is_array() || e.size() != 5) {
+        fail(tp, tpath, std::string("expected [u, v, w, lambda exponents, factor ") + (vector ? "\"p\" or \"d\"]" : "\"1\"]"));
+      }
+      int degree = 0;
+      for (int i = 0; i < 4; ++i) {
+        const double v = number(tp + "/" + std::to_string(i), tpath + "[" + std::to_string(i) + "]");
+        if (v != std::floor(v) || v < 0 || v > kMaxPolyDegree) {
+          fail(tp + "/" + std::to_string(i), tpath, "an exponent must be a whole number in 0.." + std::to_string(kMaxPolyDegree));
+        }
+        terms[t].exponents[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(v);
+      }
+      const json& f = at(tp + "/4");
+      const std::string factor = f.is_string() ? f.get<std::string>() : std::string();
+      if (vector && factor == "p") {
+        terms[t].factor = RayFactor::kPosition;
+      } else if (vector && factor == "d") {
+        terms[t].factor = RayFactor::kDirection;
+      } else if (!vector && factor == "1") {
+        terms[t].factor = RayFactor::kOne;
+      } else {
+        fail(tp + "/4", tpath + "[4]", std::string("expected the factor ") + (vector ? "\"p\" or \"d\"" : "\"1\""));
+      }
+      degree = terms[t].total_degree();
+      if (degree > kMaxPolyDegree) fail(tp, tpath, "total degree above " + std::to_string(kMaxPolyDegree));
+      const std::string cp = r.child_pointer("coefficients") + "/" + std::to_string(t);
+      const std::string cpath = r.child_path("coefficients") + "[" + std::to_string(t) + "]";
+      const json& c = at(cp);
+      if (!c.is_array() || c.size() != static_cast<std::size_t>(outputs)) {
+        fail(cp, cpath, "expected " + std::to_string(outputs) + " coefficients (one per output)");
+      }
+      for (int k = 0; k < outputs; ++k) {
+        coefficients.push_back(number(cp + "/" + std::to_string(k), cpath + "[" + std::to_string(k) + "]"));
+      }
+    }
+    r.finish({"outputs", "terms", "coefficients"});
+    try {
+      return RotationalMap(std::move(terms), outputs, std::move(coefficients));
+    } catch (const FitError& e) {
+      parent.fail(key, e.what());
+    }
+  }
+
+ private:
+  const LocatedJson& doc_;
+};
+
+}  // namespace
+
+std::string LensFit::to_json() const {
+  json root;
+  root["format"] = kFormat;
+  root["version"] = kVersion;
+  root["lens"] = {{"name", lens_name_}, {"prescription_hash", lens_hash_}};
+  json options = {{"degree", options_.degree},
+                  {"terms", options_.terms},
+                  {"training_rays", options_.training_rays},
+                  {"test_rays", options_.test_rays},
+                  {"seed", options_.seed},
+                  {"min_wavelength_nm", options_.min_wavelength_nm},
+                  {"max_wavelength_nm", options_.max_wavelength_nm},
+                  {"pupil_margin", options_.pupil_margin},
+                  {"aperture_margin", options_.aperture_margin}};
+  if (options_.image_radius_mm) options["image_radius_mm"] = *options_.image_radius_mm;
+  if (options_.f_number) options["f_number"] = *options_.f_number;
+  root["options"] = options;
+  root["sensor_plane_z_mm"] = sensor_z_mm_;
+  root["image_radius_mm"] = image_radius_mm_;
+  json clip = json::array();
+  for (const ClipSurface& c : clip_) clip.push_back({{"surface", c.surface}, {"semi_diameter_mm", c.semi_diameter_mm}});
+  root["clip_surfaces"] = clip;
+  root["scales"] = {{"sensor_position_mm", scales_.sensor_position_mm},
+                    {"sensor_direction", scales_.sensor_direction},
+                    {"outer_position_mm", scales_.outer_position_mm},
+                    {"outer_direction", scales_.outer_direction},
+                    {"wavelength_centre_nm", scales_.wavelength_centre_nm},
+                    {"wavelength_half_range_nm", scales_.wavelength_half_range_nm}};
+  root["pupils"] = {{"z_entrance_pupil_mm", pupils_.z_entrance_pupil_mm},
+                    {"entrance_per_stop", pupils_.entrance_per_stop},
+                    {"z_exit_pupil_mm", pupils_.z_exit_pupil_mm},
+                    {"exit_per_stop", pupils_.exit_per_stop}};
+  root["maps"] = {
+      {"sensor_to_outer", map_to_json(sensor_to_outer_, {"position on the outer plane, mm", "direction on the outer plane"})},
+      {"sensor_to_clip", map_to_json(sensor_clip_, clip_names(clip_))},
+      {"outer_to_sensor", map_to_json(outer_to_sensor_, {"position on the sensor plane, mm", "direction on the sensor plane"})},
+      {"outer_to_clip", map_to_json(outer_clip_, clip_names(clip_))},
+      {"transmittance", map_to_json(transmittance_, {"uncoated Fresnel transmittance"})}};
+  root["test_errors"] = {{"test_rays", errors_.test_rays},
+                         {"position_rms_um", errors_.position_rms_um},
+                         {"position_p99_um", errors_.position_p99_um},
+                         {"direction_rms_mrad", errors_.direction_rms_mrad},
+                         {"stop_rms_um", errors_.stop_rms_um},
+                         {"transmittance_rms", errors_.transmittance_rms},
+                         {"sensor_position_rms_um", errors_.sensor_position_rms_um},
+                         {"sensor_position_p99_um", errors_.sensor_position_p99_um},
+                         {"sensor_direction_rms_mrad", errors_.sensor_direction_rms_mrad},
+                         {"vignetting_mismatch", errors_.vignetting_mismatch}};
+  root["timing"] = {{"fit_seconds", timing_.fit_seconds},
+                    {"exact_ns_per_ray", timing_.exact_ns_per_ray},
+                    {"poly_ns_per_ray", timing_.poly_ns_per_ray}};
+  return root.dump(1) + "\n";
+}
+
+void LensFit::write(const std::string& path) const { write_file_atomically(path, to_json()); }
+
+LensFit LensFit::read(const std::string& path) {
+  const std::string bytes = read_file_bytes(path);
+  return parse(decode_text(bytes, path), path);
+}
+
+LensFit LensFit::parse(std::string_view text, const std::string& file_name) {
+  const LocatedJson doc = LocatedJson::parse(text, file_name);
+  const FitReader in(doc);
+  JsonObjectReader top(doc, "", "");
+  if (top.get_string("format") != kFormat) top.fail("format", std::string("expected \"") + kFormat + "\"");
+  const double version = top.get_number("version");
+  if (version != kVersion) {
+    top.fail("version", "this lensmith reads version " + std::to_string(kVersion) + " fit files");
+  }
+  LensFit fit;
+  {
+    JsonObjectReader lens = in.object(top, "lens");
+    fit.lens_name_ = lens.get_string("name");
+    fit.lens_hash_ = lens.get_string("prescription_hash");
+    if (fit.lens_hash_.size() != 16 || fit.lens_hash_.find_first_not_of("0123456789abcdef") != std::string::npos) {
+      lens.fail("prescription_hash", "expected 16 lower-case hex digits");
+    }
+    lens.finish({"name", "prescription_hash"});
+  }
+  {
+    JsonObjectReader o = in.object(top, "options");
+    LensFitOptions& opt = fit.options_;
+    opt.degree = in.integer(o, "degree", 1, kMaxPolyDegree);
+    opt.terms = in.integer(o, "terms", 1, 1 << 20);
+    opt.training_rays = in.integer(o, "training_rays", 1, 1 << 30);
+    opt.test_rays = in.integer(o, "test_rays", 1, 1 << 30);
+    const json* seed = o.get("seed");
+    if (seed == nullptr || !seed->is_number_unsigned()) o.fail("seed", "expected a whole number >= 0");
+    opt.seed = seed->get<std::uint64_t>();
+    opt.min_wavelength_nm = in.positive(o, "min_wavelength_nm");
+    opt.max_wavelength_nm = in.positive(o, "max_wavelength_nm");
+    if (o.has("image_radius_mm")) opt.image_radius_mm = in.positive(o, "image_radius_mm");
+    if (o.has("f_number")) opt.f_number = in.positive(o, "f_number");
+    opt.pupil_margin = in.positive(o, "pupil_margin");
+    opt.aperture_margin = in.positive(o, "aperture_margin");
+    o.finish({"degree", "terms", "training_rays", "test_rays", "seed", "min_wavelength_nm", "max_wavelength_nm",
+              "image_radius_mm", "f_number", "pupil_margin", "aperture_margin"});
+    if (!(opt.max_wavelength_nm > opt.min_wavelength_nm)) o.fail("max_wavelength_nm", "must exceed min_wavelength_nm");
+  }
+  fit.sensor_z_mm_ = in.finite(top, "sensor_plane_z_mm");
+  fit.image_radius_mm_ = in.positive(top, "image_radius_mm");
+  const std::size_t clips = top.get_array_size("clip_surfaces");
+  if (clips < 1 || clips > static_cast<std::size_t>(kMaxMapOutputs)) {
+    top.fail("clip_surfaces", "expected 1.." + std::to_string(kMaxMapOutputs) + " surfaces (the stop first)");
+  }
+  for (std::size_t q = 0; q < clips; ++q) {
+    JsonObjectReader c(doc, top.child_pointer("clip_surfaces") + "/" + std::to_string(q),
+                       top.child_path("clip_surfaces") + "[" + std::to_string(q) + "]");
+    ClipSurface s;
+    s.surface = in.integer(c, "surface", 1, 100000);
+    s.semi_diameter_mm = in.positive(c, "semi_diameter_mm");
+    c.finish({"surface", "semi_diameter_mm"});
+    fit.clip_.push_back(s);
+  }
+  {
+    JsonObjectReader s = in.object(top, "scales");
+    fit.scales_.sensor_position_mm = in.positive(s, "sensor_position_mm");
+    fit.scales_.sensor_direction = in.positive(s, "sensor_direction");
+    fit.scales_.outer_position_mm = in.positive(s, "outer_position_mm");
+    fit.scales_.outer_direction = in.positive(s, "outer_direction");
+    fit.scales_.wavelength_centre_nm = in.positive(s, "wavelength_centre_nm");
+    fit.scales_.wavelength_half_range_nm = in.positive(s, "wavelength_half_range_nm");
+    s.finish({"sensor_position_mm", "sensor_direction", "outer_position_mm", "outer_direction", "wavelength_centre_nm",
+              "wavelength_half_range_nm"});
+  }
+  {
+    JsonObjectReader p = in.object(top, "pupils");
+    fit.pupils_.z_entrance_pupil_mm = in.finite(p, "z_entrance_pupil_mm");
+    fit.pupils_.entrance_per_stop = in.finite(p, "entrance_per_stop");
+    fit.pupils_.z_exit_pupil_mm = in.finite(p, "z_exit_pupil_mm");
+    fit.pupils_.exit_per_stop = in.finite(p, "exit_per_stop");
+    p.finish({"z_entrance_pupil_mm", "entrance_per_stop", "z_exit_pupil_mm", "exit_per_stop"});
+  }
+  {
+    JsonObjectReader m = in.object(top, "maps");
+    const int clip_outputs = static_cast<int>(clips);
+    fit.sensor_to_outer_ = in.map(m, "sensor_to_outer", 2, true);
+    fit.sensor_clip_ = in.map(m, "sensor_to_clip", clip_outputs, true);
+    fit.outer_to_sensor_ = in.map(m, "outer_to_sensor", 2, true);
+    fit.outer_clip_ = in.map(m, "outer_to_clip", clip_outputs, true);
+    fit.transmittance_ = in.map(m, "transmittance", 1, false);
+    m.finish({"sensor_to_outer", "sensor_to_clip", "outer_to_sensor", "outer_to_clip", "transmittance"});
+  }
+  {
+    JsonObjectReader e = in.object(top, "test_errors");
+    LensFitErrors& x = fit.errors_;
+    x.test_rays = in.integer(e, "test_rays", 0, 1 << 30);
+    x.position_rms_um = in.finite(e, "position_rms_um");
+    x.position_p99_um = in.finite(e, "position_p99_um");
+    x.direction_rms_mrad = in.finite(e, "direction_rms_mrad");
+    x.stop_rms_um = in.finite(e, "stop_rms_um");
+    x.transmittance_rms = in.finite(e, "transmittance_rms");
+    x.sensor_position_rms_um = in.finite(e, "sensor_position_rms_um");
+    x.sensor_position_p99_um = in.finite(e, "sensor_position_p99_um");
+    x.sensor_direction_rms_mrad = in.finite(e, "sensor_direction_rms_mrad");
+    x.vignetting_mismatch = in.finite(e, "vignetting_mismatch");
+    e.finish({"test_rays", "position_rms_um", "position_p99_um", "direction_rms_mrad", "stop_rms_um",
+              "transmittance_rms", "sensor_position_rms_um", "sensor_position_p99_um", "sensor_direction_rms_mrad",
+              "vignetting_mismatch"});
+  }
+  {
+    JsonObjectReader t = in.object(top, "timing");
+    fit.timing_.fit_seconds = in.finite(t, "fit_seconds");
+    fit.timing_.exact_ns_per_ray = in.finite(t, "exact_ns_per_ray");
+    fit.timing_.poly_ns_per_ray = in.finite(t, "poly_ns_per_ray");
+    t.finish({"fit_seconds", "exact_ns_per_ray", "poly_ns_per_ray"});
+  }
+  top.finish({"format", "version", "lens", "options", "sensor_plane_z_mm", "image_radius_mm", "clip_surfaces", "scales",
+              "pupils", "maps", "test_errors", "timing"});
+  return fit;
+}
+
+}  // namespace lensmith
