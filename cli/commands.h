@@ -183,7 +183,7 @@ int run_validate(const ValidateCommandOptions& options, const GlobalOptions& glo
 struct FitCommandOptions {
   std::string lens;                      // LENS: file or shipped name
   int degree = 7;                        // --degree: highest total degree of a term (1-11)
-  int terms = 40;                        // --terms: term budget per output
+  int terms = 0;                         // --terms: term budget per output (0 = automatic)
   int training_rays = 30000;             // --training-rays
   int test_rays = 10000;                 // --test-rays
   std::uint64_t seed = 2016;             // --seed of the training rays (the test rays use another stream)

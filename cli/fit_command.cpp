@@ -58,7 +58,7 @@ int run_fit(const FitCommandOptions& o, const GlobalOptions& global) {
     j["lens"] = lens.name;
     j["prescription_hash"] = fit.lens_hash();
     j["degree"] = options.degree;
-    j["terms"] = options.terms;
+    j["terms"] = fit.term_budget();
     j["terms_sensor_to_outer"] = fit.sensor_to_outer().size();
     j["terms_outer_to_sensor"] = fit.outer_to_sensor().size();
     j["clip_surfaces"] = ojson::array();
@@ -83,7 +83,7 @@ int run_fit(const FitCommandOptions& o, const GlobalOptions& global) {
   }
   std::cout << std::fixed;
   std::cout << "Polynomial fit of " << lens.name << "\n"
-            << "  degree " << options.degree << ", at most " << options.terms << " terms per output ("
+            << "  degree " << options.degree << ", at most " << fit.term_budget() << " terms per output ("
             << fit.sensor_to_outer().size() << " sensor->outer, " << fit.outer_to_sensor().size()
             << " outer->sensor), " << options.training_rays << " training rays, 380-780 nm\n"
             << "  clipping surfaces:";

@@ -173,3 +173,50 @@ TEST_CASE("Apertures: blades are regular polygons on the unit circle, meshes car
   CHECK_THROWS_AS(Aperture::blades(2, 0.0), OptionsError);
   CHECK_THROWS_AS(Aperture::mask(4, 4, std::vector<float>(16, 0.0f)), OptionsError);
 }
+
+TEST_CASE("The poly model lands rays where the exact model does, to the fit's own held-out error", "[camera][poly]") {
+  // Outside truth: the exact model traces every ray through the prescription. The fit is checked
+  // against the same tracer on held-out rays; the model adds Newton aiming and the sensor shift, so
+  // its hits must agree with exact ones to a few times that held-out error.
+  const Prescription lens = LensLibrary::load("sasian-triplet").prescription;
+  const Camera cam = Camera::from_lens(lens, options(3.0, 5.6), 640, 480);
+  LensFitOptions fo;
+  fo.training_rays = 6000;
+  fo.test_rays = 2000;
+  RayModelOptions mo;
+  mo.fit = std::make_shared<const LensFit>(LensFit::fit(*cam.lens(), fo));
+  const auto poly = make_ray_model(RayModelKind::Poly, cam, mo);
+  const auto exact = make_ray_model(RayModelKind::Exact, cam);
+  const double tolerance_mm = 5e-3 * mo.fit->errors().sensor_position_rms_um + 2e-3;
+  double worst = 0.0;
+  int compared = 0;
+  for (const double field : {0.0, 0.15, 0.3}) {
+    for (const double depth_m : {1.0, 3.0, 10.0}) {
+      const ScenePoint point{0.0, field, 1.0 / (1000.0 * depth_m)};
+      const auto a = hits(*poly, point, 550.0, kPupil);
+      const auto b = hits(*exact, point, 550.0, kPupil);
+      for (std::size_t i = 0; i < kPupil.size(); ++i) {
+        if (!(a[i].ok && b[i].ok)) continue;
+        worst = std::max(worst, std::hypot(a[i].x_mm - b[i].x_mm, a[i].y_mm - b[i].y_mm));
+        ++compared;
+      }
+    }
+  }
+  INFO("worst " << worst << " mm over " << compared << " rays, tolerance " << tolerance_mm << " mm");
+  CHECK(compared > 50);
+  CHECK(worst < tolerance_mm);
+}
+
+TEST_CASE("The poly model refuses a fit of another lens and a stop wider than its fit", "[camera][poly]") {
+  const Prescription lens = LensLibrary::load("sasian-triplet").prescription;
+  LensFitOptions fo;
+  fo.training_rays = 1000;
+  fo.test_rays = 300;
+  fo.degree = 3;
+  RayModelOptions mo;
+  mo.fit = std::make_shared<const LensFit>(LensFit::fit(lens, fo));  // at the lens's own f-number
+  const Camera wide = Camera::from_lens(lens, options(3.0, 1.0), 640, 480);
+  CHECK_THROWS_AS(make_ray_model(RayModelKind::Poly, wide, mo), OptionsError);
+  const Camera biotar = Camera::from_lens(LensLibrary::load("zeiss-biotar-1927").prescription, options(3.0, 8.0), 640, 480);
+  CHECK_THROWS_AS(make_ray_model(RayModelKind::Poly, biotar, mo), OptionsError);
+}

@@ -66,6 +66,14 @@ TEST_CASE("the Angenieux double Gauss fit beats the published polynomial-optics 
   CHECK(fit.sensor_to_outer().size() <= 40);
 }
 
+TEST_CASE("the automatic term budget grows with the lens and stays within 12 to 40") {
+  CHECK(LensFit::automatic_term_budget(3) == 12);
+  CHECK(LensFit::automatic_term_budget(6) == 15);
+  CHECK(LensFit::automatic_term_budget(11) == 30);
+  CHECK(LensFit::automatic_term_budget(15) == 40);
+  CHECK(LensFit::automatic_term_budget(40) == 40);
+}
+
 TEST_CASE("a fit written to JSON and read back evaluates bit for bit the same") {
   const LensFit& fit = triplet_fit();
   const std::string text = fit.to_json();
@@ -126,7 +134,10 @@ TEST_CASE("Newton on the fit reaches the requested stop point, and the exact ray
     Ray ray;
     const double dz = std::sqrt(1.0 - aim.ray.dx * aim.ray.dx - aim.ray.dy * aim.ray.dy);
     ray.direction = Eigen::Vector3d(aim.ray.dx, aim.ray.dy, dz);
-    ray.position_mm = Eigen::Vector3d(aim.ray.x_mm, aim.ray.y_mm, 0.0) - 20.0 * ray.direction;
+    // The outer ray's point lies on surface 1 (a sphere for this lens).
+    const double c = lens.surfaces[0].curvature_per_mm, r2 = aim.ray.x_mm * aim.ray.x_mm + aim.ray.y_mm * aim.ray.y_mm;
+    const double sag = c * r2 / (1.0 + std::sqrt(1.0 - c * c * r2));
+    ray.position_mm = Eigen::Vector3d(aim.ray.x_mm, aim.ray.y_mm, sag) - 20.0 * ray.direction;
     ray.wavelength_nm = 600.0;
     // The outer ray must come from the object point.
     const double depth = 1.0 / object.inverse_depth_per_mm;
@@ -183,7 +194,7 @@ TEST_CASE("fit options validate themselves") {
   o.degree = 0;
   CHECK_THROWS_AS(o.validate(), OptionsError);
   o = {};
-  o.terms = 0;
+  o.terms = -1;
   CHECK_THROWS_AS(o.validate(), OptionsError);
   o = {};
   o.min_wavelength_nm = 700.0;

@@ -86,10 +86,12 @@ void PolyModel::map(const ScenePoint& point, double wavelength_nm, std::span<con
       x = aim.ray.x_mm;
       y = aim.ray.y_mm;
     }
-    const double w = object.inverse_depth_per_mm;
-    const double ux = w * x - object.tan_x, uy = w * y - object.tan_y, uz = 1.0 - w * object.origin_z_mm;
-    const double len = std::sqrt(ux * ux + uy * uy + uz * uz);
-    const FitTrace t = fit_->from_outer(PlaneRay{x, y, ux / len, uy / len}, wavelength_nm, stop_radius_mm_);
+    const std::optional<PlaneRay> outer = fit_->outer_ray_from_object(object, x, y);
+    if (!outer) {
+      hits[i] = {};
+      continue;
+    }
+    const FitTrace t = fit_->from_outer(*outer, wavelength_nm, stop_radius_mm_);
     const double dz = std::sqrt(std::max(1e-12, 1.0 - t.ray.dx * t.ray.dx - t.ray.dy * t.ray.dy));
     hits[i] = SensorHit{t.ray.x_mm + t.ray.dx / dz * dz_sensor, t.ray.y_mm + t.ray.dy / dz * dz_sensor, t.passes, true};
   }

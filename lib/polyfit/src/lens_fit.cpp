@@ -113,10 +113,9 @@ struct Sampler {
                                                std::abs(h.direction_after.dot(h.normal)));
       incoming = h.direction_after;
     }
-    // The object-space ray, as light travels it, on the plane z = 0.
+    // The object-space ray, as light travels it, where it meets surface 1.
     const Eigen::Vector3d f = -t.ray.direction;
-    const Eigen::Vector3d p = t.ray.position_mm + f * ((0.0 - t.ray.position_mm.z()) / f.z());
-    c.outer = PlaneRay{p.x(), p.y(), f.x(), f.y()};
+    c.outer = PlaneRay{t.ray.position_mm.x(), t.ray.position_mm.y(), f.x(), f.y()};
     return c;
   }
 
@@ -218,11 +217,15 @@ std::array<double, 2> damped_newton(std::array<double, 2> u, const Residual& res
 
 }  // namespace
 
+int LensFit::automatic_term_budget(std::size_t surfaces) {
+  return std::clamp(3 * static_cast<int>(surfaces) - 3, 12, 40);
+}
+
 void LensFitOptions::validate() const {
   if (degree < 1 || degree > kMaxPolyDegree) {
     throw OptionsError("fit degree must be in 1.." + std::to_string(kMaxPolyDegree) + ", got " + std::to_string(degree));
   }
-  if (terms < 1) throw OptionsError("fit term budget must be >= 1, got " + std::to_string(terms));
+  if (terms < 0) throw OptionsError("fit term budget must be >= 1 (or 0 for automatic), got " + std::to_string(terms));
   if (training_rays < 200) throw OptionsError("a fit needs at least 200 training rays, got " + std::to_string(training_rays));
   if (test_rays < 100) throw OptionsError("a fit needs at least 100 test rays, got " + std::to_string(test_rays));
   if (!(std::isfinite(min_wavelength_nm) && std::isfinite(max_wavelength_nm) && min_wavelength_nm > 100.0 &&
@@ -316,6 +319,8 @@ LensFit LensFit::fit(const Prescription& lens, const LensFitOptions& options,
   fit.pupils_.entrance_per_stop = ep.magnification;
   fit.pupils_.z_exit_pupil_mm = xp.z_mm;
   fit.pupils_.exit_per_stop = xp.magnification;
+  const Surface& front = lens.surfaces.front();
+  fit.front_ = FrontSurface{front.curvature_per_mm, front.conic, front.even_asphere};
 
   Sampler sampler{tracer, options, fit.sensor_z_mm_, fit.image_radius_mm_, xp.z_mm,
                   options.pupil_margin * std::abs(xp.magnification) * stop_radius, {}};
@@ -390,7 +395,8 @@ LensFit LensFit::fit(const Prescription& lens, const LensFitOptions& options,
   }
   FitOptions fo;
   fo.max_degree = options.degree;
-  fo.max_terms = options.terms;
+  fit.term_budget_ = options.terms > 0 ? options.terms : automatic_term_budget(lens.surfaces.size());
+  fo.max_terms = fit.term_budget_;
   fo.max_selection_samples = kSelectionSamples;
   const std::vector<InvariantTerm> pool = vector_invariant_terms(options.degree);
   fit.sensor_to_outer_ = fit_rotational_map(sensor_in, to_outer, pool, fo).map;
@@ -599,21 +605,31 @@ FitAim LensFit::aim_from_object(const ObjectPoint& o, double stop_x_mm, double s
   const RotationalMap& map = outer_clip_;
   std::array<double, 2> at;
   std::array<double, 8> jac;
-  // The outer-plane ray through (x, y) from the object point; its direction's derivatives in x, y.
+  // The outer ray through the front-surface point above (x, y) from the object point, and the
+  // derivatives of its direction in x and y (chain rule through the sag).
   struct Line {
     PlaneRay ray;
     double ddx_dx, ddy_dx, ddx_dy, ddy_dy;
   };
-  auto line = [&](double x, double y) {
-    const double ux = w * x - o.tan_x, uy = w * y - o.tan_y, uz = 1.0 - w * o.origin_z_mm;
+  auto line = [&](double x, double y) -> std::optional<Line> {
+    double dz_ds = 0.0;
+    const std::optional<double> z = front_sag(x * x + y * y, &dz_ds);
+    if (!z) return std::nullopt;
+    // w times the vector from the object point to the surface point (finite at w = 0).
+    const double ux = w * x - o.tan_x, uy = w * y - o.tan_y, uz = 1.0 + w * (*z - o.origin_z_mm);
+    if (uz <= 0.0) return std::nullopt;  // the object point is not in front of the surface
     const double len = std::sqrt(ux * ux + uy * uy + uz * uz);
-    const double dx = ux / len, dy = uy / len;
-    return Line{PlaneRay{x, y, dx, dy}, w * (1.0 - dx * dx) / len, -w * dx * dy / len, -w * dx * dy / len,
-                w * (1.0 - dy * dy) / len};
+    const double fx = ux / len, fy = uy / len, fz = uz / len;
+    // d(w u) / dx = (w, 0, w dz/dx), d(w u) / dy = (0, w, w dz/dy); d f = (g - f (f.g)) / |w u|.
+    const double zx = 2.0 * x * dz_ds, zy = 2.0 * y * dz_ds;
+    const double fgx = w * (fx + fz * zx), fgy = w * (fy + fz * zy);
+    return Line{PlaneRay{x, y, fx, fy}, (w - fx * fgx) / len, (0.0 - fy * fgx) / len, (0.0 - fx * fgy) / len,
+                (w - fy * fgy) / len};
   };
   auto residual = [&](const std::array<double, 2>& u, double& ex, double& ey, std::array<double, 4>* j) {
-    const Line l = line(u[0], u[1]);
-    if (1.0 - w * o.origin_z_mm <= 0.0) return false;  // the object point is not in front of the outer plane
+    const std::optional<Line> found = line(u[0], u[1]);
+    if (!found) return false;
+    const Line& l = *found;
     const PolyPoint va = normalised(l.ray, ps, ds, lambda);
     for (int i = 0; i < 4; ++i) {
       if (std::abs(va[i]) > kDomainLimit) return false;
@@ -640,19 +656,46 @@ FitAim LensFit::aim_from_object(const ObjectPoint& o, double stop_x_mm, double s
   };
   FitAim aim;
   const auto u = damped_newton(start, residual, options, aim);
-  aim.ray = line(u[0], u[1]).ray;
+  const std::optional<Line> last = line(u[0], u[1]);
+  aim.ray = last ? last->ray : PlaneRay{u[0], u[1], 0.0, 0.0};
   return aim;
+}
+
+std::optional<double> LensFit::front_sag(double r2, double* dz_dr2) const {
+  // z = c s / (1 + sqrt(1 - (1 + k) c^2 s)) + sum_j a_j s^(j + 1), s = r^2; dz/ds = c / (2 q) + ...
+  const double c = front_.curvature_per_mm, k = front_.conic;
+  const double q2 = 1.0 - (1.0 + k) * c * c * r2;
+  if (q2 <= 0.0) return std::nullopt;
+  const double q = std::sqrt(q2);
+  double z = c * r2 / (1.0 + q);
+  double slope = 0.5 * c / q;
+  double power = 1.0;  // s^j
+  for (std::size_t j = 0; j < front_.even_asphere.size(); ++j) {
+    const double a = front_.even_asphere[j];
+    slope += a * static_cast<double>(j + 1) * power;
+    power *= r2;
+    z += a * power;
+  }
+  if (dz_dr2) *dz_dr2 = slope;
+  return z;
+}
+
+std::optional<PlaneRay> LensFit::outer_ray_from_object(const ObjectPoint& o, double x_mm, double y_mm) const {
+  const std::optional<double> z = front_sag(x_mm * x_mm + y_mm * y_mm, nullptr);
+  if (!z) return std::nullopt;
+  const double w = o.inverse_depth_per_mm;
+  const double ux = w * x_mm - o.tan_x, uy = w * y_mm - o.tan_y, uz = 1.0 + w * (*z - o.origin_z_mm);
+  if (uz <= 0.0) return std::nullopt;
+  const double len = std::sqrt(ux * ux + uy * uy + uz * uz);
+  return PlaneRay{x_mm, y_mm, ux / len, uy / len};
 }
 
 std::optional<std::array<double, 2>> LensFit::stop_from_object(const ObjectPoint& o, double x_mm, double y_mm,
                                                               double wavelength_nm) const {
-  const double w = o.inverse_depth_per_mm;
-  const double ux = w * x_mm - o.tan_x, uy = w * y_mm - o.tan_y, uz = 1.0 - w * o.origin_z_mm;
-  if (uz <= 0.0) return std::nullopt;
-  const double len = std::sqrt(ux * ux + uy * uy + uz * uz);
+  const std::optional<PlaneRay> ray = outer_ray_from_object(o, x_mm, y_mm);
+  if (!ray) return std::nullopt;
   const double lambda = (wavelength_nm - scales_.wavelength_centre_nm) / scales_.wavelength_half_range_nm;
-  const PolyPoint v = normalised(PlaneRay{x_mm, y_mm, ux / len, uy / len}, scales_.outer_position_mm,
-                                 scales_.outer_direction, lambda);
+  const PolyPoint v = normalised(*ray, scales_.outer_position_mm, scales_.outer_direction, lambda);
   for (int i = 0; i < 4; ++i) {
     if (std::abs(v[i]) > kDomainLimit) return std::nullopt;
   }
@@ -697,7 +740,7 @@ void LensFit::check_matches(const Prescription& lens) const {
 std::string LensFit::to_string() const {
   std::ostringstream os;
   os << "LensFit{lens=\"" << lens_name_ << "\", hash=" << lens_hash_ << ", degree=" << options_.degree
-     << ", terms=" << options_.terms << ", sensor_to_outer=" << sensor_to_outer_ << ", outer_to_sensor="
+     << ", terms=" << term_budget_ << ", sensor_to_outer=" << sensor_to_outer_ << ", outer_to_sensor="
      << outer_to_sensor_ << ", clip_surfaces=" << clip_.size() << ", " << errors_.to_string() << "}";
   return os.str();
 }

@@ -90,6 +90,7 @@ class FitReader {
       r.fail("outputs", "expected " + std::to_string(outputs) + " outputs, got " + std::to_string(names));
     }
     const std::size_t count = r.get_array_size("terms");
+    if (count == 0) r.fail("terms", "expected at least one term");
     if (r.get_array_size("coefficients") != count) {
       r.fail("coefficients", "expected one row per term (" + std::to_string(count) + ")");
     }
@@ -154,6 +155,7 @@ std::string LensFit::to_json() const {
   root["lens"] = {{"name", lens_name_}, {"prescription_hash", lens_hash_}};
   json options = {{"degree", options_.degree},
                   {"terms", options_.terms},
+                  {"term_budget", term_budget_},
                   {"training_rays", options_.training_rays},
                   {"test_rays", options_.test_rays},
                   {"seed", options_.seed},
@@ -179,6 +181,9 @@ std::string LensFit::to_json() const {
                     {"entrance_per_stop", pupils_.entrance_per_stop},
                     {"z_exit_pupil_mm", pupils_.z_exit_pupil_mm},
                     {"exit_per_stop", pupils_.exit_per_stop}};
+  root["front_surface"] = {{"curvature_per_mm", front_.curvature_per_mm},
+                           {"conic", front_.conic},
+                           {"even_asphere", front_.even_asphere}};
   root["maps"] = {
       {"sensor_to_outer", map_to_json(sensor_to_outer_, {"position on the outer plane, mm", "direction on the outer plane"})},
       {"sensor_to_clip", map_to_json(sensor_clip_, clip_names(clip_))},
@@ -231,7 +236,8 @@ LensFit LensFit::parse(std::string_view text, const std::string& file_name) {
     JsonObjectReader o = in.object(top, "options");
     LensFitOptions& opt = fit.options_;
     opt.degree = in.integer(o, "degree", 1, kMaxPolyDegree);
-    opt.terms = in.integer(o, "terms", 1, 1 << 20);
+    opt.terms = in.integer(o, "terms", 0, 1 << 20);
+    fit.term_budget_ = in.integer(o, "term_budget", 1, 1 << 20);
     opt.training_rays = in.integer(o, "training_rays", 1, 1 << 30);
     opt.test_rays = in.integer(o, "test_rays", 1, 1 << 30);
     const json* seed = o.get("seed");
@@ -243,7 +249,7 @@ LensFit LensFit::parse(std::string_view text, const std::string& file_name) {
     if (o.has("f_number")) opt.f_number = in.positive(o, "f_number");
     opt.pupil_margin = in.positive(o, "pupil_margin");
     opt.aperture_margin = in.positive(o, "aperture_margin");
-    o.finish({"degree", "terms", "training_rays", "test_rays", "seed", "min_wavelength_nm", "max_wavelength_nm",
+    o.finish({"degree", "terms", "term_budget", "training_rays", "test_rays", "seed", "min_wavelength_nm", "max_wavelength_nm",
               "image_radius_mm", "f_number", "pupil_margin", "aperture_margin"});
     if (!(opt.max_wavelength_nm > opt.min_wavelength_nm)) o.fail("max_wavelength_nm", "must exceed min_wavelength_nm");
   }
@@ -282,6 +288,18 @@ LensFit LensFit::parse(std::string_view text, const std::string& file_name) {
     p.finish({"z_entrance_pupil_mm", "entrance_per_stop", "z_exit_pupil_mm", "exit_per_stop"});
   }
   {
+    JsonObjectReader f = in.object(top, "front_surface");
+    fit.front_.curvature_per_mm = in.finite(f, "curvature_per_mm");
+    fit.front_.conic = in.finite(f, "conic");
+    const std::size_t n = f.get_array_size("even_asphere");
+    if (n != fit.front_.even_asphere.size()) f.fail("even_asphere", "expected 8 coefficients (a2 .. a16)");
+    for (std::size_t i = 0; i < n; ++i) {
+      fit.front_.even_asphere[i] = in.number(f.child_pointer("even_asphere") + "/" + std::to_string(i),
+                                             f.child_path("even_asphere") + "[" + std::to_string(i) + "]");
+    }
+    f.finish({"curvature_per_mm", "conic", "even_asphere"});
+  }
+  {
     JsonObjectReader m = in.object(top, "maps");
     const int clip_outputs = static_cast<int>(clips);
     fit.sensor_to_outer_ = in.map(m, "sensor_to_outer", 2, true);
@@ -316,7 +334,7 @@ LensFit LensFit::parse(std::string_view text, const std::string& file_name) {
     t.finish({"fit_seconds", "exact_ns_per_ray", "poly_ns_per_ray"});
   }
   top.finish({"format", "version", "lens", "options", "sensor_plane_z_mm", "image_radius_mm", "clip_surfaces", "scales",
-              "pupils", "maps", "test_errors", "timing"});
+              "pupils", "front_surface", "maps", "test_errors", "timing"});
   return fit;
 }
 

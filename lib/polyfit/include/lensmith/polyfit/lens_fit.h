@@ -5,14 +5,17 @@
 //   sensor plane  z = sensor_plane_z_mm(), the paraxial focus of the lens (primary wavelength, the
 //                 prescription's object distance); a camera that focuses elsewhere moves its sensor
 //                 and carries the rays there in a straight line, which is exact in air;
-//   outer plane   z = 0, the tangent plane at the vertex of surface 1 (the "outer pupil").
-// A ray on a plane is PlaneRay: where it crosses the plane (mm) and the x, y components of its unit
-// direction taken along the light's travel toward the image (+z), so the same four numbers describe
-// the line whichever way it is traced.
+//   outer pupil   surface 1 itself: a ray is taken where it meets the front surface (as Schrade et
+//                 al. 2016 take the outer pupil on the front element). A plane in front of the lens
+//                 would do for most lenses but not for fisheyes, whose object-side rays run nearly
+//                 parallel to any such plane.
+// A ray there is PlaneRay: its x, y where it crosses the plane or the front surface (mm; z follows
+// from the surface's sag) and the x, y components of its unit direction taken along the light's
+// travel toward the image (+z), so the same four numbers describe the line whichever way it is traced.
 //
 // Maps, each a rotation-invariant polynomial (rotational_map.h: out = A p + B d with A, B polynomials
 // in |p|^2, p.d, |d|^2 and the wavelength) with its own greedily chosen term set:
-//   sensor -> outer:  position and direction on the outer plane;
+//   sensor -> outer:  position and direction on the outer pupil;
 //   sensor -> clip:   position on every clipping surface (the stop first), from the sensor ray;
 //   outer -> sensor:  position and direction on the sensor plane;
 //   outer -> clip:    position on the same clipping surfaces, from the outer ray;
@@ -45,7 +48,11 @@ namespace lensmith {
 
 struct LensFitOptions {
   int degree = 7;              // highest total degree of a term, 1..kMaxPolyDegree
-  int terms = 40;              // term budget per output (shared by the outputs of a map), >= 1
+  // Term budget per output (shared by the outputs of a map), >= 1; 0 = automatic: 3 per surface less
+  // 3, within 12..40. Why: the exact tracer costs about 24 ns per surface and a term about 0.6 ns
+  // (docs/performance.md), so this keeps a fit at least 10 times faster than tracing on any machine
+  // where both scale alike, and short lenses, whose aberrations are simpler, need fewer terms.
+  int terms = 0;
   int training_rays = 30000;   // rays the coefficients are fitted to, >= 200
   int test_rays = 10000;       // held-out rays (a different random stream) the errors are measured on, >= 100
   std::uint64_t seed = 2016;   // training stream; the test stream is derived from it
@@ -84,7 +91,7 @@ struct ClipSurface {
 // Position and direction errors are lengths of the 2-D error vectors (not per component).
 struct LensFitErrors {
   int test_rays = 0;                   // passing test rays the errors are taken over
-  double position_rms_um = 0.0;        // sensor -> outer: position on the outer plane
+  double position_rms_um = 0.0;        // sensor -> outer: position on the outer pupil (surface 1)
   double position_p99_um = 0.0;
   double direction_rms_mrad = 0.0;     // sensor -> outer: direction (1e-3 of a unit direction component)
   double stop_rms_um = 0.0;            // sensor -> outer: position on the stop
@@ -100,7 +107,7 @@ struct LensFitErrors {
 };
 
 // Times measured when the fit was made, on one thread, for the same held-out rays from the sensor to
-// the outer plane: the exact tracer's batch path (unclipped) and the fit's batch evaluation of all
+// the outer pupil: the exact tracer's batch path (unclipped) and the fit's batch evaluation of all
 // sensor -> outer ray (no clipping). Median of 5 runs.
 struct LensFitTiming {
   double fit_seconds = 0.0;  // sampling, term selection and coefficients, all threads
@@ -151,6 +158,8 @@ class LensFit {
   // Traces training and test rays through `lens` (materials resolved) and fits every map. Reports
   // progress in [0, 1] when given. Throws OptionsError, FitError (too few rays pass the lens) and what
   // the tracer throws.
+  // The automatic term budget for a lens of `surfaces` surfaces (LensFitOptions::terms = 0).
+  static int automatic_term_budget(std::size_t surfaces);
   static LensFit fit(const Prescription& lens, const LensFitOptions& options = {},
                      const std::function<void(double)>& progress = {});
 
@@ -170,6 +179,7 @@ class LensFit {
   const std::string& lens_name() const { return lens_name_; }
   const std::string& lens_hash() const { return lens_hash_; }
   const LensFitOptions& options() const { return options_; }
+  int term_budget() const { return term_budget_; }  // the budget used (options().terms or the automatic one)
   double sensor_plane_z_mm() const { return sensor_z_mm_; }
   double image_radius_mm() const { return image_radius_mm_; }
   int stop_surface() const { return clip_.front().surface; }
@@ -203,7 +213,10 @@ class LensFit {
   // entrance-pupil image of the stop point.
   FitAim aim_from_object(const ObjectPoint& object, double stop_x_mm, double stop_y_mm, double wavelength_nm,
                          std::optional<std::array<double, 2>> guess = {}, const FitAimOptions& options = {}) const;
-  // Where the fitted outer-plane ray through (x, y) (mm) from `object` crosses the stop (mm); empty
+  // The ray from `object` to the point of the front surface above (x, y) (mm), as the outer maps take
+  // it; empty when the object point is not in front of that point or (x, y) is off the surface.
+  std::optional<PlaneRay> outer_ray_from_object(const ObjectPoint& object, double x_mm, double y_mm) const;
+  // Where the fitted outer ray through (x, y) (mm) from `object` crosses the stop (mm); empty
   // when that ray lies outside the fit's domain. The residual of aim_from_object, for callers that
   // iterate with a Jacobian of their own (a chord method across a pupil).
   std::optional<std::array<double, 2>> stop_from_object(const ObjectPoint& object, double x_mm, double y_mm,
@@ -235,21 +248,33 @@ class LensFit {
   };
   const Scales& scales() const { return scales_; }
   const Pupils& pupils() const { return pupils_; }
+  // The shape of surface 1 (the outer pupil): z = sag(r) with the surface's conic and even asphere.
+  struct FrontSurface {
+    double curvature_per_mm = 0.0;
+    double conic = 0.0;
+    std::array<double, 8> even_asphere{};  // a2 .. a16 as in Surface
+    friend bool operator==(const FrontSurface&, const FrontSurface&) = default;
+  };
+  const FrontSurface& front_surface() const { return front_; }
 
  private:
   LensFit() = default;
+  // Sag of the front surface at r^2 (mm) and optionally dz / d(r^2); empty beyond the conic's domain.
+  std::optional<double> front_sag(double r2, double* dz_dr2) const;
   FitTrace evaluate(const RotationalMap& map, const RotationalMap& clip, double position_scale, double direction_scale,
                     const PlaneRay& in, double wavelength_nm, std::optional<double> stop_radius_mm) const;
 
   std::string lens_name_;
   std::string lens_hash_;
   LensFitOptions options_;
+  int term_budget_ = 0;
   double sensor_z_mm_ = 0.0;
   double image_radius_mm_ = 0.0;
   std::vector<ClipSurface> clip_;
   Scales scales_;
   Pupils pupils_;
-  RotationalMap sensor_to_outer_;  // outputs: position, direction on the outer plane
+  FrontSurface front_;
+  RotationalMap sensor_to_outer_;  // outputs: position, direction on the outer pupil
   RotationalMap sensor_clip_;      // outputs: position on each clip surface
   RotationalMap outer_to_sensor_;  // outputs: position, direction on the sensor plane
   RotationalMap outer_clip_;       // outputs: position on each clip surface
