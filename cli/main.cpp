@@ -244,7 +244,7 @@ int main(int argc, char** argv) {
       "fit", "Fit the lens's ray mapping with polynomials (polynomial optics): held-out errors, speed, a fit file");
   fit_cmd->add_option("lens", fit.lens, "Lens file or shipped lens name")->required();
   fit_cmd->add_option("--degree", fit.degree, "Highest total degree of a term (1-11, default 7)")->check(CLI::Range(1, 11));
-  fit_cmd->add_option("--terms", fit.terms, "Term budget per output (1-1000; default: 3 per surface less 3, within 12-40)")
+  fit_cmd->add_option("--terms", fit.terms, "Term budget per output (1-1000; default: 5 per surface less 12, within 12-40)")
       ->check(CLI::Range(1, 1000));
   fit_cmd->add_option("--training-rays", fit.training_rays, "Rays the fit is made from (200-10000000, default 30000)")
       ->check(CLI::Range(200, 10000000));

@@ -218,7 +218,7 @@ std::array<double, 2> damped_newton(std::array<double, 2> u, const Residual& res
 }  // namespace
 
 int LensFit::automatic_term_budget(std::size_t surfaces) {
-  return std::clamp(3 * static_cast<int>(surfaces) - 3, 12, 40);
+  return std::clamp(5 * static_cast<int>(surfaces) - 12, 12, 40);
 }
 
 void LensFitOptions::validate() const {
@@ -530,24 +530,11 @@ void LensFit::outer_rays(std::span<const double> x_mm, std::span<const double> y
       out_x_mm.size() != count || out_y_mm.size() != count || out_dx.size() != count || out_dy.size() != count) {
     throw FitError("LensFit::outer_rays: every span must hold the same number of rays");
   }
-  // Chunks with their normalised inputs and the clipping outputs on the stack.
-  constexpr std::size_t kChunk = 256;
-  alignas(64) double nx[kChunk], ny[kChunk], ndx[kChunk], ndy[kChunk], nl[kChunk];
   const double ps = 1.0 / scales_.sensor_position_mm, ds = 1.0 / scales_.sensor_direction;
-  const double lc = scales_.wavelength_centre_nm, ls = 1.0 / scales_.wavelength_half_range_nm;
-  for (std::size_t start = 0; start < count; start += kChunk) {
-    const std::size_t n = std::min(kChunk, count - start);
-    for (std::size_t i = 0; i < n; ++i) {
-      nx[i] = x_mm[start + i] * ps;
-      ny[i] = y_mm[start + i] * ps;
-      ndx[i] = dx[start + i] * ds;
-      ndy[i] = dy[start + i] * ds;
-      nl[i] = (wavelength_nm[start + i] - lc) * ls;
-    }
-    const std::array<double*, 4> out{out_x_mm.data() + start, out_y_mm.data() + start, out_dx.data() + start,
-                                     out_dy.data() + start};
-    sensor_to_outer_.evaluate_batch({nx, ny, ndx, ndy, nl}, out, n);
-  }
+  const double ls = 1.0 / scales_.wavelength_half_range_nm;
+  const std::array<double*, 4> out{out_x_mm.data(), out_y_mm.data(), out_dx.data(), out_dy.data()};
+  sensor_to_outer_.evaluate_batch({x_mm.data(), y_mm.data(), dx.data(), dy.data(), wavelength_nm.data()}, out, count,
+                                  {ps, ps, ds, ds, ls}, {0.0, 0.0, 0.0, 0.0, -scales_.wavelength_centre_nm * ls});
 }
 
 FitAim LensFit::aim_from_sensor(double x_mm, double y_mm, double stop_x_mm, double stop_y_mm, double wavelength_nm,

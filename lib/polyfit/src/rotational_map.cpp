@@ -237,6 +237,19 @@ RotationalMap::RotationalMap(std::vector<InvariantTerm> terms, int outputs, std:
     degree_ = std::max(degree_, t.total_degree());
     for (int i = 0; i < kInvariants; ++i) max_exponent_[i] = std::max<int>(max_exponent_[i], t.exponents[i]);
   }
+  for (const RayFactor pass : {RayFactor::kPosition, RayFactor::kDirection, RayFactor::kOne}) {
+    for (std::size_t t = 0; t < terms_.size(); ++t) {
+      if (terms_[t].factor != pass) continue;
+      std::array<std::uint32_t, 4> offsets{};
+      for (int i = 0; i < kInvariants; ++i) {
+        offsets[static_cast<std::size_t>(i)] =
+            static_cast<std::uint32_t>((i * (kMaxPolyDegree + 1) + terms_[t].exponents[static_cast<std::size_t>(i)]) * kBlock);
+      }
+      batch_offsets_.push_back(offsets);
+      for (int k = 0; k < outputs_; ++k) batch_coefficients_.push_back(coefficient(t, k));
+    }
+    if (pass == RayFactor::kPosition) batch_position_terms_ = batch_offsets_.size();
+  }
 }
 
 void RotationalMap::evaluate(const PolyPoint& v, std::span<double> out) const {
@@ -310,17 +323,78 @@ void RotationalMap::evaluate_with_jacobian(const PolyPoint& v, int k, std::array
   }
 }
 
-void RotationalMap::evaluate_batch(const std::array<const double*, kPolyVariables>& in, std::span<double* const> out,
-                                   std::size_t count) const {
+namespace {
+
+// Accumulates the block's A and B (or scalar) sums. Two outputs (the ray maps) take a register-
+// blocked path: 16 rays at a time, the four sums in registers, each monomial used as soon as it is
+// formed; other maps form each monomial once and add it to every output.
+void accumulate(const double* pw, const std::array<std::uint32_t, 4>* offsets, const double* coefficients,
+                std::size_t first_terms, std::size_t all_terms, int outputs, bool vector, double (*acc)[kBlock]) {
+  constexpr std::size_t kSub = 16;
+  if (vector && outputs == 2) {
+    // Sum of the terms [from, to) into x, y (16 rays each), kept in registers.
+    const auto sum = [&](std::size_t s, std::size_t from, std::size_t to, double* __restrict x, double* __restrict y) {
+      double u[kSub] = {}, v[kSub] = {};
+      for (std::size_t t = from; t < to; ++t) {
+        const auto& o = offsets[t];
+        const double* p0 = pw + o[0] + s;
+        const double* p1 = pw + o[1] + s;
+        const double* p2 = pw + o[2] + s;
+        const double* p3 = pw + o[3] + s;
+        const double c0 = coefficients[2 * t], c1 = coefficients[2 * t + 1];
+        for (std::size_t r = 0; r < kSub; ++r) {
+          const double m = p0[r] * p1[r] * p2[r] * p3[r];
+          u[r] += c0 * m;
+          v[r] += c1 * m;
+        }
+      }
+      for (std::size_t r = 0; r < kSub; ++r) {
+        x[r] = u[r];
+        y[r] = v[r];
+      }
+    };
+    for (std::size_t s = 0; s < kBlock; s += kSub) {
+      sum(s, 0, first_terms, acc[0] + s, acc[1] + s);
+      sum(s, first_terms, all_terms, acc[2] + s, acc[3] + s);
+    }
+    return;
+  }
+  const int accumulators = vector ? 2 * outputs : outputs;
+  for (int k = 0; k < accumulators; ++k) std::fill(acc[k], acc[k] + kBlock, 0.0);
+  alignas(64) double m[kBlock];
+  for (std::size_t t = 0; t < all_terms; ++t) {
+    const auto& o = offsets[t];
+    for (std::size_t r = 0; r < kBlock; ++r) m[r] = pw[o[0] + r] * pw[o[1] + r] * pw[o[2] + r] * pw[o[3] + r];
+    const int offset = vector && t >= first_terms ? outputs : 0;
+    for (int k = 0; k < outputs; ++k) {
+      const double ck = coefficients[t * static_cast<std::size_t>(outputs) + static_cast<std::size_t>(k)];
+      double* a = acc[offset + k];
+      for (std::size_t r = 0; r < kBlock; ++r) a[r] += ck * m[r];
+    }
+  }
+}
+
+// The whole batch: per block, the invariants and their powers, the sums, and out = A p + B d. With
+// GCC on x86-64 it is built twice, for AVX2+FMA (x86-64-v3) and the baseline, and chosen at load time,
+// as the splat buffer's inner loop is.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+__attribute__((target_clones("arch=x86-64-v3", "default")))
+#endif
+void evaluate_blocks(const std::array<const double*, kPolyVariables>& in, double* const* out, std::size_t count,
+                     const std::array<double, kPolyVariables>& scale, const std::array<double, kPolyVariables>& offset,
+                     const std::array<int, 4>& max_exponent, const std::array<std::uint32_t, 4>* offsets,
+                     const double* coefficients, std::size_t first_terms, std::size_t all_terms, int outputs,
+                     bool vector) {
   alignas(64) double pw[kInvariants][kMaxPolyDegree + 1][kBlock];
   alignas(64) double acc[2 * kMaxMapOutputs][kBlock];  // A_k, then B_k (vector maps)
-  alignas(64) double m[kBlock];
   alignas(64) double p[kPolyVariables][kBlock];
-  const int accumulators = vector_ ? 2 * outputs_ : outputs_;
   for (std::size_t start = 0; start < count; start += kBlock) {
     const std::size_t n = std::min(kBlock, count - start);
     for (int i = 0; i < kPolyVariables; ++i) {
-      for (std::size_t r = 0; r < kBlock; ++r) p[i][r] = r < n ? in[i][start + r] : 0.0;
+      const double* src = in[static_cast<std::size_t>(i)] + start;
+      const double a = scale[static_cast<std::size_t>(i)], b = offset[static_cast<std::size_t>(i)];
+      for (std::size_t r = 0; r < n; ++r) p[i][r] = src[r] * a + b;
+      for (std::size_t r = n; r < kBlock; ++r) p[i][r] = 0.0;
     }
     for (std::size_t r = 0; r < kBlock; ++r) {
       pw[0][1][r] = p[0][r] * p[0][r] + p[1][r] * p[1][r];
@@ -330,34 +404,18 @@ void RotationalMap::evaluate_batch(const std::array<const double*, kPolyVariable
     }
     for (int i = 0; i < kInvariants; ++i) {
       for (std::size_t r = 0; r < kBlock; ++r) pw[i][0][r] = 1.0;
-      for (int e = 2; e <= max_exponent_[i]; ++e) {
+      for (int e = 2; e <= max_exponent[static_cast<std::size_t>(i)]; ++e) {
         for (std::size_t r = 0; r < kBlock; ++r) pw[i][e][r] = pw[i][e - 1][r] * pw[i][1][r];
       }
     }
-    for (int k = 0; k < accumulators; ++k) std::fill(acc[k], acc[k] + kBlock, 0.0);
-    const double* c = coefficients_.data();
-    for (const InvariantTerm& t : terms_) {
-      const auto& e = t.exponents;
-      const double* p0 = pw[0][e[0]];
-      const double* p1 = pw[1][e[1]];
-      const double* p2 = pw[2][e[2]];
-      const double* p3 = pw[3][e[3]];
-      for (std::size_t r = 0; r < kBlock; ++r) m[r] = p0[r] * p1[r] * p2[r] * p3[r];
-      const int offset = t.factor == RayFactor::kDirection ? outputs_ : 0;
-      for (int k = 0; k < outputs_; ++k) {
-        const double ck = c[k];
-        double* a = acc[offset + k];
-        for (std::size_t r = 0; r < kBlock; ++r) a[r] += ck * m[r];
-      }
-      c += outputs_;
-    }
-    if (!vector_) {
-      for (int k = 0; k < outputs_; ++k) std::copy(acc[k], acc[k] + n, out[k] + start);
+    accumulate(&pw[0][0][0], offsets, coefficients, first_terms, all_terms, outputs, vector, acc);
+    if (!vector) {
+      for (int k = 0; k < outputs; ++k) std::copy(acc[k], acc[k] + n, out[k] + start);
       continue;
     }
-    for (int k = 0; k < outputs_; ++k) {
+    for (int k = 0; k < outputs; ++k) {
       const double* a = acc[k];
-      const double* b = acc[outputs_ + k];
+      const double* b = acc[outputs + k];
       double* ox = out[2 * k] + start;
       double* oy = out[2 * k + 1] + start;
       for (std::size_t r = 0; r < n; ++r) {
@@ -366,6 +424,15 @@ void RotationalMap::evaluate_batch(const std::array<const double*, kPolyVariable
       }
     }
   }
+}
+
+}  // namespace
+
+void RotationalMap::evaluate_batch(const std::array<const double*, kPolyVariables>& in, std::span<double* const> out,
+                                   std::size_t count, const std::array<double, kPolyVariables>& scale,
+                                   const std::array<double, kPolyVariables>& offset) const {
+  evaluate_blocks(in, out.data(), count, scale, offset, max_exponent_, batch_offsets_.data(), batch_coefficients_.data(),
+                  vector_ ? batch_position_terms_ : batch_offsets_.size(), batch_offsets_.size(), outputs_, vector_);
 }
 
 std::string RotationalMap::to_string() const {

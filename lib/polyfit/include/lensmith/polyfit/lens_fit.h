@@ -48,10 +48,10 @@ namespace lensmith {
 
 struct LensFitOptions {
   int degree = 7;              // highest total degree of a term, 1..kMaxPolyDegree
-  // Term budget per output (shared by the outputs of a map), >= 1; 0 = automatic: 3 per surface less
-  // 3, within 12..40. Why: the exact tracer costs about 24 ns per surface and a term about 0.6 ns
-  // (docs/performance.md), so this keeps a fit at least 10 times faster than tracing on any machine
-  // where both scale alike, and short lenses, whose aberrations are simpler, need fewer terms.
+  // Term budget per output (shared by the outputs of a map), >= 1; 0 = automatic: 5 per surface less
+  // 12, within 12..40. Why: the exact tracer costs about 24 ns per surface per ray and a fit about
+  // 5 ns plus 0.4 ns per term (docs/performance.md), so this keeps a fit over 10 times faster than
+  // tracing where both scale alike; short lenses, whose aberrations are simpler, need fewer terms.
   int terms = 0;
   int training_rays = 30000;   // rays the coefficients are fitted to, >= 200
   int test_rays = 10000;       // held-out rays (a different random stream) the errors are measured on, >= 100

@@ -73,8 +73,10 @@ class RotationalMap {
   // Batch, structure of arrays: in[i] holds `count` values of variable i; out has one pointer per
   // output value (2 per vector output, as in evaluate()). Blocks of rays together, vectorisable,
   // allocation-free.
+  // `scale` and `offset`, when given, normalise the inputs on the fly: v_i = in_i * scale_i + offset_i.
   void evaluate_batch(const std::array<const double*, kPolyVariables>& in, std::span<double* const> out,
-                      std::size_t count) const;
+                      std::size_t count, const std::array<double, kPolyVariables>& scale = {1, 1, 1, 1, 1},
+                      const std::array<double, kPolyVariables>& offset = {}) const;
 
   std::string to_string() const;  // "RotationalMap{vector, outputs=2, terms=40, degree=7}"
   friend std::ostream& operator<<(std::ostream& os, const RotationalMap& m) { return os << m.to_string(); }
@@ -87,6 +89,11 @@ class RotationalMap {
   bool vector_ = false;
   int degree_ = 0;
   std::array<int, 4> max_exponent_{};
+  // The batch path's view of the terms: p terms first, then d terms (scalar maps: all), each as the
+  // offsets of its four power rows in the block's power table, with its coefficients in that order.
+  std::vector<std::array<std::uint32_t, 4>> batch_offsets_;
+  std::vector<double> batch_coefficients_;
+  std::size_t batch_position_terms_ = 0;
 };
 
 struct RotationalFitResult {
