@@ -274,6 +274,27 @@ std::string LensFitErrors::to_string() const {
   return os.str();
 }
 
+std::string LensFitTiming::to_string() const {
+  std::ostringstream os;
+  os << "LensFitTiming{fit=" << fit_seconds << " s, exact=" << exact_ns_per_ray << " ns/ray, poly=" << poly_ns_per_ray
+     << " ns/ray}";
+  return os.str();
+}
+
+std::string FitTrace::to_string() const {
+  std::ostringstream os;
+  os << "FitTrace{" << ray << ", stop=(" << stop_x_mm << ", " << stop_y_mm << ") mm, " << (passes ? "passes" : "clipped")
+     << "}";
+  return os.str();
+}
+
+std::string FitAim::to_string() const {
+  std::ostringstream os;
+  os << "FitAim{" << ray << ", " << (converged ? "converged" : "not converged") << " after " << iterations
+     << " iterations, miss=" << miss_mm << " mm}";
+  return os.str();
+}
+
 void FitAimOptions::validate() const {
   if (!(tolerance_mm > 0.0 && std::isfinite(tolerance_mm))) {
     throw OptionsError("aim tolerance must be a finite length > 0 mm, got " + format_number(tolerance_mm));

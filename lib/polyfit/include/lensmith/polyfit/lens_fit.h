@@ -107,12 +107,14 @@ struct LensFitErrors {
 };
 
 // Times measured when the fit was made, on one thread, for the same held-out rays from the sensor to
-// the outer pupil: the exact tracer's batch path (unclipped) and the fit's batch evaluation of all
-// sensor -> outer ray (no clipping). Median of 5 runs.
+// the outer pupil: the exact tracer's batch path (unclipped) and the fit's batch evaluation of the
+// sensor -> outer map (LensFit::outer_rays, no clipping). Median of 5 runs.
 struct LensFitTiming {
   double fit_seconds = 0.0;  // sampling, term selection and coefficients, all threads
   double exact_ns_per_ray = 0.0;
   double poly_ns_per_ray = 0.0;
+  std::string to_string() const;
+  friend std::ostream& operator<<(std::ostream& os, const LensFitTiming& t) { return os << t.to_string(); }
 };
 
 // Where a fitted ray goes: the ray on the far plane, where it crosses the stop, and whether every
@@ -122,6 +124,8 @@ struct FitTrace {
   double stop_x_mm = 0.0;
   double stop_y_mm = 0.0;
   bool passes = false;
+  std::string to_string() const;
+  friend std::ostream& operator<<(std::ostream& os, const FitTrace& t) { return os << t.to_string(); }
 };
 
 // A point of the scene for aiming from the object side: the direction tangents from an on-axis
@@ -146,20 +150,22 @@ struct FitAimOptions {
 struct FitAim {
   PlaneRay ray;
   // d(stop x, stop y) / d(unknown 1, unknown 2) at `ray`, row-major: the unknowns are the direction
-  // (dx, dy) for aim_from_sensor and the outer-plane position (x, y, mm) for aim_from_object.
+  // (dx, dy) for aim_from_sensor and the outer-pupil position (x, y, mm) for aim_from_object.
   std::array<double, 4> jacobian{};
   bool converged = false;
   int iterations = 0;
   double miss_mm = 0.0;
+  std::string to_string() const;
+  friend std::ostream& operator<<(std::ostream& os, const FitAim& a) { return os << a.to_string(); }
 };
 
 class LensFit {
  public:
+  // The automatic term budget for a lens of `surfaces` surfaces (LensFitOptions::terms = 0).
+  static int automatic_term_budget(std::size_t surfaces);
   // Traces training and test rays through `lens` (materials resolved) and fits every map. Reports
   // progress in [0, 1] when given. Throws OptionsError, FitError (too few rays pass the lens) and what
   // the tracer throws.
-  // The automatic term budget for a lens of `surfaces` surfaces (LensFitOptions::terms = 0).
-  static int automatic_term_budget(std::size_t surfaces);
   static LensFit fit(const Prescription& lens, const LensFitOptions& options = {},
                      const std::function<void(double)>& progress = {});
 
@@ -204,12 +210,12 @@ class LensFit {
                   std::span<const double> dy, std::span<const double> wavelength_nm, std::span<double> out_x_mm,
                   std::span<double> out_y_mm, std::span<double> out_dx, std::span<double> out_dy) const;
 
-  // Newton on the sensor -> outer map: the direction from sensor point (x, y) whose fitted ray crosses
+  // Newton on the sensor -> clip map: the direction from sensor point (x, y) whose fitted ray crosses
   // the stop at (stop_x, stop_y) (mm). The first guess aims at the paraxial exit-pupil image of the stop point.
   FitAim aim_from_sensor(double x_mm, double y_mm, double stop_x_mm, double stop_y_mm, double wavelength_nm,
                          const FitAimOptions& options = {}) const;
-  // Newton on the outer -> sensor map: the outer-plane ray from `object` whose fitted path crosses the
-  // stop at (stop_x, stop_y). `guess` is a first outer-plane position (x, y in mm); empty: the paraxial
+  // Newton on the outer -> clip map: the outer-pupil ray from `object` whose fitted path crosses the
+  // stop at (stop_x, stop_y). `guess` is a first outer-pupil position (x, y in mm); empty: the paraxial
   // entrance-pupil image of the stop point.
   FitAim aim_from_object(const ObjectPoint& object, double stop_x_mm, double stop_y_mm, double wavelength_nm,
                          std::optional<std::array<double, 2>> guess = {}, const FitAimOptions& options = {}) const;
@@ -221,7 +227,7 @@ class LensFit {
   // iterate with a Jacobian of their own (a chord method across a pupil).
   std::optional<std::array<double, 2>> stop_from_object(const ObjectPoint& object, double x_mm, double y_mm,
                                                         double wavelength_nm) const;
-  // The outer-plane position (x, y, mm) of the paraxial ray from `object` through the entrance-pupil
+  // The outer-pupil position (x, y, mm; where it crosses the plane of surface 1's vertex) of the paraxial ray from `object` through the entrance-pupil
   // image of a stop point, at the primary wavelength: the first guess of aim_from_object.
   std::array<double, 2> paraxial_outer_position(const ObjectPoint& object, double stop_x_mm, double stop_y_mm) const;
 

@@ -37,6 +37,7 @@ struct InvariantTerm {
 
   int total_degree() const;  // in (x, y, dx, dy, lambda)
   std::string to_string() const;  // "u^2*lambda*p", "v*d", "1"
+  friend std::ostream& operator<<(std::ostream& os, const InvariantTerm& t) { return os << t.to_string(); }
   friend bool operator==(const InvariantTerm&, const InvariantTerm&) = default;
   friend auto operator<=>(const InvariantTerm&, const InvariantTerm&) = default;
 };
