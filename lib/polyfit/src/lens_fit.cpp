@@ -173,6 +173,14 @@ PolyPoint normalised(const PlaneRay& r, double position_scale, double direction_
   return {r.x_mm / position_scale, r.y_mm / position_scale, r.dx / direction_scale, r.dy / direction_scale, lambda};
 }
 
+// Newton stays where the fit was made: every normalised ray coordinate within kDomainLimit.
+bool in_domain(const PolyPoint& v) {
+  for (int i = 0; i < 4; ++i) {
+    if (std::abs(v[static_cast<std::size_t>(i)]) > kDomainLimit) return false;
+  }
+  return true;
+}
+
 // The fitted 2x2 system of a Newton aim, solved; false when singular.
 bool solve2(const std::array<double, 4>& j, double fx, double fy, double& dx, double& dy) {
   const double det = j[0] * j[3] - j[1] * j[2];
@@ -392,7 +400,6 @@ LensFit LensFit::fit(const Prescription& lens, const LensFitOptions& options,
   }
   s.wavelength_centre_nm = 0.5 * (options.min_wavelength_nm + options.max_wavelength_nm);
   s.wavelength_half_range_nm = 0.5 * (options.max_wavelength_nm - options.min_wavelength_nm);
-  const auto lambda_of = [&](double nm) { return (nm - s.wavelength_centre_nm) / s.wavelength_half_range_nm; };
 
   // Each training ray counts twice: as itself for the x outputs and mirrored in x = y for the y
   // outputs, which the same polynomial must give (lens_fit.h).
@@ -401,7 +408,7 @@ LensFit LensFit::fit(const Prescription& lens, const LensFitOptions& options,
   std::vector<std::vector<std::array<double, 2>>> to_outer(2), to_sensor(2), clip(clip_count);
   std::vector<std::vector<double>> transmittance_target(1);
   for (const Candidate& c : train) {
-    const double lambda = lambda_of(c.wavelength_nm);
+    const double lambda = fit.normalised_wavelength(c.wavelength_nm);
     sensor_in.push_back(normalised(c.sensor, s.sensor_position_mm, s.sensor_direction, lambda));
     outer_in.push_back(normalised(c.outer, s.outer_position_mm, s.outer_direction, lambda));
     to_outer[0].push_back({c.outer.x_mm, c.outer.y_mm});
@@ -506,7 +513,7 @@ LensFit LensFit::fit(const Prescription& lens, const LensFitOptions& options,
 FitTrace LensFit::evaluate(const RotationalMap& map, const RotationalMap& clip, double position_scale,
                            double direction_scale, const PlaneRay& in, double wavelength_nm,
                            std::optional<double> stop_radius_mm) const {
-  const double lambda = (wavelength_nm - scales_.wavelength_centre_nm) / scales_.wavelength_half_range_nm;
+  const double lambda = normalised_wavelength(wavelength_nm);
   const PolyPoint v = normalised(in, position_scale, direction_scale, lambda);
   std::array<double, 4> ray;
   map.evaluate(v, ray);
@@ -536,7 +543,7 @@ FitTrace LensFit::from_outer(const PlaneRay& outer, double wavelength_nm, std::o
 }
 
 double LensFit::transmittance(const PlaneRay& sensor, double wavelength_nm) const {
-  const double lambda = (wavelength_nm - scales_.wavelength_centre_nm) / scales_.wavelength_half_range_nm;
+  const double lambda = normalised_wavelength(wavelength_nm);
   double t = 0.0;
   transmittance_.evaluate(normalised(sensor, scales_.sensor_position_mm, scales_.sensor_direction, lambda),
                           std::span<double>(&t, 1));
@@ -561,7 +568,7 @@ void LensFit::outer_rays(std::span<const double> x_mm, std::span<const double> y
 FitAim LensFit::aim_from_sensor(double x_mm, double y_mm, double stop_x_mm, double stop_y_mm, double wavelength_nm,
                                 const FitAimOptions& options) const {
   options.validate();
-  const double lambda = (wavelength_nm - scales_.wavelength_centre_nm) / scales_.wavelength_half_range_nm;
+  const double lambda = normalised_wavelength(wavelength_nm);
   const double ps = scales_.sensor_position_mm, ds = scales_.sensor_direction;
   // First guess: toward the paraxial exit-pupil image of the stop point.
   const double px = stop_x_mm * pupils_.exit_per_stop, py = stop_y_mm * pupils_.exit_per_stop;
@@ -575,9 +582,7 @@ FitAim LensFit::aim_from_sensor(double x_mm, double y_mm, double stop_x_mm, doub
   std::array<double, 8> jac;
   auto residual = [&](const std::array<double, 2>& u, double& ex, double& ey, std::array<double, 4>* j) {
     const PolyPoint va = normalised(PlaneRay{x_mm, y_mm, u[0], u[1]}, ps, ds, lambda);
-    for (int i = 0; i < 4; ++i) {
-      if (std::abs(va[i]) > kDomainLimit) return false;
-    }
+    if (!in_domain(va)) return false;
     // Output 0 is the stop; its Jacobian columns 2, 3 are d/d(dx, dy) in normalised units.
     if (j) {
       map.evaluate_with_jacobian(va, 0, at, jac);
@@ -606,42 +611,18 @@ std::array<double, 2> LensFit::paraxial_outer_position(const ObjectPoint& o, dou
 FitAim LensFit::aim_from_object(const ObjectPoint& o, double stop_x_mm, double stop_y_mm, double wavelength_nm,
                                 std::optional<std::array<double, 2>> guess, const FitAimOptions& options) const {
   options.validate();
-  const double lambda = (wavelength_nm - scales_.wavelength_centre_nm) / scales_.wavelength_half_range_nm;
+  const double lambda = normalised_wavelength(wavelength_nm);
   const double ps = scales_.outer_position_mm, ds = scales_.outer_direction;
-  const double w = o.inverse_depth_per_mm;
   const std::array<double, 2> start = guess ? *guess : paraxial_outer_position(o, stop_x_mm, stop_y_mm);
   const RotationalMap& map = outer_clip_;
   std::array<double, 2> at;
   std::array<double, 8> jac;
-  // The outer ray through the front-surface point above (x, y) from the object point, and the
-  // derivatives of its direction in x and y (chain rule through the sag).
-  struct Line {
-    PlaneRay ray;
-    double ddx_dx, ddy_dx, ddx_dy, ddy_dy;
-  };
-  auto line = [&](double x, double y) -> std::optional<Line> {
-    double dz_ds = 0.0;
-    const std::optional<double> z = front_sag(x * x + y * y, &dz_ds);
-    if (!z) return std::nullopt;
-    // w times the vector from the object point to the surface point (finite at w = 0).
-    const double ux = w * x - o.tan_x, uy = w * y - o.tan_y, uz = 1.0 + w * (*z - o.origin_z_mm);
-    if (uz <= 0.0) return std::nullopt;  // the object point is not in front of the surface
-    const double len = std::sqrt(ux * ux + uy * uy + uz * uz);
-    const double fx = ux / len, fy = uy / len, fz = uz / len;
-    // d(w u) / dx = (w, 0, w dz/dx), d(w u) / dy = (0, w, w dz/dy); d f = (g - f (f.g)) / |w u|.
-    const double zx = 2.0 * x * dz_ds, zy = 2.0 * y * dz_ds;
-    const double fgx = w * (fx + fz * zx), fgy = w * (fy + fz * zy);
-    return Line{PlaneRay{x, y, fx, fy}, (w - fx * fgx) / len, (0.0 - fy * fgx) / len, (0.0 - fx * fgy) / len,
-                (w - fy * fgy) / len};
-  };
   auto residual = [&](const std::array<double, 2>& u, double& ex, double& ey, std::array<double, 4>* j) {
-    const std::optional<Line> found = line(u[0], u[1]);
+    const std::optional<OuterLine> found = outer_line(o, u[0], u[1]);
     if (!found) return false;
-    const Line& l = *found;
+    const OuterLine& l = *found;
     const PolyPoint va = normalised(l.ray, ps, ds, lambda);
-    for (int i = 0; i < 4; ++i) {
-      if (std::abs(va[i]) > kDomainLimit) return false;
-    }
+    if (!in_domain(va)) return false;
     if (!j) {
       at = map.evaluate_output(va, 0);
       ex = at[0] - stop_x_mm;
@@ -664,7 +645,7 @@ FitAim LensFit::aim_from_object(const ObjectPoint& o, double stop_x_mm, double s
   };
   FitAim aim;
   const auto u = damped_newton(start, residual, options, aim);
-  const std::optional<Line> last = line(u[0], u[1]);
+  const std::optional<OuterLine> last = outer_line(o, u[0], u[1]);
   aim.ray = last ? last->ray : PlaneRay{u[0], u[1], 0.0, 0.0};
   return aim;
 }
@@ -688,25 +669,36 @@ std::optional<double> LensFit::front_sag(double r2, double* dz_dr2) const {
   return z;
 }
 
-std::optional<PlaneRay> LensFit::outer_ray_from_object(const ObjectPoint& o, double x_mm, double y_mm) const {
-  const std::optional<double> z = front_sag(x_mm * x_mm + y_mm * y_mm, nullptr);
+std::optional<LensFit::OuterLine> LensFit::outer_line(const ObjectPoint& o, double x, double y) const {
+  double dz_ds = 0.0;
+  const std::optional<double> z = front_sag(x * x + y * y, &dz_ds);
   if (!z) return std::nullopt;
+  // w times the vector from the object point to the surface point (finite at w = 0).
   const double w = o.inverse_depth_per_mm;
-  const double ux = w * x_mm - o.tan_x, uy = w * y_mm - o.tan_y, uz = 1.0 + w * (*z - o.origin_z_mm);
-  if (uz <= 0.0) return std::nullopt;
+  const double ux = w * x - o.tan_x, uy = w * y - o.tan_y, uz = 1.0 + w * (*z - o.origin_z_mm);
+  if (uz <= 0.0) return std::nullopt;  // the object point is not in front of the surface
   const double len = std::sqrt(ux * ux + uy * uy + uz * uz);
-  return PlaneRay{x_mm, y_mm, ux / len, uy / len};
+  const double fx = ux / len, fy = uy / len, fz = uz / len;
+  // d(w u) / dx = (w, 0, w dz/dx), d(w u) / dy = (0, w, w dz/dy); d f = (g - f (f.g)) / |w u|.
+  const double zx = 2.0 * x * dz_ds, zy = 2.0 * y * dz_ds;
+  const double fgx = w * (fx + fz * zx), fgy = w * (fy + fz * zy);
+  return OuterLine{PlaneRay{x, y, fx, fy}, (w - fx * fgx) / len, (0.0 - fy * fgx) / len, (0.0 - fx * fgy) / len,
+                   (w - fy * fgy) / len};
+}
+
+std::optional<PlaneRay> LensFit::outer_ray_from_object(const ObjectPoint& o, double x_mm, double y_mm) const {
+  const std::optional<OuterLine> line = outer_line(o, x_mm, y_mm);
+  if (!line) return std::nullopt;
+  return line->ray;
 }
 
 std::optional<std::array<double, 2>> LensFit::stop_from_object(const ObjectPoint& o, double x_mm, double y_mm,
                                                               double wavelength_nm) const {
   const std::optional<PlaneRay> ray = outer_ray_from_object(o, x_mm, y_mm);
   if (!ray) return std::nullopt;
-  const double lambda = (wavelength_nm - scales_.wavelength_centre_nm) / scales_.wavelength_half_range_nm;
+  const double lambda = normalised_wavelength(wavelength_nm);
   const PolyPoint v = normalised(*ray, scales_.outer_position_mm, scales_.outer_direction, lambda);
-  for (int i = 0; i < 4; ++i) {
-    if (std::abs(v[i]) > kDomainLimit) return std::nullopt;
-  }
+  if (!in_domain(v)) return std::nullopt;
   return outer_clip_.evaluate_output(v, 0);
 }
 
@@ -721,8 +713,7 @@ std::string LensFit::prescription_hash(const Prescription& lens) {
   };
   const ParaxialSystem paraxial(lens);
   const int stop = paraxial.stop_surface();
-  auto index = [&](const Glass& g, double nm) { return g.index(nm); };
-  for (const double nm : {380.0, kWavelengthD_nm, 780.0}) mix(index(lens.object_medium, nm));
+  for (const double nm : {380.0, kWavelengthD_nm, 780.0}) mix(lens.object_medium.index(nm));
   for (std::size_t k = 0; k < lens.surfaces.size(); ++k) {
     const Surface& s = lens.surfaces[k];
     mix(s.curvature_per_mm);
@@ -730,7 +721,7 @@ std::string LensFit::prescription_hash(const Prescription& lens) {
     mix(s.conic);
     for (const double a : s.even_asphere) mix(a);
     mix(static_cast<int>(k + 1) == stop ? -1.0 : s.semi_diameter_mm.value_or(kInfinity));
-    for (const double nm : {380.0, kWavelengthD_nm, 780.0}) mix(index(s.medium, nm));
+    for (const double nm : {380.0, kWavelengthD_nm, 780.0}) mix(s.medium.index(nm));
   }
   char text[17];
   std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));

@@ -267,6 +267,15 @@ class LensFit {
   LensFit() = default;
   // Sag of the front surface at r^2 (mm) and optionally dz / d(r^2); empty beyond the conic's domain.
   std::optional<double> front_sag(double r2, double* dz_dr2) const;
+  // outer_ray_from_object's ray with the derivatives of its direction in the surface point's x, y.
+  struct OuterLine {
+    PlaneRay ray;
+    double ddx_dx, ddy_dx, ddx_dy, ddy_dy;
+  };
+  std::optional<OuterLine> outer_line(const ObjectPoint& object, double x_mm, double y_mm) const;
+  double normalised_wavelength(double wavelength_nm) const {
+    return (wavelength_nm - scales_.wavelength_centre_nm) / scales_.wavelength_half_range_nm;
+  }
   FitTrace evaluate(const RotationalMap& map, const RotationalMap& clip, double position_scale, double direction_scale,
                     const PlaneRay& in, double wavelength_nm, std::optional<double> stop_radius_mm) const;
 
