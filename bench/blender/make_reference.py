@@ -34,6 +34,9 @@ GROUND_Z = -0.45
 FAR_Y = 20.0
 FAR_TOP_Z = 2.6
 OCCLUDER_Y = 1.2
+# The portrait scene (--scene portrait).
+SUBJECT_Y = 1.0
+PORTRAIT_WALL_Y = 5.0
 
 
 def parse_args():
@@ -47,6 +50,10 @@ def parse_args():
     p.add_argument("--spp", type=int, required=True, help="samples per pixel for both renders (>= 1)")
     p.add_argument("--threads", type=int, default=0, help="render threads, 0 = all (also pass blender -t)")
     p.add_argument("--seed", type=int, default=0, help="Cycles seed, the same for both renders")
+    p.add_argument("--scene", choices=["street", "portrait"], default="street",
+                   help="street: posts and a sign at 1.2 m, walls at 3 and 20 m, string lights (default); "
+                        "portrait: a sharp striped bar, a checkered disc and a thin rod at 1 m over a "
+                        "textured wall at 5 m with highlights (the sharp-subject case)")
     p.add_argument("--skip-pinhole", action="store_true",
                    help="render only reference.exr (reuse an existing DIR/pinhole.exr)")
     a = p.parse_args(argv)
@@ -140,6 +147,22 @@ def noise_colour(scale, c1, c2):
     return fn
 
 
+def stripe_colour(scale, c1, c2):
+    """Horizontal stripes with hard edges: a checker that varies along z only."""
+    def fn(nodes, links, target):
+        tc = nodes.new("ShaderNodeTexCoord")
+        mapping = nodes.new("ShaderNodeMapping")
+        mapping.inputs["Scale"].default_value = (0.0, 0.0, 1.0)
+        ch = nodes.new("ShaderNodeTexChecker")
+        ch.inputs["Scale"].default_value = scale
+        ch.inputs["Color1"].default_value = (*c1, 1)
+        ch.inputs["Color2"].default_value = (*c2, 1)
+        links.new(tc.outputs["Object"], mapping.inputs["Vector"])
+        links.new(mapping.outputs["Vector"], ch.inputs["Vector"])
+        links.new(ch.outputs["Color"], target)
+    return fn
+
+
 def flat_colour(rgb):
     def fn(nodes, links, target):
         target.default_value = (*rgb, 1)
@@ -200,27 +223,91 @@ def sphere(name, centre, radius, mat):
     return ob
 
 
+def sky_and_sun(name, sky_rgb, sun_energy, sun_angle_deg, sun_rgb, tilt_deg, turn_deg):
+    """A constant world colour (no texture), which also lights the scene softly, and a sun lamp
+    rotated tilt_deg about x, then turn_deg about z."""
+    scene = bpy.context.scene
+    world = bpy.data.worlds.new(name)
+    world.use_nodes = True
+    bg = world.node_tree.nodes["Background"]
+    bg.inputs["Color"].default_value = (*sky_rgb, 1)
+    bg.inputs["Strength"].default_value = 1.0
+    scene.world = world
+    sun_data = bpy.data.lights.new("sun", type="SUN")
+    sun_data.energy = sun_energy
+    sun_data.angle = math.radians(sun_angle_deg)
+    sun_data.color = sun_rgb
+    sun = bpy.data.objects.new("sun", sun_data)
+    sun.rotation_euler = (math.radians(tilt_deg), 0.0, math.radians(turn_deg))
+    scene.collection.objects.link(sun)
+
+
 def build_scene(args):
+    """Builds the chosen scene and the camera; returns (camera, highlights, planar depths)."""
     scene = bpy.context.scene
     for ob in list(bpy.data.objects):
         bpy.data.objects.remove(ob, do_unlink=True)
+    lights, depths = (build_portrait if args.scene == "portrait" else build_street)(args)
+    for name, centre, radius, rgb, strength in lights:
+        sphere(name, centre, radius, emission("em_" + name, rgb, strength))
 
-    # Dusk sky (no texture: a constant world colour), which also lights the scene softly.
-    world = bpy.data.worlds.new("dusk")
-    world.use_nodes = True
-    bg = world.node_tree.nodes["Background"]
-    bg.inputs["Color"].default_value = (0.06, 0.09, 0.22, 1)
-    bg.inputs["Strength"].default_value = 1.0
-    scene.world = world
+    cam_data = bpy.data.cameras.new("camera")
+    cam_data.lens = FOCAL_LENGTH_MM
+    cam_data.sensor_width = SENSOR_WIDTH_MM
+    cam_data.sensor_fit = "HORIZONTAL"
+    cam_data.clip_start = 0.05
+    cam_data.clip_end = 1000.0
+    cam = bpy.data.objects.new("camera", cam_data)
+    cam.location = (0.0, 0.0, 0.0)
+    cam.rotation_euler = (math.radians(90.0), 0.0, 0.0)  # look along +Y, up +Z
+    scene.collection.objects.link(cam)
+    scene.camera = cam
+    return cam, lights, depths
 
-    # A low sun from behind the camera, up and to the left: the post casts a shadow on the wall.
-    sun_data = bpy.data.lights.new("sun", type="SUN")
-    sun_data.energy = 2.5
-    sun_data.angle = math.radians(2.0)
-    sun_data.color = (1.0, 0.85, 0.7)
-    sun = bpy.data.objects.new("sun", sun_data)
-    sun.rotation_euler = (math.radians(60.0), 0.0, math.radians(-20.0))  # light travels +x, +y, -z
-    scene.collection.objects.link(sun)
+
+def build_portrait(args):
+    """The sharp-subject case: patterned foreground at 1 m, in focus, over a textured wall at 5 m.
+
+    Every subject face is a quad at planar depth exactly SUBJECT_Y facing the camera, so its depth is
+    one value and it is in focus when --focus is SUBJECT_Y. Its patterns have hard edges in every
+    direction (horizontal stripes, a checker, a diagonal rod) and colours the wall does not have.
+    """
+    sky_and_sun("overcast", (0.35, 0.38, 0.42), 2.0, 3.0, (1.0, 0.9, 0.8), 50.0, -30.0)
+
+    # The wall fills the frame at 5 m (half-width 1.8 m, half-height 1.2 m at 600 x 400).
+    wall = diffuse("bricks", brick_colour)
+    quad_xz("wall_5m", PORTRAIT_WALL_Y, -4.0, 4.0, -3.0, 3.0, wall)
+    # A striped bar (2 cm horizontal stripes, cream and dark blue), full height.
+    stripes = diffuse("stripes", stripe_colour(50.0, (0.75, 0.72, 0.6), (0.03, 0.05, 0.2)))
+    quad_xz("bar", SUBJECT_Y, -0.16, -0.06, -1.0, 1.0, stripes)
+    # A checkered disc (a head) on a neck, and a thin diagonal rod.
+    checks = diffuse("checks", checker_colour(40.0, (0.8, 0.15, 0.5), (0.05, 0.3, 0.1)))
+    bpy.ops.mesh.primitive_circle_add(vertices=128, radius=0.075, fill_type="NGON",
+                                      location=(0.1, SUBJECT_Y, 0.05), rotation=(math.radians(90.0), 0.0, 0.0))
+    head = bpy.context.active_object
+    head.name = "head"
+    head.data.materials.append(checks)
+    neck = diffuse("neck", flat_colour((0.6, 0.35, 0.2)))
+    quad_xz("neck", SUBJECT_Y + 0.002, 0.08, 0.12, -1.0, -0.02, neck)  # 2 mm behind the head: no z-fighting
+    rod = diffuse("rod", flat_colour((0.9, 0.8, 0.1)))
+    quad("rod", [(0.2, SUBJECT_Y, -0.3), (0.204, SUBJECT_Y, -0.3), (0.334, SUBJECT_Y, 0.2), (0.33, SUBJECT_Y, 0.2)], rod)
+    # Highlights on the wall, some just behind the subject's edges, and one on the subject.
+    # wall_a lies 8 px left of the bar's silhouette, wall_b behind the bar, wall_c behind the head.
+    lights = [("wall_a", (-0.84, PORTRAIT_WALL_Y - 0.02, 0.3), 0.012, (1.0, 0.9, 0.7), 100.0),
+              ("wall_b", (-0.5, PORTRAIT_WALL_Y - 0.02, -0.2), 0.012, (0.3, 0.5, 1.0), 150.0),
+              ("wall_c", (0.75, PORTRAIT_WALL_Y - 0.02, 0.1), 0.012, (1.0, 0.3, 0.2), 150.0),
+              ("wall_d", (1.2, PORTRAIT_WALL_Y - 0.02, -0.6), 0.012, (1.0, 1.0, 0.9), 80.0),
+              ("wall_e", (-1.3, PORTRAIT_WALL_Y - 0.02, -0.7), 0.012, (0.4, 1.0, 0.5), 120.0),
+              ("subject_glint", (0.09, SUBJECT_Y - 0.002, 0.08), 0.0014, (1.0, 1.0, 1.0), 60.0)]
+    depths = {"subject_faces": SUBJECT_Y, "wall": PORTRAIT_WALL_Y}
+    return lights, depths
+
+
+def build_street(args):
+    """Posts and a round sign at 1.2 m, a brick wall at 3 m over a checker ground, a far wall at 20 m."""
+    # Dusk sky, and a low sun from behind the camera, up and to the left (light travels +x, +y, -z):
+    # the post casts a shadow on the wall.
+    sky_and_sun("dusk", (0.06, 0.09, 0.22), 2.5, 2.0, (1.0, 0.85, 0.7), 60.0, -20.0)
 
     wall = diffuse("bricks", brick_colour)
     quad_xz("wall_3m", WALL_Y, -2.0, 2.0, GROUND_Z, WALL_TOP_Z, wall)
@@ -255,21 +342,10 @@ def build_scene(args):
                ("post_bolt", (-0.26, OCCLUDER_Y - 0.002, 0.05), 0.0017, (1.0, 0.95, 0.9), 100.0),
                ("post_led", (-0.26, OCCLUDER_Y - 0.002, -0.20), 0.0017, (0.1, 1.0, 0.9), 120.0),
                ("sign_glint", (0.26, OCCLUDER_Y - 0.002, -0.08), 0.0017, (1.0, 1.0, 1.0), 60.0)]
-    for name, centre, radius, rgb, strength in lights:
-        sphere(name, centre, radius, emission("em_" + name, rgb, strength))
-
-    cam_data = bpy.data.cameras.new("camera")
-    cam_data.lens = FOCAL_LENGTH_MM
-    cam_data.sensor_width = SENSOR_WIDTH_MM
-    cam_data.sensor_fit = "HORIZONTAL"
-    cam_data.clip_start = 0.05
-    cam_data.clip_end = 1000.0
-    cam = bpy.data.objects.new("camera", cam_data)
-    cam.location = (0.0, 0.0, 0.0)
-    cam.rotation_euler = (math.radians(90.0), 0.0, 0.0)  # look along +Y, up +Z
-    scene.collection.objects.link(cam)
-    scene.camera = cam
-    return cam, lights
+    depths = {"occluders_front_face": OCCLUDER_Y, "wall": WALL_Y, "far_plane": FAR_Y, "sky": "1e10 (escaped rays)",
+              "ground": "z = %.2f m, visible up to %.1f m" % (GROUND_Z, WALL_Y),
+              "wall_top_z_m": WALL_TOP_Z, "far_top_z_m": FAR_TOP_Z}
+    return lights, depths
 
 
 def configure_render(args):
@@ -329,7 +405,7 @@ def render_to(path, with_z):
 def main():
     args = parse_args()
     os.makedirs(args.out, exist_ok=True)
-    cam, lights = build_scene(args)
+    cam, lights, depths = build_scene(args)
     configure_render(args)
     scene = bpy.context.scene
     focal_px = args.width * FOCAL_LENGTH_MM / SENSOR_WIDTH_MM
@@ -382,12 +458,8 @@ def main():
             "reference.exr": "thin lens, same samples and seed; R, G, B linear float32",
         },
         "depth_pass": "planar distance along the view axis (see README for the check)",
-        "scene_depths_m": {
-            "occluders_front_face": OCCLUDER_Y, "wall": WALL_Y, "far_plane": FAR_Y, "sky": "1e10 (escaped rays)",
-            "ground": "z = %.2f m, visible from about %.2f to %.1f m" % (
-                GROUND_Z, -GROUND_Z / math.tan(math.atan(args.height / 2 / focal_px)), WALL_Y),
-            "wall_top_z_m": WALL_TOP_Z, "far_top_z_m": FAR_TOP_Z,
-        },
+        "scene": args.scene,
+        "scene_depths_m": depths,
         "highlights": [
             {"name": n, "centre_m": list(c), "radius_m": r, "planar_depth_of_front_m": c[1] - r,
              "radiance_rgb": [s * v for v in rgb], "pixel_xy": pixel_of(c)}

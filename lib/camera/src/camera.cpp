@@ -153,7 +153,7 @@ void Camera::finish() {
   focus_mm_ = mm_from_m(options_.focus_distance_m);
   const FirstOrderSample ref = first_order(reference_nm_);
   z_perspective_mm_ = ref.z_entrance_pupil_mm;
-  const double w_focus = std::isinf(focus_mm_) ? 0.0 : 1.0 / focus_mm_;
+  const double w_focus = inverse_per_mm(focus_mm_);
   const double scale = 1.0 / (1.0 + (ref.z_front_principal_mm - z_perspective_mm_) * w_focus);
   if (!(scale > 0.0) || 1.0 / ref.efl_mm - w_focus * scale <= 0.0) {
     throw ComputationError("cannot focus at " + format_number(options_.focus_distance_m) +

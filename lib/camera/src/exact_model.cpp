@@ -20,7 +20,7 @@ Ray ray_towards(const ScenePoint& p, double z_perspective_mm, double target_x, d
   Ray r;
   r.wavelength_nm = wavelength_nm;
   if (p.inverse_depth_per_mm > 0.0) {
-    const double depth = 1.0 / p.inverse_depth_per_mm;
+    const double depth = distance_mm_from_inverse(p.inverse_depth_per_mm);
     r.position_mm = Eigen::Vector3d(p.tan_x * depth, p.tan_y * depth, z_perspective_mm - depth);
     r.direction = (Eigen::Vector3d(target_x, target_y, target_z) - r.position_mm).normalized();
   } else {

@@ -17,7 +17,7 @@ ReferenceSphereModel::ReferenceSphereModel(RayModelKind kind, const Camera& came
   t.object_distances_mm.clear();
   for (int k = 0; k < options.seidel_distance_samples; ++k) {
     const double inverse = (1.0 / nearest_object_mm) * k / (options.seidel_distance_samples - 1);
-    t.object_distances_mm.push_back(inverse == 0.0 ? kInfinity : 1.0 / inverse);
+    t.object_distances_mm.push_back(distance_mm_from_inverse(inverse));
   }
   t.seidel.f_number = camera.f_number();
   const PinholeFrame& f = camera.frame();
@@ -46,9 +46,8 @@ void ReferenceSphereModel::map(const ScenePoint& point, double wavelength_nm, st
 
   // Seidel: Born & Wolf's frame has y along the image point's direction from the axis (positive
   // field y0), x completing a right-handed pair; the pupil coordinate is the same in both pupils.
-  const double object_distance_mm = point.inverse_depth_per_mm > 0.0
-                                         ? 1.0 / point.inverse_depth_per_mm - camera_.z_perspective_mm()
-                                         : kInfinity;
+  // Depth is measured from the perspective centre, object distances from surface 1.
+  const double object_distance_mm = distance_mm_from_inverse(point.inverse_depth_per_mm) - camera_.z_perspective_mm();
   const AberrationCoefficients c = table_->at(wavelength_nm, std::max(object_distance_mm, 1.0)).coefficients;
   const double t_len = std::hypot(point.tan_x, point.tan_y);
   double ey_x = 0.0, ey_y = 1.0;

@@ -6,13 +6,11 @@
 #include <sstream>
 
 #include "lensmith/core/errors.h"
+#include "lensmith/core/units.h"
 
 namespace lensmith {
 
 namespace {
-
-// Inverse distance (1/mm): 0 at infinity, so far and near objects interpolate smoothly.
-double inverse_distance(double d_mm) { return std::isinf(d_mm) ? 0.0 : 1.0 / d_mm; }
 
 AberrationCoefficients lerp(const AberrationCoefficients& a, const AberrationCoefficients& b, double t) {
   auto mix = [t](double x, double y) { return x + (y - x) * t; };
@@ -72,8 +70,8 @@ AberrationTable::AberrationTable(const Prescription& lens, const AberrationTable
   }
   distances_mm_ = options.object_distances_mm;
   // Sorted by inverse distance (infinity first): the interpolation variable.
-  std::sort(distances_mm_.begin(), distances_mm_.end(), [](double a, double b) { return inverse_distance(a) < inverse_distance(b); });
-  for (double d : distances_mm_) inverse_distances_per_mm_.push_back(inverse_distance(d));
+  std::sort(distances_mm_.begin(), distances_mm_.end(), [](double a, double b) { return inverse_per_mm(a) < inverse_per_mm(b); });
+  for (double d : distances_mm_) inverse_distances_per_mm_.push_back(inverse_per_mm(d));
   samples_.reserve(wavelengths_nm_.size() * distances_mm_.size());
   for (double d : distances_mm_) {
     SpectralTableOptions spectral;
@@ -99,7 +97,7 @@ AberrationTable::AberrationTable(const Prescription& lens, const AberrationTable
 
 AberrationSample AberrationTable::at(double wavelength_nm, double object_distance_mm) const {
   const auto [i, ti] = locate(wavelengths_nm_, wavelength_nm);
-  const auto [j, tj] = locate(inverse_distances_per_mm_, inverse_distance(object_distance_mm));
+  const auto [j, tj] = locate(inverse_distances_per_mm_, inverse_per_mm(object_distance_mm));
   const std::size_t i1 = std::min(i + 1, wavelengths_nm_.size() - 1);
   const std::size_t j1 = std::min(j + 1, distances_mm_.size() - 1);
   const AberrationSample near_lambda = lerp(sample(i, j), sample(i1, j), ti);

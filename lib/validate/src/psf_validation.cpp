@@ -22,7 +22,7 @@ std::vector<double> depths_for(const Camera& camera, const PsfValidationOptions&
 
 ScenePoint scene_point(const Camera& camera, double relative_field, double depth_m) {
   const double tan_x = relative_field * 0.5 * camera.frame().width_px() / camera.frame().focal_length_px();
-  return {tan_x, 0.0, std::isinf(depth_m) ? 0.0 : 1.0 / mm_from_m(depth_m)};
+  return {tan_x, 0.0, inverse_depth_per_mm(depth_m)};
 }
 
 std::string depth_text(double depth_m) {

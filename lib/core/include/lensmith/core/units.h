@@ -2,6 +2,7 @@
 // Lens geometry is in millimetres, wavelengths in nanometres, scene depth in metres.
 #pragma once
 
+#include <cmath>
 #include <limits>
 
 namespace lensmith {
@@ -24,6 +25,12 @@ inline double nm_from_um_rounded(double micrometres) {
 }
 constexpr double um_from_mm(double millimetres) { return millimetres * 1000.0; }
 constexpr double mm_from_nm(double nanometres) { return nanometres / 1.0e6; }
+// The one conversion between a distance and its inverse (depth and object distance in the camera and
+// the aberration tables, which interpolate in 1/distance): 1/mm, with 0 for +inf both ways.
+inline double inverse_per_mm(double distance_mm) { return std::isinf(distance_mm) ? 0.0 : 1.0 / distance_mm; }
+inline double distance_mm_from_inverse(double inverse_per_mm) { return inverse_per_mm > 0.0 ? 1.0 / inverse_per_mm : kInfinity; }
+// Inverse planar depth (1/mm) of a scene depth in metres (+inf: 0).
+inline double inverse_depth_per_mm(double depth_m) { return inverse_per_mm(mm_from_m(depth_m)); }
 constexpr double rad_from_deg(double degrees) { return degrees * (kPi / 180.0); }
 constexpr double deg_from_rad(double radians) { return radians * (180.0 / kPi); }
 

@@ -1,0 +1,64 @@
+// A source pixel's footprint on the output: planned from a probe of the ray model (its size, the
+// rows it may touch, how many wavelength groups and which pupil mesh it needs), then deposited into
+// SplatBuffers as the model maps the aperture. Three ways, cheapest first:
+// - a point, for footprints under 0.2 px (the 2 px tent filter hides their shape);
+// - one uniformly lit polygon, the aperture's outline mapped by three rays, where the model is
+//   affine in the pupil (thin, paraxial) or departs from its affine fit by under 1/4 px;
+// - a pupil mesh mapped vertex by vertex: nested ring polygons where the mapped rings nest (the
+//   radial light distribution kept), else triangle by triangle (folds, caustics, vignetting).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include "lensmith/camera/ray_model.h"
+#include "lensmith/render/splat_buffer.h"
+#include "pupil_mesh_table.h"
+#include "scatter_source.h"
+#include "spectral_groups.h"
+
+namespace lensmith::render_detail {
+
+// What the planner decided for one source.
+struct FootprintPlan {
+  static constexpr int kPoint = -2;  // `outline` value of the point path
+  float y_min = 0.0f;  // rows the footprint may touch (px, with margin)
+  float y_max = 0.0f;
+  int groups = 1;      // wavelength groups
+  int mesh = -1;       // PupilMeshTable mesh index, or -1 for the single-polygon and point paths
+  int outline = 0;     // PupilMeshTable sector step (single polygon), or kPoint
+};
+
+// Per-thread scratch space, so planning and deposits allocate nothing once warm.
+struct FootprintScratch {
+  std::vector<PupilPoint> pupil;
+  std::vector<SensorHit> hits;
+  std::vector<Point2f> points;
+  std::vector<double> areas;
+};
+
+// Everything a footprint depends on besides its source; one per render, shared by the threads.
+class FootprintScatter {
+ public:
+  FootprintScatter(const RayModel& model, const Aperture& aperture, const SpectralGroups& groups,
+                   const PupilMeshTable& meshes, const BokehOptions& options);
+
+  FootprintPlan plan(const ScatterSource& s, FootprintScratch& scratch) const;
+  // Deposits the footprint: footprint-sized polygons into `buffer`, mesh triangles into `fine`
+  // (which has every sub-row). Adds the mesh triangles deposited to `triangles`.
+  void deposit(const ScatterSource& s, const FootprintPlan& p, SplatBuffer& buffer, SplatBuffer& fine,
+               FootprintScratch& scratch, std::size_t& triangles) const;
+
+ private:
+  const RayModel& model_;
+  const Camera& camera_;
+  const Aperture& aperture_;
+  const SpectralGroups& groups_;
+  const PupilMeshTable& meshes_;
+  const BokehOptions& options_;
+  // The probe: the pupil centre and 8 points on the aperture's edge, from the top anticlockwise.
+  std::array<PupilPoint, 9> probe_{};
+};
+
+}  // namespace lensmith::render_detail

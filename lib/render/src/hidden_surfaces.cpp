@@ -1,0 +1,102 @@
+#include "hidden_surfaces.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "lensmith/core/units.h"
+#include "push_pull.h"
+
+namespace lensmith::render_detail {
+
+namespace {
+// The interpolation's tone map and its inverse (capped so that the inverse stays finite).
+constexpr double kMaxTone = 0.999;
+double tone(float v) { return static_cast<double>(v) / (1.0 + static_cast<double>(v)); }
+float untone(double t) { return static_cast<float>(std::min(t, kMaxTone) / (1.0 - std::min(t, kMaxTone))); }
+}  // namespace
+
+std::vector<ScatterSource> extend_layer(const Image& image, const DepthMap& depth, const Camera& camera,
+                                        const DepthLayers& layers, int layer, double reach_px, int threads) {
+  const int w = image.width, h = image.height;
+  const std::vector<int>& layer_of = layers.layer_of;
+  // Nearer pixels within a (2 reach + 1)-pixel square of a pixel of the layer: a separable
+  // dilation, rows then columns, each line independent (threads).
+  const int reach = static_cast<int>(reach_px);
+  const int far = std::numeric_limits<int>::max() / 4;
+  std::vector<int> row_distance(static_cast<std::size_t>(w) * h);
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (int y = 0; y < h; ++y) {
+    int* d = row_distance.data() + static_cast<std::size_t>(y) * w;
+    const int* l = layer_of.data() + static_cast<std::size_t>(y) * w;
+    int last = far;
+    for (int x = 0; x < w; ++x) d[x] = l[x] == layer ? (last = 0) : (last = std::min(far, last + 1));
+    last = far;
+    for (int x = w - 1; x >= 0; --x) d[x] = std::min(d[x], l[x] == layer ? (last = 0) : (last = std::min(far, last + 1)));
+  }
+  std::vector<std::uint8_t> within(static_cast<std::size_t>(w) * h, 0);
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (int x = 0; x < w; ++x) {
+    int last = far;
+    for (int y = 0; y < h; ++y) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      last = row_distance[i] <= reach ? 0 : std::min(far, last + 1);
+      within[i] = last <= reach ? 1 : 0;
+    }
+    last = far;
+    for (int y = h - 1; y >= 0; --y) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      last = row_distance[i] <= reach ? 0 : std::min(far, last + 1);
+      within[i] = (within[i] || last <= reach) ? 1 : 0;
+    }
+  }
+  std::vector<std::size_t> targets;
+  int x0 = w, x1 = -1, y0 = h, y1 = -1;
+  for (std::size_t i = 0; i < within.size(); ++i) {
+    if (layer_of[i] > layer && within[i]) {
+      targets.push_back(i);
+      const int x = static_cast<int>(i % static_cast<std::size_t>(w)), y = static_cast<int>(i / static_cast<std::size_t>(w));
+      x0 = std::min(x0, x);
+      x1 = std::max(x1, x);
+      y0 = std::min(y0, y);
+      y1 = std::max(y1, y);
+    }
+  }
+  if (targets.empty()) return {};
+  // Push-pull over the window of the targets widened by the reach, where the layer's pixels that
+  // feed them lie.
+  x0 = std::max(0, x0 - reach);
+  y0 = std::max(0, y0 - reach);
+  x1 = std::min(w - 1, x1 + reach);
+  y1 = std::min(h - 1, y1 + reach);
+  const int ww = x1 - x0 + 1, wh = y1 - y0 + 1;
+  std::vector<std::array<double, 5>> cells(static_cast<std::size_t>(ww) * wh, std::array<double, 5>{});
+  for (int y = y0; y <= y1; ++y) {
+    for (int x = x0; x <= x1; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      if (layer_of[i] != layer) continue;
+      cells[static_cast<std::size_t>(y - y0) * ww + (x - x0)] = {tone(image.at(x, y, 0)), tone(image.at(x, y, 1)),
+                                                                  tone(image.at(x, y, 2)),
+                                                                  inverse_depth_per_mm(depth.at(x, y)), 1.0};
+    }
+  }
+  push_pull(ww, wh, cells);
+  std::vector<ScatterSource> out;
+  out.reserve(targets.size());
+  for (std::size_t i : targets) {
+    const std::size_t wx = i % static_cast<std::size_t>(w) - static_cast<std::size_t>(x0);
+    const std::size_t wy = i / static_cast<std::size_t>(w) - static_cast<std::size_t>(y0);
+    const auto& v = cells[wy * static_cast<std::size_t>(ww) + wx];
+    ScatterSource s;
+    s.x = static_cast<int>(i % static_cast<std::size_t>(w));
+    s.y = static_cast<int>(i / static_cast<std::size_t>(w));
+    s.rgb = {untone(v[0]), untone(v[1]), untone(v[2])};
+    s.inverse_depth_per_mm = v[3];
+    s.coc_px = camera.signed_coc_px(v[3]);
+    out.push_back(s);
+  }
+  return out;
+}
+
+}  // namespace lensmith::render_detail

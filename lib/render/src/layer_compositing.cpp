@@ -1,0 +1,52 @@
+#include "layer_compositing.h"
+
+#include <algorithm>
+#include <array>
+
+#include "push_pull.h"
+
+namespace lensmith::render_detail {
+
+namespace {
+// Pixels covered at least this much are known colour for filling the gaps of others (coverage of
+// a tiling of distorted footprints wanders a few per cent around 1; a pixel whose own light spread
+// away is far below).
+constexpr double kKnownCoverage = 0.9;
+// Coverage short of 1 by less than this is rounding, not a gap.
+constexpr double kGapTolerance = 1e-9;
+}  // namespace
+
+void composite_layer_over(const std::vector<float>& layer_rgba, std::vector<double>& result, int width, int row_begin,
+                          int row_end) {
+  for (std::size_t k = static_cast<std::size_t>(row_begin) * width; k < static_cast<std::size_t>(row_end) * width; ++k) {
+    double c[4] = {layer_rgba[4 * k], layer_rgba[4 * k + 1], layer_rgba[4 * k + 2], layer_rgba[4 * k + 3]};
+    if (c[3] > 1.0) {
+      for (double& v : c) v /= c[3];
+    } else if (c[3] < 0.0) {
+      continue;  // rounding of an empty region
+    }
+    const double keep = 1.0 - c[3];
+    for (std::size_t ch = 0; ch < 4; ++ch) result[4 * k + ch] = c[ch] + keep * result[4 * k + ch];
+  }
+}
+
+Image finish_composite(const std::vector<double>& result, int width, int height) {
+  std::vector<std::array<double, 5>> fill(static_cast<std::size_t>(width) * height, std::array<double, 5>{});
+  bool any_gap = false;
+  for (std::size_t k = 0; k < fill.size(); ++k) {
+    const double coverage = result[4 * k + 3];
+    any_gap = any_gap || coverage < 1.0 - kGapTolerance;
+    if (coverage >= kKnownCoverage) fill[k] = {result[4 * k], result[4 * k + 1], result[4 * k + 2], 0.0, coverage};
+  }
+  if (any_gap) push_pull(width, height, fill);
+  Image out(width, height, 3);
+  for (std::size_t k = 0; k < out.pixel_count(); ++k) {
+    const double gap = std::max(0.0, 1.0 - result[4 * k + 3]);
+    for (std::size_t c = 0; c < 3; ++c) {
+      out.data[3 * k + c] = static_cast<float>(std::max(0.0, result[4 * k + c] + (gap > 0.0 ? gap * fill[k][c] : 0.0)));
+    }
+  }
+  return out;
+}
+
+}  // namespace lensmith::render_detail

@@ -1,0 +1,53 @@
+#include "pupil_mesh_table.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "lensmith/core/units.h"
+
+namespace lensmith::render_detail {
+
+namespace {
+
+constexpr std::array<int, 9> kSectorSteps{8, 12, 16, 24, 32, 48, 64, 96, 128};
+constexpr std::array<int, 8> kRingSteps{1, 2, 3, 4, 6, 8, 12, 16};
+constexpr std::array<int, 5> kGridSteps{4, 8, 16, 32, 64};
+// Aperture::mesh's sector count, which grids do not use (it must be at least 3).
+constexpr int kGridSectorsUnused = 4;
+
+template <std::size_t N>
+int step_index(const std::array<int, N>& steps, double wanted) {
+  for (std::size_t i = 0; i < N; ++i) {
+    if (steps[i] >= wanted) return static_cast<int>(i);
+  }
+  return static_cast<int>(N) - 1;
+}
+
+}  // namespace
+
+PupilMeshTable::PupilMeshTable(const Aperture& aperture) {
+  if (aperture.kind() == Aperture::Kind::Mask) {
+    for (int cells : kGridSteps) meshes_.push_back(aperture.mesh(cells, kGridSectorsUnused));
+    return;
+  }
+  for (int rings : kRingSteps) {
+    for (int sectors : kSectorSteps) meshes_.push_back(aperture.mesh(rings, sectors));
+  }
+  for (int sectors : kSectorSteps) {
+    outlines_.push_back(aperture.outline(aperture.kind() == Aperture::Kind::Blades ? aperture.blade_count() : sectors));
+  }
+}
+
+int PupilMeshTable::sector_step(double diameter_px) {
+  // A polygon of S sectors inscribed in a circle of diameter d departs from it by d (1 - cos(pi/S)) / 2
+  // ~ d pi^2 / (4 S^2): below 0.1 px for S >= pi sqrt(2.5 d).
+  return step_index(kSectorSteps, kPi * std::sqrt(2.5 * std::max(diameter_px, 0.0)));
+}
+
+int PupilMeshTable::polar_mesh(double rings, int sector_step) {
+  return step_index(kRingSteps, rings) * static_cast<int>(kSectorSteps.size()) + sector_step;
+}
+
+int PupilMeshTable::grid_mesh(double cells) { return step_index(kGridSteps, cells); }
+
+}  // namespace lensmith::render_detail

@@ -1,0 +1,34 @@
+// The pupil meshes and outlines a render uses, built once from fixed size steps: polar meshes
+// (rings x sectors, the outer ring on the aperture's edge) for circles and blades, Cartesian grids
+// for aperture pictures, and outlines for the single-polygon footprints of affine models.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "lensmith/camera/aperture.h"
+
+namespace lensmith::render_detail {
+
+class PupilMeshTable {
+ public:
+  explicit PupilMeshTable(const Aperture& aperture);
+
+  // Step index of the sector count that keeps a polygon inscribed in a circle of this diameter (px)
+  // within 0.1 px of it.
+  static int sector_step(double diameter_px);
+  // Mesh index of a polar mesh with at least `rings` rings (capped) and the sectors of `sector_step`.
+  static int polar_mesh(double rings, int sector_step);
+  // Mesh index of a grid with at least `cells` cells per side (capped); aperture pictures only.
+  static int grid_mesh(double cells);
+
+  const PupilMesh& mesh(int index) const { return meshes_[static_cast<std::size_t>(index)]; }
+  // The outline for a sector step (blades: their corners only).
+  const std::vector<PupilPoint>& outline(int sector_step) const { return outlines_[static_cast<std::size_t>(sector_step)]; }
+
+ private:
+  std::vector<PupilMesh> meshes_;                  // polar: ring step * sector steps + sector step; masks: grid steps
+  std::vector<std::vector<PupilPoint>> outlines_;  // per sector step
+};
+
+}  // namespace lensmith::render_detail

@@ -1,0 +1,16 @@
+// Push-pull interpolation of scattered samples over a grid (Gortler, Grzeszczuk, Szeliski & Cohen,
+// "The Lumigraph", SIGGRAPH 1996, sec. 3.4): the renderer's way of guessing colour and depth where a
+// single image does not know them (behind foreground edges, beyond the frame).
+#pragma once
+
+#include <array>
+#include <vector>
+
+namespace lensmith::render_detail {
+
+// `cells` holds, per pixel of a w x h grid, four weighted sums and their weight (0 = unknown). Pull
+// sums 2 x 2 blocks down to one cell; push gives every unknown cell its parent's normalised value.
+// On return every cell holds normalised values and weight 1 (all zero if no cell was known).
+void push_pull(int w, int h, std::vector<std::array<double, 5>>& cells);
+
+}  // namespace lensmith::render_detail
