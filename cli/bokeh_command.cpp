@@ -99,6 +99,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   BokehOptions options;
   options.threads = o.threads;
   options.hidden = parse_hidden_surfaces(o.hidden);
+  options.split_edge_pixels = o.edge_pixels == "split";
   options.spectral = !o.no_spectral;
   options.spectral_samples = o.spectral_samples;
   options.layer_spacing_px = o.layer_spacing_px;
@@ -119,6 +120,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   meta.f_number = cam->f_number();
   meta.focus_m = o.focus_m;
   meta.extra = {{"aperture", aperture.to_string()}, {"hidden_surfaces", std::string(to_string(options.hidden))},
+                {"edge_pixels", o.edge_pixels},
                 {"spectral", options.spectral ? std::to_string(options.spectral_samples) + " nodes" : "off"}};
   write_output_image(output, out, meta);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

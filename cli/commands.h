@@ -147,6 +147,7 @@ struct BokehCommandOptions {
   std::string aperture_image;                // --aperture-image PNG
   std::string model;                         // --model thin|paraxial|seidel|exact; default seidel (thin with --thin-lens)
   std::string hidden = "extend";             // --hidden extend|stretch
+  std::string edge_pixels = "split";         // --edge-pixels split|keep
   bool no_spectral = false;                  // --no-spectral
   int spectral_samples = 16;                 // --spectral-samples
   double highlight_gain = 1.0;               // --highlight-gain (8-bit inputs)

@@ -195,6 +195,9 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   bokeh_cmd->add_option("--hidden", bokeh.hidden, "Background hidden behind foreground edges: extend (default) | stretch")
       ->check(CLI::IsMember({"extend", "stretch"}));
+  bokeh_cmd->add_option("--edge-pixels", bokeh.edge_pixels,
+                        "Anti-aliased depth-edge pixels: split (default: between their two surfaces by colour) | keep (at their depth)")
+      ->check(CLI::IsMember({"split", "keep"}));
   bokeh_cmd->add_flag("--no-spectral", bokeh.no_spectral, "Trace every ray at 587.6 nm and keep RGB as it is (no colour fringes)");
   bokeh_cmd->add_option("--spectral-samples", bokeh.spectral_samples, "Wavelengths of the spectral quadrature (3-64, default 16)")
       ->check(CLI::Range(3, 64));

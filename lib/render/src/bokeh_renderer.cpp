@@ -1,5 +1,6 @@
 // The bokeh renderer's stages in order (docs/bokeh.md; each stage's file says where its method
-// comes from): sources from the image and its depth (scatter_source), depth layers (depth_layers),
+// comes from): sources from the image and its depth (scatter_source), anti-aliased edge pixels split
+// into their two surfaces (mixed_pixels), depth layers (depth_layers),
 // per layer the hidden surfaces behind nearer pixels (hidden_surfaces), footprint planning and the
 // deposit into per-thread bands of rows (footprint, with spectral_groups and pupil_mesh_table),
 // then front-to-back compositing and the fill of what nothing covers (layer_compositing).
@@ -19,6 +20,7 @@
 #include "footprint.h"
 #include "hidden_surfaces.h"
 #include "layer_compositing.h"
+#include "mixed_pixels.h"
 #include "lensmith/core/errors.h"
 #include "lensmith/core/number_parsing.h"
 #include "lensmith/core/units.h"
@@ -42,11 +44,11 @@ constexpr float kMediumFootprintPx = 20.0f;
 constexpr float kTallFootprintPx = 68.0f;
 // Bands of rows per thread: each band scatters the footprints that reach it.
 constexpr int kBandsPerThread = 4;
-// The hidden surface behind nearer layers is continued as far as half their largest blur plus
-// this margin (px): the 2 px tent.
-constexpr double kExtendMarginPx = 2.0;
-// Nearer layers blurred less than this (px) hide nothing worth extending.
-constexpr double kMinExtendBlurPx = 1.0;
+// Hidden sources reach half the blur of the layer and of the nearer ones, plus this margin (px): the
+// 2 px tent.
+constexpr double kHiddenMarginPx = 2.0;
+// Where the layer and the nearer ones blur less than this (px) together, nothing hidden shows.
+constexpr double kMinHiddenBlurPx = 1.0;
 
 // The splat options with the sub-row count divided by `divisor` (at least 1).
 SplatOptions subrow_options(const SplatOptions& splat, int divisor) {
@@ -64,11 +66,14 @@ Image render(const Image& image, const DepthMap& depth, const RayModel& model, c
   const render_detail::PupilMeshTable meshes(aperture);
   const FootprintScatter scatter(model, aperture, groups, meshes, options);
 
-  const std::vector<ScatterSource> sources = render_detail::make_scatter_sources(image, depth, camera, options, threads, stats);
-  const DepthLayers layers = render_detail::make_depth_layers(sources, options.layer_spacing_px, options.max_layers);
+  std::vector<ScatterSource> sources = render_detail::make_scatter_sources(image, depth, camera, options, threads, stats);
+  if (options.split_edge_pixels) render_detail::split_mixed_pixels(sources, w, h, camera, threads, stats);
+  const DepthLayers layers = render_detail::make_depth_layers(sources, w, options.layer_spacing_px, options.max_layers);
   stats.layer_spacing_px = layers.spacing_px;
 
+  const bool stretch = options.hidden == HiddenSurfaces::Stretch;
   std::vector<float> layer_rgba(static_cast<std::size_t>(w) * h * 4);
+  std::vector<float> hole_rgba(stretch ? layer_rgba.size() : 0);  // Stretch: coverage of the hidden sources
   std::vector<double> result(static_cast<std::size_t>(w) * h * 4, 0.0);  // premultiplied RGB + coverage
   const int bands = std::max(1, std::min(h, threads * kBandsPerThread));
   std::size_t done = 0;
@@ -79,10 +84,12 @@ Image render(const Image& image, const DepthMap& depth, const RayModel& model, c
     std::vector<ScatterSource> layer;
     layer.reserve(layers.members[u].size());
     for (int i : layers.members[u]) layer.push_back(sources[static_cast<std::size_t>(i)]);
-    if (options.hidden == HiddenSurfaces::Extend && !layer.empty() && layers.nearer_blur_px[u] >= kMinExtendBlurPx) {
-      const double reach = std::min(0.5 * layers.nearer_blur_px[u] + kExtendMarginPx, 0.5 * (w + h));
-      std::vector<ScatterSource> extra = render_detail::extend_layer(image, depth, camera, layers, l, reach, threads);
-      stats.extended_pixels += extra.size();
+    const double hidden_blur = layers.max_blur_px[u] + layers.nearer_blur_px[u];
+    if (!layer.empty() && l + 1 < layers.count && hidden_blur >= kMinHiddenBlurPx) {
+      const double reach = std::min(0.5 * hidden_blur + kHiddenMarginPx, 0.5 * (w + h));
+      std::vector<ScatterSource> extra =
+          render_detail::hidden_sources(sources, layers, l, w, h, reach, options.hidden, camera, threads);
+      stats.hidden_sources += extra.size();
       layer.insert(layer.end(), extra.begin(), extra.end());
     }
     if (layer.empty()) continue;
@@ -107,29 +114,34 @@ Image render(const Image& image, const DepthMap& depth, const RayModel& model, c
       for (int b = 0; b < bands; ++b) {
         const int row_begin = b * h / bands, row_end = (b + 1) * h / bands;
         if (row_begin == row_end) continue;
-        // A buffer is made only for the sub-row classes this band meets in this layer.
-        std::array<std::optional<SplatBuffer>, 3> buffers;
+        // A buffer is made only for the sub-row classes this band meets in this layer; light and
+        // (Stretch) the coverage of hidden sources apart.
+        std::array<std::array<std::optional<SplatBuffer>, 3>, 2> buffers;
         for (std::size_t i = 0; i < layer.size(); ++i) {
           if (plans[i].y_max < static_cast<float>(row_begin) - 1.0f || plans[i].y_min > static_cast<float>(row_end) + 1.0f) continue;
           const float height = plans[i].y_max - plans[i].y_min;
           const int kind = height < kMediumFootprintPx ? 0 : height < kTallFootprintPx ? 1 : 2;
-          std::optional<SplatBuffer>& buffer = buffers[static_cast<std::size_t>(kind)];
+          auto& set = buffers[layer[i].coverage_only ? 1 : 0];
+          std::optional<SplatBuffer>& buffer = set[static_cast<std::size_t>(kind)];
           if (!buffer) buffer.emplace(w, row_begin, row_end, subrow_options(options.splat, 1 << kind));
-          std::optional<SplatBuffer>& fine = buffers[0];
+          std::optional<SplatBuffer>& fine = set[0];
           if (plans[i].mesh >= 0 && !fine) fine.emplace(w, row_begin, row_end, subrow_options(options.splat, 1));
           scatter.deposit(layer[i], plans[i], *buffer, plans[i].mesh >= 0 ? *fine : *buffer, scratch, local_triangles);
           local_footprints += static_cast<std::size_t>(plans[i].groups);
         }
-        float* rows = layer_rgba.data() + static_cast<std::size_t>(row_begin) * w * 4;
-        std::fill(rows, rows + static_cast<std::size_t>(row_end - row_begin) * w * 4, 0.0f);
         bool any = false;
-        for (const std::optional<SplatBuffer>& buffer : buffers) {
-          if (!buffer) continue;
-          buffer->resolve_into(layer_rgba.data());
-          any = true;
+        for (int set = 0; set < (stretch ? 2 : 1); ++set) {
+          std::vector<float>& target = set == 0 ? layer_rgba : hole_rgba;
+          float* rows = target.data() + static_cast<std::size_t>(row_begin) * w * 4;
+          std::fill(rows, rows + static_cast<std::size_t>(row_end - row_begin) * w * 4, 0.0f);
+          for (const std::optional<SplatBuffer>& buffer : buffers[static_cast<std::size_t>(set)]) {
+            if (!buffer) continue;
+            buffer->resolve_into(target.data());
+            any = true;
+          }
         }
         if (!any) continue;  // nothing of this layer reaches these rows: the result is unchanged
-        render_detail::composite_layer_over(layer_rgba, result, w, row_begin, row_end);
+        render_detail::composite_layer_over(layer_rgba, stretch ? &hole_rgba : nullptr, result, w, row_begin, row_end);
       }
       footprints += local_footprints;
       triangles += local_triangles;
@@ -182,7 +194,8 @@ std::string BokehOptions::to_string() const {
 std::string BokehStatistics::to_string() const {
   std::ostringstream os;
   os << "BokehStatistics(" << layers << " layers at " << layer_spacing_px << " px, " << source_pixels << " pixels, "
-     << extended_pixels << " extended, " << footprints << " footprints, " << triangles << " triangles, "
+     << hidden_sources << " hidden sources, " << split_edge_pixels << " edge pixels split, " << redepthed_edge_pixels
+     << " moved, " << footprints << " footprints, " << triangles << " triangles, "
      << clamped_depths << " clamped depths, max |CoC| " << max_abs_coc_px << " px)";
   return os.str();
 }

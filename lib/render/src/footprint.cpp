@@ -143,7 +143,8 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
     if (ok[1][i] && ok[2][i]) spread = std::max(spread, std::hypot(px[1][i].x - px[2][i].x, px[1][i].y - px[2][i].y));
   }
   const double size = std::max(x_max - x_min, y_max - y_min);
-  p.groups = std::clamp(static_cast<int>(std::ceil(spread / options_.chromatic_tolerance_px)), 1, groups_.max_count());
+  // Coverage has no colour: one group carries it.
+  p.groups = s.coverage_only ? 1 : std::clamp(static_cast<int>(std::ceil(spread / options_.chromatic_tolerance_px)), 1, groups_.max_count());
   const double margin = near_affine ? kTentMarginPx : kTentMarginPx + kMeshMarginFraction * size;
   p.y_min = static_cast<float>(y_min - margin);
   p.y_max = static_cast<float>(y_max + margin);
@@ -172,7 +173,7 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
   for (const SpectralGroup& g : groups_.split(p.groups)) {
     std::array<float, 4> value{};
     for (std::size_t c = 0; c < 3; ++c) value[c] = g.m[c][0] * s.rgb[0] + g.m[c][1] * s.rgb[1] + g.m[c][2] * s.rgb[2];
-    value[3] = g.alpha;
+    value[3] = g.alpha * s.coverage;
     if (p.outline == FootprintPlan::kPoint) {
       static constexpr std::array<PupilPoint, 1> kCentre{{{0.0, 0.0}}};
       hits.resize(1);

@@ -5,7 +5,6 @@
 #include <cstdint>
 #include <limits>
 
-#include "lensmith/core/units.h"
 #include "push_pull.h"
 
 namespace lensmith::render_detail {
@@ -17,10 +16,11 @@ double tone(float v) { return static_cast<double>(v) / (1.0 + static_cast<double
 float untone(double t) { return static_cast<float>(std::min(t, kMaxTone) / (1.0 - std::min(t, kMaxTone))); }
 }  // namespace
 
-std::vector<ScatterSource> extend_layer(const Image& image, const DepthMap& depth, const Camera& camera,
-                                        const DepthLayers& layers, int layer, double reach_px, int threads) {
-  const int w = image.width, h = image.height;
-  const std::vector<int>& layer_of = layers.layer_of;
+std::vector<ScatterSource> hidden_sources(const std::vector<ScatterSource>& sources, const DepthLayers& layers, int layer,
+                                          int width, int height, double reach_px, HiddenSurfaces mode, const Camera& camera,
+                                          int threads) {
+  const int w = width, h = height;
+  const std::vector<PixelLayers>& pixels = layers.pixels;
   // Nearer pixels within a (2 reach + 1)-pixel square of a pixel of the layer: a separable
   // dilation, rows then columns, each line independent (threads).
   const int reach = static_cast<int>(reach_px);
@@ -29,11 +29,11 @@ std::vector<ScatterSource> extend_layer(const Image& image, const DepthMap& dept
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (int y = 0; y < h; ++y) {
     int* d = row_distance.data() + static_cast<std::size_t>(y) * w;
-    const int* l = layer_of.data() + static_cast<std::size_t>(y) * w;
+    const PixelLayers* l = pixels.data() + static_cast<std::size_t>(y) * w;
     int last = far;
-    for (int x = 0; x < w; ++x) d[x] = l[x] == layer ? (last = 0) : (last = std::min(far, last + 1));
+    for (int x = 0; x < w; ++x) d[x] = l[x].in(layer) ? (last = 0) : (last = std::min(far, last + 1));
     last = far;
-    for (int x = w - 1; x >= 0; --x) d[x] = std::min(d[x], l[x] == layer ? (last = 0) : (last = std::min(far, last + 1)));
+    for (int x = w - 1; x >= 0; --x) d[x] = std::min(d[x], l[x].in(layer) ? (last = 0) : (last = std::min(far, last + 1)));
   }
   std::vector<std::uint8_t> within(static_cast<std::size_t>(w) * h, 0);
 #pragma omp parallel for num_threads(threads) schedule(static)
@@ -54,7 +54,7 @@ std::vector<ScatterSource> extend_layer(const Image& image, const DepthMap& dept
   std::vector<std::size_t> targets;
   int x0 = w, x1 = -1, y0 = h, y1 = -1;
   for (std::size_t i = 0; i < within.size(); ++i) {
-    if (layer_of[i] > layer && within[i]) {
+    if (within[i] && pixels[i].nearer_than(layer) > 0.0f) {
       targets.push_back(i);
       const int x = static_cast<int>(i % static_cast<std::size_t>(w)), y = static_cast<int>(i / static_cast<std::size_t>(w));
       x0 = std::min(x0, x);
@@ -72,14 +72,17 @@ std::vector<ScatterSource> extend_layer(const Image& image, const DepthMap& dept
   y1 = std::min(h - 1, y1 + reach);
   const int ww = x1 - x0 + 1, wh = y1 - y0 + 1;
   std::vector<std::array<double, 5>> cells(static_cast<std::size_t>(ww) * wh, std::array<double, 5>{});
-  for (int y = y0; y <= y1; ++y) {
-    for (int x = x0; x <= x1; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * w + x;
-      if (layer_of[i] != layer) continue;
-      cells[static_cast<std::size_t>(y - y0) * ww + (x - x0)] = {tone(image.at(x, y, 0)), tone(image.at(x, y, 1)),
-                                                                  tone(image.at(x, y, 2)),
-                                                                  inverse_depth_per_mm(depth.at(x, y)), 1.0};
-    }
+  // The layer's own parts, weighted by their coverage, their colours un-premultiplied.
+  for (int i : layers.members[static_cast<std::size_t>(layer)]) {
+    const ScatterSource& p = sources[static_cast<std::size_t>(i)];
+    if (p.x < x0 || p.x > x1 || p.y < y0 || p.y > y1 || !(p.coverage > 0.0f)) continue;
+    std::array<double, 5>& cell = cells[static_cast<std::size_t>(p.y - y0) * ww + (p.x - x0)];
+    const double c = p.coverage;
+    cell[0] += c * tone(p.rgb[0] / p.coverage);
+    cell[1] += c * tone(p.rgb[1] / p.coverage);
+    cell[2] += c * tone(p.rgb[2] / p.coverage);
+    cell[3] += c * p.inverse_depth_per_mm;
+    cell[4] += c;
   }
   push_pull(ww, wh, cells);
   std::vector<ScatterSource> out;
@@ -91,7 +94,9 @@ std::vector<ScatterSource> extend_layer(const Image& image, const DepthMap& dept
     ScatterSource s;
     s.x = static_cast<int>(i % static_cast<std::size_t>(w));
     s.y = static_cast<int>(i / static_cast<std::size_t>(w));
-    s.rgb = {untone(v[0]), untone(v[1]), untone(v[2])};
+    s.coverage = pixels[i].nearer_than(layer);
+    s.coverage_only = mode == HiddenSurfaces::Stretch;
+    if (!s.coverage_only) s.rgb = {s.coverage * untone(v[0]), s.coverage * untone(v[1]), s.coverage * untone(v[2])};
     s.inverse_depth_per_mm = v[3];
     s.coc_px = camera.signed_coc_px(v[3]);
     out.push_back(s);

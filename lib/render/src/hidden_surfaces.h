@@ -1,20 +1,27 @@
-// What a single image cannot show: the part of a depth layer hidden behind nearer pixels, which a
-// real lens sees around blurred edges. HiddenSurfaces::Extend continues the layer under the nearer
-// pixels within reach of it, with colours and inverse depths interpolated from the layer's own
-// pixels by push-pull (Gortler et al. 1996), in x / (1 + x) so that a few HDR highlights do not
-// flood the invented surface: a plausible guess, not knowledge.
+// What a single image cannot show: the part of a depth layer hidden behind nearer pixels. A real
+// lens sees some of it: around a blurred foreground (which turns partly transparent at its edge),
+// and around a sharp one too, because a blurred background point spreads its light past the sharp
+// silhouette in front of it. So each layer gets hidden sources under the nearer pixels within
+// reach of its own pixels: half the blur of the layer itself and of every nearer layer, plus the
+// 2 px tent. Their coverage is the part of the pixel the nearer layers take; their inverse depth is
+// interpolated from the layer's own pixels by push-pull (Gortler et al., "The Lumigraph", 1996).
+//
+// HiddenSurfaces::Extend also interpolates their colour (in x / (1 + x), so that a few HDR
+// highlights do not flood it): a plausible guess, not knowledge. HiddenSurfaces::Stretch invents no
+// colour: its hidden sources only add coverage, and the layer's own colours are renormalised over it.
 #pragma once
 
 #include <vector>
 
 #include "depth_layers.h"
-#include "lensmith/render/image.h"
 #include "scatter_source.h"
 
 namespace lensmith::render_detail {
 
-// Sources continuing `layer` under the nearer pixels within `reach_px` (a square) of its own pixels.
-std::vector<ScatterSource> extend_layer(const Image& image, const DepthMap& depth, const Camera& camera,
-                                        const DepthLayers& layers, int layer, double reach_px, int threads);
+// Hidden sources of `layer`, under the nearer pixels within `reach_px` (a square) of its own pixels
+// of an image `width` x `height`; coverage-only for HiddenSurfaces::Stretch.
+std::vector<ScatterSource> hidden_sources(const std::vector<ScatterSource>& sources, const DepthLayers& layers, int layer,
+                                          int width, int height, double reach_px, HiddenSurfaces mode, const Camera& camera,
+                                          int threads);
 
 }  // namespace lensmith::render_detail

@@ -8,18 +8,30 @@
 namespace lensmith::render_detail {
 
 namespace {
-// Pixels covered at least this much are known colour for filling the gaps of others (coverage of
-// a tiling of distorted footprints wanders a few per cent around 1; a pixel whose own light spread
-// away is far below).
+// A pixel covered at least this much takes the colour of its covered part for the whole pixel (a
+// normalised gather, as at the frame's border, where the blur from beyond the frame is missing: the
+// Cycles portrait scene of bench/blender scored 49.2 dB against 47.7 dB with the push-pull fill).
+constexpr double kRenormaliseCoverage = 0.05;
+// Below that, the gap is filled with the colour of the pixels around covered at least this much
+// (coverage of a tiling of distorted footprints wanders a few per cent around 1), never with the
+// pixel's own amplified light.
 constexpr double kKnownCoverage = 0.9;
 // Coverage short of 1 by less than this is rounding, not a gap.
 constexpr double kGapTolerance = 1e-9;
 }  // namespace
 
-void composite_layer_over(const std::vector<float>& layer_rgba, std::vector<double>& result, int width, int row_begin,
-                          int row_end) {
+void composite_layer_over(const std::vector<float>& layer_rgba, const std::vector<float>* holes, std::vector<double>& result,
+                          int width, int row_begin, int row_end) {
   for (std::size_t k = static_cast<std::size_t>(row_begin) * width; k < static_cast<std::size_t>(row_end) * width; ++k) {
     double c[4] = {layer_rgba[4 * k], layer_rgba[4 * k + 1], layer_rgba[4 * k + 2], layer_rgba[4 * k + 3]};
+    if (holes && c[3] > kGapTolerance) {
+      // The layer's colour spread over its own coverage and that of its hidden sources.
+      const double total = std::min(1.0, c[3] + std::max(0.0, static_cast<double>((*holes)[4 * k + 3])));
+      if (total > c[3]) {
+        const double scale = total / c[3];
+        for (double& v : c) v *= scale;
+      }
+    }
     if (c[3] > 1.0) {
       for (double& v : c) v /= c[3];
     } else if (c[3] < 0.0) {
@@ -35,13 +47,17 @@ Image finish_composite(const std::vector<double>& result, int width, int height)
   bool any_gap = false;
   for (std::size_t k = 0; k < fill.size(); ++k) {
     const double coverage = result[4 * k + 3];
-    any_gap = any_gap || coverage < 1.0 - kGapTolerance;
+    any_gap = any_gap || coverage < kRenormaliseCoverage;
     if (coverage >= kKnownCoverage) fill[k] = {result[4 * k], result[4 * k + 1], result[4 * k + 2], 0.0, coverage};
   }
   if (any_gap) push_pull(width, height, fill);
   Image out(width, height, 3);
   for (std::size_t k = 0; k < out.pixel_count(); ++k) {
     const double gap = std::max(0.0, 1.0 - result[4 * k + 3]);
+    if (gap > 0.0 && result[4 * k + 3] >= kRenormaliseCoverage) {
+      for (std::size_t c = 0; c < 3; ++c) out.data[3 * k + c] = static_cast<float>(std::max(0.0, result[4 * k + c] / result[4 * k + 3]));
+      continue;
+    }
     for (std::size_t c = 0; c < 3; ++c) {
       out.data[3 * k + c] = static_cast<float>(std::max(0.0, result[4 * k + c] + (gap > 0.0 ? gap * fill[k][c] : 0.0)));
     }

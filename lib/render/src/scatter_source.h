@@ -19,6 +19,7 @@ struct ScatterSource {
   int y = 0;
   std::array<float, 3> rgb{};       // linear radiance it sends (premultiplied by coverage)
   float coverage = 1.0f;            // fraction of the pixel's area this part stands for (0..1]
+  bool coverage_only = false;       // a hidden source of HiddenSurfaces::Stretch: coverage, no light
   double inverse_depth_per_mm = 0.0;
   double coc_px = 0.0;              // signed blur diameter at the reference wavelength (Camera::signed_coc_px)
 };

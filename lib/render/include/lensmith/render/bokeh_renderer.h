@@ -48,6 +48,7 @@ struct BokehOptions {
   double layer_spacing_px = 2.0;         // signed circle-of-confusion step between depth layers (> 0)
   int max_layers = 64;                   // cap; the spacing grows when the blur range needs more (1..1024)
   HiddenSurfaces hidden = HiddenSurfaces::Extend;
+  bool split_edge_pixels = true;         // split anti-aliased depth-edge pixels between their two surfaces
   bool spectral = true;                  // false: every ray at the reference wavelength, RGB as given
   int spectral_samples = 16;             // wavelength nodes of the quadrature (3..64)
   double chromatic_tolerance_px = 0.5;   // largest colour separation left unresolved within a pixel's bokeh
@@ -61,7 +62,9 @@ struct BokehStatistics {
   int layers = 0;                   // non-empty depth layers
   double layer_spacing_px = 0.0;    // signed CoC spacing used
   std::size_t source_pixels = 0;    // input pixels scattered
-  std::size_t extended_pixels = 0;  // hidden-surface pixels invented (Extend)
+  std::size_t hidden_sources = 0;   // hidden-surface sources added behind nearer pixels (hidden_surfaces.h)
+  std::size_t split_edge_pixels = 0;     // anti-aliased edge pixels split into a near and a far part
+  std::size_t redepthed_edge_pixels = 0; // edge pixels whose colour is one surface's, moved to its depth
   std::size_t footprints = 0;       // (pixel, wavelength group) footprints deposited
   std::size_t triangles = 0;        // mesh triangles deposited (seidel, exact, masks)
   std::size_t clamped_depths = 0;   // pixels brought back to max_blur_px or in front of the lens

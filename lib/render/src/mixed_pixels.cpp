@@ -1,0 +1,181 @@
+#include "mixed_pixels.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+
+#include "lensmith/core/units.h"
+
+namespace lensmith::render_detail {
+
+namespace {
+
+// Neighbourhoods whose blur differs by less than this (px, signed CoC) hold no depth edge worth
+// splitting at: the 2 px tent filter makes both parts land alike.
+constexpr double kMinBlurDifferencePx = 1.0;
+// Relative colour contrast |c_near - c_far| / (|c_near| + |c_far|) from which alpha comes wholly
+// from colour, and below which wholly from depth (linear between).
+constexpr double kColourContrastLow = 0.02;
+constexpr double kColourContrastHigh = 0.10;
+// Distance of the pixel's colour from the line through the two surfaces' colours, relative to their
+// difference, up to which the two-colour model is trusted fully, and from which not at all (a
+// textured surface whose neighbours do not describe the pixel).
+constexpr double kFitResidualLow = 0.3;
+constexpr double kFitResidualHigh = 0.6;
+// alpha within this of 0 or 1 is a pure pixel of one surface (noise of the colour estimate).
+constexpr double kPureAlpha = 0.03;
+// Passes that move pixels wholly to the surface their colour shows, before the split: a depth edge
+// up to this many pixels off the colour edge (nearest-surface, farthest-surface or filtered depth)
+// comes back to it, a pixel per pass.
+constexpr int kMovePasses = 3;
+
+struct Group {
+  std::array<double, 3> rgb{};
+  double inverse_depth_per_mm = 0.0;
+  double coc_px = 0.0;
+  int count = 0;
+  void add(const ScatterSource& s) {
+    for (std::size_t c = 0; c < 3; ++c) rgb[c] += s.rgb[c];
+    inverse_depth_per_mm += s.inverse_depth_per_mm;
+    coc_px += s.coc_px;
+    ++count;
+  }
+  void finish() {
+    for (double& v : rgb) v /= count;
+    inverse_depth_per_mm /= count;
+    coc_px /= count;
+  }
+};
+
+double norm(const std::array<double, 3>& v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
+
+// What to do with one pixel: nothing, move it wholly to one surface's depth, or split it.
+struct Decision {
+  enum class Kind { Keep, Move, Split } kind = Kind::Keep;
+  double alpha = 1.0;  // coverage of the near part (Split)
+  Group near, far;
+};
+
+Decision decide(const std::vector<ScatterSource>& sources, int width, int height, int x, int y) {
+  const ScatterSource& p = sources[static_cast<std::size_t>(y) * width + x];
+  Decision d;
+  double lo = p.coc_px, hi = p.coc_px;
+  const int x0 = std::max(0, x - 1), x1 = std::min(width - 1, x + 1);
+  const int y0 = std::max(0, y - 1), y1 = std::min(height - 1, y + 1);
+  for (int qy = y0; qy <= y1; ++qy) {
+    for (int qx = x0; qx <= x1; ++qx) {
+      const double c = sources[static_cast<std::size_t>(qy) * width + qx].coc_px;
+      lo = std::min(lo, c);
+      hi = std::max(hi, c);
+    }
+  }
+  if (hi - lo < kMinBlurDifferencePx) return d;
+  // The two surfaces: the 8 neighbours on either side of the middle of the blur range (larger
+  // signed blur is nearer: Camera::signed_coc_px grows with inverse depth).
+  const double mid = 0.5 * (lo + hi);
+  for (int qy = y0; qy <= y1; ++qy) {
+    for (int qx = x0; qx <= x1; ++qx) {
+      if (qx == x && qy == y) continue;
+      const ScatterSource& q = sources[static_cast<std::size_t>(qy) * width + qx];
+      (q.coc_px >= mid ? d.near : d.far).add(q);
+    }
+  }
+  if (d.near.count == 0 || d.far.count == 0) return d;  // a 1-px feature: nothing to unmix it with
+  d.near.finish();
+  d.far.finish();
+  // alpha from depth: where the pixel's blur lies between the two surfaces'.
+  const double alpha_depth = std::clamp((p.coc_px - d.far.coc_px) / (d.near.coc_px - d.far.coc_px), 0.0, 1.0);
+  // alpha from colour: the projection on the segment from the far colour to the near one, trusted
+  // where the colours differ clearly and the pixel lies near the line through them.
+  std::array<double, 3> span{}, offset{};
+  for (std::size_t c = 0; c < 3; ++c) {
+    span[c] = d.near.rgb[c] - d.far.rgb[c];
+    offset[c] = p.rgb[c] - d.far.rgb[c];
+  }
+  const double span2 = span[0] * span[0] + span[1] * span[1] + span[2] * span[2];
+  double alpha = alpha_depth;
+  if (span2 > 0.0) {
+    const double alpha_colour =
+        std::clamp((offset[0] * span[0] + offset[1] * span[1] + offset[2] * span[2]) / span2, 0.0, 1.0);
+    std::array<double, 3> miss{};
+    for (std::size_t c = 0; c < 3; ++c) miss[c] = offset[c] - alpha_colour * span[c];
+    const double residual = norm(miss) / std::sqrt(span2);
+    const double contrast = std::sqrt(span2) / (norm(d.near.rgb) + norm(d.far.rgb));
+    const double trust =
+        std::clamp((contrast - kColourContrastLow) / (kColourContrastHigh - kColourContrastLow), 0.0, 1.0) *
+        std::clamp((kFitResidualHigh - residual) / (kFitResidualHigh - kFitResidualLow), 0.0, 1.0);
+    alpha = trust * alpha_colour + (1.0 - trust) * alpha_depth;
+  }
+  if (alpha < kPureAlpha) alpha = 0.0;
+  if (alpha > 1.0 - kPureAlpha) alpha = 1.0;
+  d.alpha = alpha;
+  if (alpha > 0.0 && alpha < 1.0) {
+    d.kind = Decision::Kind::Split;
+  } else {
+    // Wholly one surface: move it there if its depth says otherwise.
+    const Group& own = alpha == 1.0 ? d.near : d.far;
+    if (std::abs(p.coc_px - own.coc_px) >= 0.5 * kMinBlurDifferencePx) d.kind = Decision::Kind::Move;
+  }
+  return d;
+}
+
+// The part of `p` on surface `g`: its own depth if it lies on that surface, else the surface's.
+void place_on(ScatterSource& part, const ScatterSource& p, const Group& g, const Camera& camera) {
+  if (std::abs(p.coc_px - g.coc_px) < 0.5 * kMinBlurDifferencePx) return;
+  part.inverse_depth_per_mm = g.inverse_depth_per_mm;
+  part.coc_px = camera.signed_coc_px(g.inverse_depth_per_mm);
+}
+
+void apply(std::vector<ScatterSource>& sources, std::size_t i, const Decision& d, const Camera& camera, BokehStatistics& stats) {
+  const ScatterSource p = sources[i];
+  if (d.kind == Decision::Kind::Move) {
+    place_on(sources[i], p, d.alpha == 1.0 ? d.near : d.far, camera);
+    ++stats.redepthed_edge_pixels;
+    return;
+  }
+  // Near part: the pixel less the far surface's share; the far part what remains, so the two add
+  // up to the pixel exactly.
+  ScatterSource near = p, far = p;
+  for (std::size_t c = 0; c < 3; ++c) {
+    near.rgb[c] = static_cast<float>(std::max(0.0, p.rgb[c] - (1.0 - d.alpha) * d.far.rgb[c]));
+    far.rgb[c] = p.rgb[c] - near.rgb[c];
+  }
+  near.coverage = static_cast<float>(d.alpha);
+  far.coverage = static_cast<float>(1.0 - d.alpha);
+  place_on(near, p, d.near, camera);
+  place_on(far, p, d.far, camera);
+  sources[i] = near;
+  sources.push_back(far);
+  ++stats.split_edge_pixels;
+}
+
+}  // namespace
+
+void split_mixed_pixels(std::vector<ScatterSource>& sources, int width, int height, const Camera& camera, int threads,
+                        BokehStatistics& stats) {
+  // Each pass decides from the sources as they were at its start, so decisions do not depend on
+  // the order of the pixels; each row keeps those that change something, applied in row order.
+  std::vector<std::vector<std::pair<std::size_t, Decision>>> rows(static_cast<std::size_t>(height));
+  for (int pass = 0; pass <= kMovePasses; ++pass) {
+    const bool last = pass == kMovePasses;
+    std::size_t changes = 0;
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 16) reduction(+ : changes)
+    for (int y = 0; y < height; ++y) {
+      auto& row = rows[static_cast<std::size_t>(y)];
+      row.clear();
+      for (int x = 0; x < width; ++x) {
+        Decision d = decide(sources, width, height, x, y);
+        if (d.kind == Decision::Kind::Keep || (!last && d.kind != Decision::Kind::Move)) continue;
+        row.emplace_back(static_cast<std::size_t>(y) * width + x, d);
+        ++changes;
+      }
+    }
+    for (const auto& row : rows) {
+      for (const auto& [i, d] : row) apply(sources, i, d, camera, stats);
+    }
+    if (!last && changes == 0) pass = kMovePasses - 1;  // nothing moved: go to the split
+  }
+}
+
+}  // namespace lensmith::render_detail
