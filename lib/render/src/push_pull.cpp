@@ -1,48 +1,83 @@
 #include "push_pull.h"
 
+#include <algorithm>
+#include <cmath>
 #include <utility>
 
 namespace lensmith::render_detail {
 
-void push_pull(int w, int h, std::vector<std::array<double, 5>>& cells) {
-  std::vector<std::vector<std::array<double, 5>>> levels;
+namespace {
+
+using Cell = std::array<double, 5>;
+
+// Normalised value of a cell of sums: the 4 values divided by the weight, and its confidence
+// min(weight, 1) in slot 4 (Gortler et al. clamp the pulled weights to 1 the same way).
+Cell normalised(const Cell& v) {
+  if (!(v[4] > 0.0)) return Cell{};
+  Cell n;
+  for (int k = 0; k < 4; ++k) n[static_cast<std::size_t>(k)] = v[static_cast<std::size_t>(k)] / v[4];
+  n[4] = std::min(v[4], 1.0);
+  return n;
+}
+
+}  // namespace
+
+void push_pull(int w, int h, std::vector<Cell>& cells) {
+  // Pull: each level sums 2 x 2 blocks of the one below, down to a single cell.
+  std::vector<std::vector<Cell>> levels;
   std::vector<std::pair<int, int>> sizes{{w, h}};
   while (sizes.back().first > 1 || sizes.back().second > 1) {
     const auto [fw, fh] = sizes.back();
-    const std::vector<std::array<double, 5>>& f = levels.empty() ? cells : levels.back();
+    const std::vector<Cell>& f = levels.empty() ? cells : levels.back();
     const int cw = (fw + 1) / 2, ch = (fh + 1) / 2;
-    std::vector<std::array<double, 5>> c(static_cast<std::size_t>(cw) * ch, std::array<double, 5>{});
+    std::vector<Cell> c(static_cast<std::size_t>(cw) * ch, Cell{});
     for (int y = 0; y < fh; ++y) {
       for (int x = 0; x < fw; ++x) {
-        auto& dst = c[static_cast<std::size_t>(y / 2) * cw + x / 2];
-        const auto& src = f[static_cast<std::size_t>(y) * fw + x];
-        for (int k = 0; k < 5; ++k) dst[k] += src[k];
+        Cell& dst = c[static_cast<std::size_t>(y / 2) * cw + x / 2];
+        const Cell& src = f[static_cast<std::size_t>(y) * fw + x];
+        for (std::size_t k = 0; k < 5; ++k) dst[k] += src[k];
       }
     }
     levels.push_back(std::move(c));
     sizes.push_back({cw, ch});
   }
-  auto normalise = [](std::array<double, 5>& v) {
-    if (v[4] > 0.0) {
-      for (int k = 0; k < 4; ++k) v[k] /= v[4];
-      v[4] = 1.0;
-    }
-  };
-  if (!levels.empty()) normalise(levels.back()[0]);
-  // Push from the coarsest level to the finest (level index l - 1; cells themselves at the end).
+  if (levels.empty()) {  // a single cell
+    cells[0] = normalised(cells[0]);
+    if (cells[0][4] > 0.0) cells[0][4] = 1.0;
+    return;
+  }
+  // Push: from the coarsest level down, every cell becomes its own normalised value blended by its
+  // confidence with the bilinear interpolation of the finished level above (cell centres at
+  // (x + 0.5) / 2 - 0.5 in its coordinates), so that filled areas are smooth, not 2^k blocks.
+  Cell& top = levels.back()[0];
+  top = normalised(top);
+  if (top[4] > 0.0) top[4] = 1.0;
   for (std::size_t l = levels.size(); l-- > 0;) {
-    std::vector<std::array<double, 5>>& f = l == 0 ? cells : levels[l - 1];
-    const std::vector<std::array<double, 5>>& c = levels[l];
+    std::vector<Cell>& f = l == 0 ? cells : levels[l - 1];
+    const std::vector<Cell>& c = levels[l];
     const auto [fw, fh] = sizes[l];
-    const int cw = sizes[l + 1].first;
+    const auto [cw, ch] = sizes[l + 1];
     for (int y = 0; y < fh; ++y) {
+      const double cy = std::clamp((y + 0.5) / 2.0 - 0.5, 0.0, static_cast<double>(ch - 1));
+      const int y0 = static_cast<int>(cy), y1 = std::min(y0 + 1, ch - 1);
+      const double ty = cy - y0;
       for (int x = 0; x < fw; ++x) {
-        auto& v = f[static_cast<std::size_t>(y) * fw + x];
-        if (v[4] > 0.0) {
-          normalise(v);
-        } else {
-          v = c[static_cast<std::size_t>(y / 2) * cw + x / 2];
+        const double cx = std::clamp((x + 0.5) / 2.0 - 0.5, 0.0, static_cast<double>(cw - 1));
+        const int x0 = static_cast<int>(cx), x1 = std::min(x0 + 1, cw - 1);
+        const double tx = cx - x0;
+        const Cell& a = c[static_cast<std::size_t>(y0) * cw + x0];
+        const Cell& b = c[static_cast<std::size_t>(y0) * cw + x1];
+        const Cell& d = c[static_cast<std::size_t>(y1) * cw + x0];
+        const Cell& e = c[static_cast<std::size_t>(y1) * cw + x1];
+        Cell& v = f[static_cast<std::size_t>(y) * fw + x];
+        const Cell own = normalised(v);
+        const double keep = own[4];
+        for (std::size_t k = 0; k < 4; ++k) {
+          const double up = (1.0 - ty) * ((1.0 - tx) * a[k] + tx * b[k]) + ty * ((1.0 - tx) * d[k] + tx * e[k]);
+          v[k] = keep * own[k] + (1.0 - keep) * up;
         }
+        // Known wherever the level above is (the coarsest cell is known if any cell was).
+        v[4] = std::max({a[4], b[4], d[4], e[4], keep}) > 0.0 ? 1.0 : 0.0;
       }
     }
   }
