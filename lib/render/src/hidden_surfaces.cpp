@@ -72,10 +72,10 @@ std::vector<ScatterSource> hidden_sources(const std::vector<ScatterSource>& sour
   y1 = std::min(h - 1, y1 + reach);
   const int ww = x1 - x0 + 1, wh = y1 - y0 + 1;
   std::vector<std::array<double, 5>> cells(static_cast<std::size_t>(ww) * wh, std::array<double, 5>{});
-  // The layer's own parts, weighted by their coverage, their colours un-premultiplied.
+  // The layer's own whole pixels (the parts of split edge pixels are uncertain estimates).
   for (int i : layers.members[static_cast<std::size_t>(layer)]) {
     const ScatterSource& p = sources[static_cast<std::size_t>(i)];
-    if (p.x < x0 || p.x > x1 || p.y < y0 || p.y > y1 || !(p.coverage > 0.0f)) continue;
+    if (p.x < x0 || p.x > x1 || p.y < y0 || p.y > y1 || p.coverage < 1.0f) continue;
     std::array<double, 5>& cell = cells[static_cast<std::size_t>(p.y - y0) * ww + (p.x - x0)];
     const double c = p.coverage;
     cell[0] += c * tone(p.rgb[0] / p.coverage);

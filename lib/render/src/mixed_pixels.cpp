@@ -14,6 +14,9 @@ namespace {
 // Neighbourhoods whose blur differs by less than this (px, signed CoC) hold no depth edge worth
 // splitting at: the 2 px tent filter makes both parts land alike.
 constexpr double kMinBlurDifferencePx = 1.0;
+// Neighbours whose blur lies within this share of the range from its nearer or farther end (at
+// least half of kMinBlurDifferencePx) stand for that surface.
+constexpr double kEndShare = 0.15;
 // Relative colour contrast |c_near - c_far| / (|c_near| + |c_far|) from which alpha comes wholly
 // from colour, and below which wholly from depth (linear between).
 constexpr double kColourContrastLow = 0.02;
@@ -57,7 +60,21 @@ struct Decision {
   Group near, far;
 };
 
-Decision decide(const std::vector<ScatterSource>& sources, int width, int height, int x, int y) {
+// Per pixel: 1 where a 4-neighbour's blur differs by kMinBlurDifferencePx or more.
+std::vector<std::uint8_t> next_to_step_map(const std::vector<ScatterSource>& sources, int width, int height) {
+  std::vector<std::uint8_t> m(static_cast<std::size_t>(width) * height, 0);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * width + x;
+      if (x + 1 < width && std::abs(sources[i].coc_px - sources[i + 1].coc_px) >= kMinBlurDifferencePx) m[i] = m[i + 1] = 1;
+      if (y + 1 < height && std::abs(sources[i].coc_px - sources[i + width].coc_px) >= kMinBlurDifferencePx) m[i] = m[i + width] = 1;
+    }
+  }
+  return m;
+}
+
+Decision decide(const std::vector<ScatterSource>& sources, const std::vector<std::uint8_t>& next_to_step, int width, int height,
+                int x, int y) {
   const ScatterSource& p = sources[static_cast<std::size_t>(y) * width + x];
   Decision d;
   double lo = p.coc_px, hi = p.coc_px;
@@ -71,16 +88,29 @@ Decision decide(const std::vector<ScatterSource>& sources, int width, int height
     }
   }
   if (hi - lo < kMinBlurDifferencePx) return d;
-  // The two surfaces: the 8 neighbours on either side of the middle of the blur range (larger
-  // signed blur is nearer: Camera::signed_coc_px grows with inverse depth).
-  const double mid = 0.5 * (lo + hi);
+  // The two surfaces: the 8 neighbours at either end of the blur range (larger signed blur is
+  // nearer: Camera::signed_coc_px grows with inverse depth). Neighbours between the ends (mixed
+  // pixels of a filtered depth) describe neither.
+  // Of those, the pure ones (not next to a depth step themselves) are preferred: a pixel next to
+  // the step may be mixed too.
+  const double tolerance = std::max(0.5 * kMinBlurDifferencePx, kEndShare * (hi - lo));
+  Group near_pure, far_pure;
   for (int qy = y0; qy <= y1; ++qy) {
     for (int qx = x0; qx <= x1; ++qx) {
       if (qx == x && qy == y) continue;
-      const ScatterSource& q = sources[static_cast<std::size_t>(qy) * width + qx];
-      (q.coc_px >= mid ? d.near : d.far).add(q);
+      const std::size_t q = static_cast<std::size_t>(qy) * width + qx;
+      const ScatterSource& s = sources[q];
+      if (s.coc_px >= hi - tolerance) {
+        d.near.add(s);
+        if (!next_to_step[q]) near_pure.add(s);
+      } else if (s.coc_px <= lo + tolerance) {
+        d.far.add(s);
+        if (!next_to_step[q]) far_pure.add(s);
+      }
     }
   }
+  if (near_pure.count > 0) d.near = near_pure;
+  if (far_pure.count > 0) d.far = far_pure;
   if (d.near.count == 0 || d.far.count == 0) return d;  // a 1-px feature: nothing to unmix it with
   d.near.finish();
   d.far.finish();
@@ -160,12 +190,13 @@ void split_mixed_pixels(std::vector<ScatterSource>& sources, int width, int heig
   for (int pass = 0; pass <= kMovePasses; ++pass) {
     const bool last = pass == kMovePasses;
     std::size_t changes = 0;
+    const std::vector<std::uint8_t> next_to_step = next_to_step_map(sources, width, height);
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 16) reduction(+ : changes)
     for (int y = 0; y < height; ++y) {
       auto& row = rows[static_cast<std::size_t>(y)];
       row.clear();
       for (int x = 0; x < width; ++x) {
-        Decision d = decide(sources, width, height, x, y);
+        Decision d = decide(sources, next_to_step, width, height, x, y);
         if (d.kind == Decision::Kind::Keep || (!last && d.kind != Decision::Kind::Move)) continue;
         row.emplace_back(static_cast<std::size_t>(y) * width + x, d);
         ++changes;
