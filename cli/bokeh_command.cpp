@@ -90,7 +90,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   for (float z : depth.z_m) nearest_m = std::min(nearest_m, z);
   RayModelOptions model_options;
   model_options.nearest_depth_m = std::isfinite(nearest_m) ? std::max(0.01, static_cast<double>(nearest_m)) : 1.0;
-  if (!o.thin_lens) model_options.fit = fit_for_models({kind}, *cam->lens(), cam->f_number(), o.fit, global);
+  if (!o.thin_lens) model_options.fit = fit_for_models({kind}, *cam, o.fit, global);
   else if (!o.fit.empty()) throw OptionsError("--fit is for --model poly with --lens");
   const auto model = make_ray_model(kind, *cam, model_options);
   const Aperture aperture = make_aperture(o);
@@ -100,6 +100,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   options.threads = o.threads;
   options.hidden = parse_hidden_surfaces(o.hidden);
   options.split_edge_pixels = o.edge_pixels == "split";
+  options.vignetting = !o.no_vignetting;
   options.spectral = !o.no_spectral;
   options.spectral_samples = o.spectral_samples;
   options.layer_spacing_px = o.layer_spacing_px;
@@ -121,6 +122,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   meta.focus_m = o.focus_m;
   meta.extra = {{"aperture", aperture.to_string()}, {"hidden_surfaces", std::string(to_string(options.hidden))},
                 {"edge_pixels", o.edge_pixels},
+                {"vignetting", options.vignetting ? "natural" : "off"},
                 {"spectral", options.spectral ? std::to_string(options.spectral_samples) + " nodes" : "off"}};
   write_output_image(output, out, meta);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

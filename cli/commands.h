@@ -148,6 +148,7 @@ struct BokehCommandOptions {
   std::string model;                         // --model thin|paraxial|seidel|exact; default seidel (thin with --thin-lens)
   std::string hidden = "extend";             // --hidden extend|stretch
   std::string edge_pixels = "split";         // --edge-pixels split|keep
+  bool no_vignetting = false;                // --no-vignetting: every point as bright as on the axis
   bool no_spectral = false;                  // --no-spectral
   int spectral_samples = 16;                 // --spectral-samples
   double highlight_gain = 1.0;               // --highlight-gain (8-bit inputs)
@@ -195,11 +196,11 @@ struct FitCommandOptions {
 };
 int run_fit(const FitCommandOptions& options, const GlobalOptions& global);
 
-// The fit for --model poly: read from `fit_file` (and checked against `lens`), or made now with the
-// default options at `f_number` (the camera's), with a progress bar unless quiet. Null when no model
-// in `models` is poly.
-std::shared_ptr<const LensFit> fit_for_models(const std::vector<RayModelKind>& models, const Prescription& lens,
-                                              double f_number, const std::string& fit_file, const GlobalOptions& global);
+// The fit for --model poly: read from `fit_file` (and checked against the camera's lens), or made
+// now to serve `camera` (lens_fit_options_for: its f-number, a sensor radius covering its frame),
+// with a progress bar unless quiet. Null when no model in `models` is poly.
+std::shared_ptr<const LensFit> fit_for_models(const std::vector<RayModelKind>& models, const Camera& camera,
+                                              const std::string& fit_file, const GlobalOptions& global);
 
 // `lensmith scene render`: an analytic scene through a pinhole (all-in-focus picture and depth) or,
 // as ground truth, through a lens (docs/cli.md, docs/scene-format.md).

@@ -13,8 +13,9 @@
 
 namespace lensmith::cli {
 
-std::shared_ptr<const LensFit> fit_for_models(const std::vector<RayModelKind>& models, const Prescription& lens,
-                                              double f_number, const std::string& fit_file, const GlobalOptions& global) {
+std::shared_ptr<const LensFit> fit_for_models(const std::vector<RayModelKind>& models, const Camera& camera,
+                                              const std::string& fit_file, const GlobalOptions& global) {
+  const Prescription& lens = *camera.lens();
   if (std::find(models.begin(), models.end(), RayModelKind::Poly) == models.end()) {
     if (!fit_file.empty()) throw OptionsError("--fit is for --model poly");
     return nullptr;
@@ -25,9 +26,7 @@ std::shared_ptr<const LensFit> fit_for_models(const std::vector<RayModelKind>& m
     return fit;
   }
   ProgressBar bar("fitting " + (lens.name.empty() ? std::string("the lens") : lens.name), !global.quiet);
-  LensFitOptions options;
-  options.f_number = f_number;
-  auto fit = std::make_shared<const LensFit>(LensFit::fit(lens, options, [&](double f) { bar.update(f); }));
+  auto fit = std::make_shared<const LensFit>(LensFit::fit(lens, lens_fit_options_for(camera), [&](double f) { bar.update(f); }));
   bar.finish();
   return fit;
 }

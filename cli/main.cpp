@@ -198,6 +198,9 @@ int main(int argc, char** argv) {
   bokeh_cmd->add_option("--edge-pixels", bokeh.edge_pixels,
                         "Anti-aliased depth-edge pixels: split (default: between their two surfaces by colour) | keep (at their depth)")
       ->check(CLI::IsMember({"split", "keep"}));
+  bokeh_cmd->add_flag("--no-vignetting", bokeh.no_vignetting,
+                      "Every point as bright as on the axis: no cos^4-type falloff, no darkening where clear apertures clip "
+                      "(the bokeh keeps its cat's-eye shape)");
   bokeh_cmd->add_flag("--no-spectral", bokeh.no_spectral, "Trace every ray at 587.6 nm and keep RGB as it is (no colour fringes)");
   bokeh_cmd->add_option("--spectral-samples", bokeh.spectral_samples, "Wavelengths of the spectral quadrature (3-64, default 16)")
       ->check(CLI::Range(3, 64));

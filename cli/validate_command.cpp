@@ -27,7 +27,7 @@ int run_validate(const ValidateCommandOptions& o, const GlobalOptions& global) {
   PsfValidationOptions psf;
   psf.pupil_samples_per_axis = o.pupil_samples;
   RayModelOptions model_options;
-  model_options.fit = fit_for_models(models, lens, camera.f_number(), o.fit, global);
+  model_options.fit = fit_for_models(models, camera, o.fit, global);
   model_options.nearest_depth_m = std::isinf(o.focus_m) ? 1.0 : std::max(0.05, 0.4 * o.focus_m);
   const PsfValidation result = validate_point_spreads(camera, models, Aperture::circular(), psf, model_options);
   const std::string psf_tables = result.to_markdown();

@@ -220,3 +220,36 @@ TEST_CASE("The poly model refuses a fit of another lens and a stop wider than it
   const Camera biotar = Camera::from_lens(LensLibrary::load("zeiss-biotar-1927").prescription, options(3.0, 8.0), 640, 480);
   CHECK_THROWS_AS(make_ray_model(RayModelKind::Poly, biotar, mo), OptionsError);
 }
+
+TEST_CASE("Clipping the pupil by a clear aperture's disc leaves the area of two intersecting circles", "[camera][vignetting]") {
+  // Two circles of radii 1 and R whose centres are d apart overlap in
+  // acos(u) + R^2 acos(v) - sqrt((-d + 1 + R)(d + 1 - R)(d - 1 + R)(d + 1 + R)) / 2,
+  // u = (d^2 + 1 - R^2) / 2d, v = (d^2 + R^2 - 1) / 2dR (the circle-circle lens, e.g. Weisstein,
+  // MathWorld "Circle-Circle Intersection"). The pupil is a 512-gon (area within 3e-5 of pi).
+  const std::vector<PupilPoint> pupil = Aperture::circular().outline(512);
+  std::vector<PupilPoint> out, work;
+  for (const auto& [d, r] : std::vector<std::pair<double, double>>{{1.2, 1.0}, {0.5, 0.8}, {1.5, 2.0}, {0.3, 2.0}}) {
+    const PupilDisc disc{d * std::cos(0.7), d * std::sin(0.7), r};
+    clip_pupil_polygon(pupil, std::span<const PupilDisc>(&disc, 1), out, work);
+    const double u = (d * d + 1.0 - r * r) / (2.0 * d), v = (d * d + r * r - 1.0) / (2.0 * d * r);
+    double expected = 0.0;
+    if (d + 1.0 <= r) {
+      expected = kPi;
+    } else if (d + r <= 1.0) {
+      expected = kPi * r * r;
+    } else {
+      expected = std::acos(u) + r * r * std::acos(v) -
+                 0.5 * std::sqrt((-d + 1.0 + r) * (d + 1.0 - r) * (d - 1.0 + r) * (d + 1.0 + r));
+    }
+    INFO("disc at distance " << d << ", radius " << r);
+    CHECK(pupil_polygon_area(out) == Approx(expected).epsilon(2e-3));
+  }
+  // Two discs in turn, and one that misses the pupil.
+  const std::vector<PupilDisc> both{{1.2, 0.0, 1.0}, {-1.2, 0.0, 1.0}};
+  clip_pupil_polygon(pupil, both, out, work);
+  CHECK(out.empty());
+  const std::vector<PupilDisc> apart{{3.0, 0.0, 1.0}};
+  clip_pupil_polygon(pupil, apart, out, work);
+  CHECK(out.empty());
+}
+

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "lensmith/core/errors.h"
@@ -177,5 +178,132 @@ std::string Aperture::to_string() const {
   }
   return "aperture";
 }
+
+double pupil_polygon_area(const std::vector<PupilPoint>& v) {
+  double twice = 0.0;
+  for (std::size_t i = 0, n = v.size(); i < n; ++i) twice += v[i].x * v[(i + 1) % n].y - v[(i + 1) % n].x * v[i].y;
+  return 0.5 * std::abs(twice);
+}
+
+void clip_pupil_polygon(const std::vector<PupilPoint>& convex, std::span<const PupilDisc> discs, std::vector<PupilPoint>& out,
+                        std::vector<PupilPoint>& work) {
+  constexpr double kArcStepRad = 0.1;  // a chord 0.1 rad long departs from its arc by 1/800 of the radius
+  out = convex;
+  for (const PupilDisc& d : discs) {
+    work.clear();
+    const std::size_t n = out.size();
+    if (n < 3) break;
+    auto inside = [&d](const PupilPoint& q) { return std::hypot(q.x - d.x, q.y - d.y) <= d.radius; };
+    // Where the segment a -> b crosses the circle (the root in [0, 1] of |a + t (b - a) - c| = R).
+    auto crossing = [&d](const PupilPoint& a, const PupilPoint& b, bool entering) {
+      const double ex = b.x - a.x, ey = b.y - a.y, fx = a.x - d.x, fy = a.y - d.y;
+      const double qa = ex * ex + ey * ey, qb = 2.0 * (fx * ex + fy * ey), qc = fx * fx + fy * fy - d.radius * d.radius;
+      const double root = std::sqrt(std::max(0.0, qb * qb - 4.0 * qa * qc));
+      const double t = std::clamp(entering ? (-qb - root) / (2.0 * qa) : (-qb + root) / (2.0 * qa), 0.0, 1.0);
+      return PupilPoint{a.x + t * ex, a.y + t * ey};
+    };
+    // The exit point of the arc being drawn, while outside.
+    std::optional<PupilPoint> exit;
+    double orientation = 0.0;
+    for (std::size_t i = 0; i < n; ++i) orientation += out[i].x * out[(i + 1) % n].y - out[(i + 1) % n].x * out[i].y;
+    auto arc = [&](const PupilPoint& from, const PupilPoint& to) {
+      // Along the circle from `from` to `to` in the polygon's winding.
+      const double a0 = std::atan2(from.y - d.y, from.x - d.x);
+      double sweep = std::atan2(to.y - d.y, to.x - d.x) - a0;
+      if (orientation > 0.0) {
+        while (sweep < 0.0) sweep += 2.0 * kPi;
+      } else {
+        while (sweep > 0.0) sweep -= 2.0 * kPi;
+      }
+      const int steps = static_cast<int>(std::ceil(std::abs(sweep) / kArcStepRad));
+      for (int k = 1; k < steps; ++k) {
+        const double a = a0 + sweep * k / steps;
+        work.push_back({d.x + d.radius * std::cos(a), d.y + d.radius * std::sin(a)});
+      }
+    };
+    // Start at a vertex inside, if any; a polygon wholly outside the disc may still contain it.
+    std::size_t start = n;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (inside(out[i])) {
+        start = i;
+        break;
+      }
+    }
+    if (start == n) {
+      bool any_crossing = false;
+      for (std::size_t i = 0; i < n && !any_crossing; ++i) {
+        const PupilPoint& a = out[i];
+        const PupilPoint& b = out[(i + 1) % n];
+        const double ex = b.x - a.x, ey = b.y - a.y;
+        const double t = std::clamp(((d.x - a.x) * ex + (d.y - a.y) * ey) / (ex * ex + ey * ey), 0.0, 1.0);
+        any_crossing = std::hypot(a.x + t * ex - d.x, a.y + t * ey - d.y) <= d.radius;
+      }
+      if (!any_crossing) {
+        // Disjoint, or the disc lies inside the polygon: then the disc itself is what passes.
+        const PupilPoint centre{d.x, d.y};
+        bool contains = true;
+        for (std::size_t i = 0; i < n; ++i) {
+          const PupilPoint& a = out[i];
+          const PupilPoint& b = out[(i + 1) % n];
+          contains = contains && ((b.x - a.x) * (centre.y - a.y) - (b.y - a.y) * (centre.x - a.x)) * orientation >= 0.0;
+        }
+        if (contains) {
+          const int steps = static_cast<int>(std::ceil(2.0 * kPi / kArcStepRad));
+          for (int k = 0; k < steps; ++k) {
+            const double a = 2.0 * kPi * k / steps * (orientation > 0.0 ? 1.0 : -1.0);
+            work.push_back({d.x + d.radius * std::cos(a), d.y + d.radius * std::sin(a)});
+          }
+        }
+        out.swap(work);
+        continue;
+      }
+      // Edges cross the disc although no vertex lies in it: walk from vertex 0, outside.
+      start = 0;
+    }
+    bool was_inside = inside(out[start]);
+    std::optional<PupilPoint> first_exit;  // when the walk starts outside
+    for (std::size_t step = 0; step <= n; ++step) {
+      const PupilPoint& a = out[(start + step) % n];
+      if (step == n) break;
+      const PupilPoint& b = out[(start + step + 1) % n];
+      const bool b_inside = inside(b);
+      if (was_inside) {
+        work.push_back(a);
+        if (!b_inside) exit = crossing(a, b, false);
+      } else if (b_inside) {
+        const PupilPoint entry = crossing(a, b, true);
+        if (exit) {
+          work.push_back(*exit);
+          arc(*exit, entry);
+        }
+        work.push_back(entry);
+        exit.reset();
+      } else {
+        // Both outside: the edge may still pass through the disc.
+        const double ex = b.x - a.x, ey = b.y - a.y;
+        const double t = std::clamp(((d.x - a.x) * ex + (d.y - a.y) * ey) / (ex * ex + ey * ey), 0.0, 1.0);
+        if (std::hypot(a.x + t * ex - d.x, a.y + t * ey - d.y) < d.radius) {
+          const PupilPoint entry = crossing(a, b, true);
+          if (exit) {
+            work.push_back(*exit);
+            arc(*exit, entry);
+          } else if (!first_exit) {
+            first_exit = entry;  // nothing before it: the arc into it is closed at the end
+          }
+          work.push_back(entry);
+          exit = crossing(a, b, false);
+        }
+      }
+      was_inside = b_inside;
+    }
+    // Close the arc from the last exit to the walk's first point on the circle.
+    if (exit && !work.empty()) {
+      work.push_back(*exit);
+      arc(*exit, first_exit ? *first_exit : work.front());
+    }
+    out.swap(work);
+  }
+}
+
 
 }  // namespace lensmith

@@ -2,7 +2,10 @@
 // traced through the prescription onto the sensor. Aiming: three unclipped traces from the scene
 // point give the affine map from entrance-pupil-plane targets to stop points; each pupil point's
 // target is its inverse image, refined by Newton steps with that Jacobian until the ray crosses the
-// stop within 1e-4 of its radius; the final trace clips at every clear aperture (vignetting).
+// stop within 1e-4 of its radius; the final trace records how far inside every clear aperture the
+// ray passes (vignetting, and where the edge of a clipped beam lies between rays). Each ray's
+// radiometric weight is the solid angle of its entrance-pupil-plane element seen from the point,
+// the element's area per unit stop area taken from the aiming's Jacobian (SensorHit).
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -36,21 +39,37 @@ Ray ray_towards(const ScenePoint& p, double z_perspective_mm, double target_x, d
 
 ExactModel::ExactModel(const Camera& camera) : RayModel(camera) {
   const Prescription& lens = *camera.lens();
-  TracerOptions clipped;
-  clipped.image_distance_mm = camera.z_sensor_mm() - lens.last_vertex_z_mm();
-  clipped_ = std::make_shared<SequentialTracer>(lens, clipped);
-  TracerOptions free = clipped;
-  free.clip_apertures = false;
-  free_ = std::make_shared<SequentialTracer>(lens, free);
+  TracerOptions free;
+  free.image_distance_mm = camera.z_sensor_mm() - lens.last_vertex_z_mm();
   // The stop Camera::from_lens sized to the f-number: the one ParaxialSystem finds.
   const ParaxialSystem p(lens);
   stop_surface_ = p.stop_surface();
   stop_radius_mm_ = lens.surfaces[static_cast<std::size_t>(stop_surface_ - 1)].semi_diameter_mm.value_or(0.0);
-  z_stop_mm_ = clipped_->vertex_z_mm(stop_surface_);
+  free.clip_apertures = false;
+  free_ = std::make_shared<SequentialTracer>(lens, free);
+  // The clear apertures that clip, as (0-based surface index, semi-diameter); the stop with the
+  // margin of kStopEdgeTolerance.
+  for (std::size_t k = 0; k < lens.surfaces.size(); ++k) {
+    const std::optional<double>& r = lens.surfaces[k].semi_diameter_mm;
+    if (!r || !(*r > 0.0)) continue;
+    apertures_.emplace_back(k, static_cast<int>(k) + 1 == stop_surface_ ? *r * (1.0 + kStopEdgeTolerance) : *r);
+  }
+  z_stop_mm_ = free_->vertex_z_mm(stop_surface_);
+  normalisation_ = WeightNormalisation(camera.min_wavelength_nm(), camera.max_wavelength_nm(), kNormalisationWavelengths,
+                                       [this, &camera](double wavelength_nm) {
+                                         return axial_mean_weight(camera, wavelength_nm, [this](auto&&... a) { map_raw(a...); });
+                                       });
 }
 
 void ExactModel::map(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
                      std::span<SensorHit> hits) const {
+  map_raw(point, wavelength_nm, pupil, hits);
+  const double scale = normalisation_.scale(wavelength_nm);
+  for (SensorHit& h : hits) h.weight *= scale;
+}
+
+void ExactModel::map_raw(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
+                         std::span<SensorHit> hits) const {
   thread_local std::vector<SurfaceHit> path;
   const FirstOrderSample fo = camera_.first_order(wavelength_nm);
   const double z_target = fo.z_entrance_pupil_mm;
@@ -83,7 +102,11 @@ void ExactModel::map(const ScenePoint& point, double wavelength_nm, std::span<co
     return;
   }
   const double i11 = j22 / det, i12 = -j12 / det, i21 = -j21 / det, i22 = j11 / det;
-  const double tolerance = 1e-4 * stop_radius_mm_;
+  // Entrance-pupil-plane area per unit stop area, across this beam (the real entrance pupil grows
+  // off axis where the stop's image does): with the solid angle of each target seen from the point,
+  // the ray's radiometric weight.
+  const double target_area = std::abs(i11 * i22 - i12 * i21);
+  const double tolerance = kAimTolerance * stop_radius_mm_;
 
   for (std::size_t i = 0; i < pupil.size(); ++i) {
     const double want_x = pupil[i].x * stop_radius_mm_, want_y = pupil[i].y * stop_radius_mm_;
@@ -106,14 +129,20 @@ void ExactModel::map(const ScenePoint& point, double wavelength_nm, std::span<co
       continue;
     }
     const Ray ray = ray_towards(point, z_persp, tx, ty, z_target, wavelength_nm, start_z);
-    const TraceResult t = clipped_->trace_forward(ray);
-    if (t.ok()) {
-      hits[i] = SensorHit{t.ray.position_mm.x(), t.ray.position_mm.y(), true, true};
+    const double weight = target_area * patch_solid_angle(point, z_persp, tx, ty, z_target);
+    // One unclipped trace: where the ray lands, and how far inside the tightest clear aperture it
+    // passes (a stopped ray still lands, for the edge of the beam between rays).
+    const TraceResult f = free_->trace_forward(ray, &path);
+    if (!f.ok()) {
+      hits[i] = SensorHit{};
       continue;
     }
-    // Stopped by a clear aperture: where it would have landed, for the edge of the beam.
-    const TraceResult f = t.status == RayStatus::Vignetted ? free_->trace_forward(ray) : TraceResult{};
-    hits[i] = f.ok() ? SensorHit{f.ray.position_mm.x(), f.ray.position_mm.y(), false, true} : SensorHit{};
+    double clearance = 1.0;
+    for (const auto& [k, radius] : apertures_) {
+      const Eigen::Vector3d& p = path[k].point_mm;
+      clearance = std::min(clearance, 1.0 - std::hypot(p.x(), p.y()) / radius);
+    }
+    hits[i] = SensorHit{f.ray.position_mm.x(), f.ray.position_mm.y(), clearance >= 0.0, true, weight, clearance};
   }
 }
 

@@ -39,17 +39,34 @@ PolyModel::PolyModel(const Camera& camera, std::shared_ptr<const LensFit> fit) :
                        format_number(fit_->options().max_wavelength_nm) + " nm, the renderer needs " +
                        format_number(camera.min_wavelength_nm()) + "-" + format_number(camera.max_wavelength_nm()) + " nm");
   }
+  normalisation_ = WeightNormalisation(camera.min_wavelength_nm(), camera.max_wavelength_nm(), kNormalisationWavelengths,
+                                       [this, &camera](double wavelength_nm) {
+                                         return axial_mean_weight(camera, wavelength_nm, [this](auto&&... a) { map_raw(a...); });
+                                       });
+}
+
+double PolyModel::outer_solid_angle(const ScenePoint& point, double z_perspective_mm, double x_mm, double y_mm) const {
+  double dz_dr2 = 0.0;
+  const double sag = fit_->front_sag(x_mm * x_mm + y_mm * y_mm, &dz_dr2).value_or(0.0);
+  return patch_solid_angle(point, z_perspective_mm, x_mm, y_mm, sag, 2.0 * x_mm * dz_dr2, 2.0 * y_mm * dz_dr2);
 }
 
 void PolyModel::map(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
                     std::span<SensorHit> hits) const {
+  map_raw(point, wavelength_nm, pupil, hits);
+  const double scale = normalisation_.scale(wavelength_nm);
+  for (SensorHit& h : hits) h.weight *= scale;
+}
+
+void PolyModel::map_raw(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
+                        std::span<SensorHit> hits) const {
   const ObjectPoint object{point.tan_x, point.tan_y, point.inverse_depth_per_mm, camera_.z_perspective_mm()};
   const double dz_sensor = camera_.z_sensor_mm() - fit_->sensor_plane_z_mm();
   // Newton for the beam's centre gives the Jacobian of stop position in outer position; every pupil
   // point then iterates with that fixed Jacobian (the chord method, as the exact model does with its
   // affine map), starting from the centre solution moved by the Jacobian's inverse: the stop map is
   // nearly affine across one beam, so a few cheap evaluations replace a Jacobian per step.
-  const double tolerance_mm = 1e-4 * stop_radius_mm_;
+  const double tolerance_mm = kAimTolerance * stop_radius_mm_;
   const FitAim centre = fit_->aim_from_object(object, 0.0, 0.0, wavelength_nm, std::nullopt, {tolerance_mm, 20});
   const auto& j = centre.jacobian;
   const double det = j[0] * j[3] - j[1] * j[2];
@@ -58,6 +75,10 @@ void PolyModel::map(const ScenePoint& point, double wavelength_nm, std::span<con
     return;
   }
   const std::array<double, 4> inverse{j[3] / det, -j[1] / det, -j[2] / det, j[0] / det};
+  // Outer-pupil area (dx dy on surface 1) per unit stop area across this beam, for the rays'
+  // radiometric weights: the solid angle of that element of surface 1 seen from the point.
+  const double outer_area = 1.0 / std::abs(det);
+  const double z_persp = camera_.z_perspective_mm();
   constexpr int kMaxChordSteps = 12;
   for (std::size_t i = 0; i < pupil.size(); ++i) {
     const double sx = pupil[i].x * stop_radius_mm_, sy = pupil[i].y * stop_radius_mm_;
@@ -91,9 +112,11 @@ void PolyModel::map(const ScenePoint& point, double wavelength_nm, std::span<con
       hits[i] = {};
       continue;
     }
-    const FitTrace t = fit_->from_outer(*outer, wavelength_nm, stop_radius_mm_);
+    // The stop as wide as the aiming tolerance may put a rim ray outside it (exact_model.cpp).
+    const FitTrace t = fit_->from_outer(*outer, wavelength_nm, stop_radius_mm_ * (1.0 + kStopEdgeTolerance));
     const double dz = std::sqrt(std::max(1e-12, 1.0 - t.ray.dx * t.ray.dx - t.ray.dy * t.ray.dy));
-    hits[i] = SensorHit{t.ray.x_mm + t.ray.dx / dz * dz_sensor, t.ray.y_mm + t.ray.dy / dz * dz_sensor, t.passes, true};
+    hits[i] = SensorHit{t.ray.x_mm + t.ray.dx / dz * dz_sensor, t.ray.y_mm + t.ray.dy / dz * dz_sensor, t.passes, true,
+                        outer_area * outer_solid_angle(point, z_persp, x, y), t.clearance};
   }
 }
 

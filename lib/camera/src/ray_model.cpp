@@ -38,6 +38,18 @@ void RayModelOptions::validate() const {
   if (seidel_distance_samples < 2) throw OptionsError("the Seidel table needs at least 2 object distances");
 }
 
+LensFitOptions lens_fit_options_for(const Camera& camera) {
+  LensFitOptions o;
+  o.f_number = camera.f_number();
+  // The frame's corner on the camera's sensor; the fit's own sensor plane (the paraxial focus for
+  // infinity) sees it about as far out, and the margin covers the difference.
+  constexpr double kFrameMargin = 1.15;
+  const double half_diagonal_mm =
+      0.5 * std::hypot(camera.frame().width_px(), camera.frame().height_px()) / std::abs(camera.px_per_sensor_mm());
+  o.image_radius_mm = std::max(LensFitOptions::kDefaultImageRadiusMm, kFrameMargin * half_diagonal_mm);
+  return o;
+}
+
 std::unique_ptr<RayModel> make_ray_model(RayModelKind kind, const Camera& camera, const RayModelOptions& options) {
   options.validate();
   if (kind == RayModelKind::Thin) {
@@ -51,7 +63,7 @@ std::unique_ptr<RayModel> make_ray_model(RayModelKind kind, const Camera& camera
   }
   if (kind == RayModelKind::Exact) return std::make_unique<camera_detail::ExactModel>(camera);
   if (kind == RayModelKind::Poly) {
-    auto fit = options.fit ? options.fit : std::make_shared<const LensFit>(LensFit::fit(*camera.lens()));
+    auto fit = options.fit ? options.fit : std::make_shared<const LensFit>(LensFit::fit(*camera.lens(), lens_fit_options_for(camera)));
     return std::make_unique<camera_detail::PolyModel>(camera, std::move(fit));
   }
   return std::make_unique<camera_detail::ReferenceSphereModel>(kind, camera, options);

@@ -2,12 +2,46 @@
 #include <cmath>
 
 #include "lensmith/core/units.h"
+#include "lensmith/paraxial/paraxial_system.h"
 #include "model_implementations.h"
 
 namespace lensmith::camera_detail {
 
+namespace {
+// Field angle of the chief ray traced to learn the apertures' chief-ray heights per unit slope
+// (paraxial optics is linear: any small angle gives the same ratio).
+constexpr double kChiefProbeAngleDeg = 1.0;
+}  // namespace
+
 ReferenceSphereModel::ReferenceSphereModel(RayModelKind kind, const Camera& camera, const RayModelOptions& options)
     : RayModel(camera), kind_(kind) {
+  if (kind_ == RayModelKind::Thin) return;
+  // First-order vignetting: any paraxial ray is a combination of the marginal ray of an object at
+  // infinity (height h at the entrance pupil, slope 0) and a chief ray (height 0 there, slope u_c),
+  // so its height at surface k is (y / h) y_marginal(k) + (u / u_c) y_chief(k).
+  {
+    Prescription probe = *camera.lens();
+    probe.field = FieldSpec{FieldSpec::Kind::AngleDeg, {kChiefProbeAngleDeg}};
+    ParaxialOptions po;
+    po.wavelength_nm = camera.reference_wavelength_nm();
+    po.object_distance_mm = kInfinity;
+    const ParaxialSystem p(probe, po);
+    const double h = 0.5 * p.entrance_pupil().diameter_mm;
+    const ParaxialRayTable& chief = *p.chief_ray();
+    z_entrance_pupil_mm_ = p.entrance_pupil().z_mm;
+    entrance_pupil_radius_mm_ = h;
+    for (std::size_t k = 0; k < probe.surfaces.size(); ++k) {
+      const std::optional<double>& r = probe.surfaces[k].semi_diameter_mm;
+      if (!r || !(*r > 0.0) || static_cast<int>(k) + 1 == p.stop_surface()) continue;
+      apertures_.push_back({p.marginal_ray().rows[k].y_mm / h, chief.rows[k].y_mm / chief.object_slope, *r});
+    }
+  }
+  // The share of the pupil that passes on the axis of the focus plane (discs centred there): the
+  // weights are normalised by it too, so that the centre of a uniform surface in focus keeps its
+  // radiance, as the exact model's and the ground truth's normalisations do.
+  std::vector<PupilDisc> axial;
+  clip_discs(ScenePoint{0.0, 0.0, inverse_per_mm(camera.focus_distance_mm())}, axial);
+  for (const PupilDisc& d : axial) axial_passing_share_ = std::min(axial_passing_share_, d.radius * d.radius);
   if (kind_ != RayModelKind::Seidel) return;
   // Coefficients over 64 wavelengths and object distances from the nearest scene depth to
   // infinity, evenly in 1 / distance, at the camera's f-number, normalised to the frame's corner.
@@ -26,6 +60,23 @@ ReferenceSphereModel::ReferenceSphereModel(RayModelKind kind, const Camera& came
   table_.emplace(*camera.lens(), t);
 }
 
+void ReferenceSphereModel::clip_discs(const ScenePoint& point, std::vector<PupilDisc>& discs) const {
+  discs.clear();
+  // The ray from the point to the entrance-pupil point a p has the height y = a p there and the
+  // slope u = (a p w - tan) / d, d = 1 + (z_EP - z_persp) w (inverse-depth form), so its height at
+  // an aperture, a_k a p + b_k u, stays within R_k on the disc |p - c| <= rho of the pupil with
+  // s = a (a_k + b_k w / d), c = (b_k / d) tan / s and rho = R_k / |s|.
+  const double w = point.inverse_depth_per_mm;
+  const double d = 1.0 + (z_entrance_pupil_mm_ - camera_.z_perspective_mm()) * w;
+  for (const ParaxialAperture& k : apertures_) {
+    const double scale = entrance_pupil_radius_mm_ * (k.a + k.b * w / d);
+    if (!(std::abs(scale) > 0.0)) continue;
+    const PupilDisc disc{k.b / d * point.tan_x / scale, k.b / d * point.tan_y / scale, k.radius_mm / std::abs(scale)};
+    // Only discs that cut the unit pupil matter.
+    if (std::hypot(disc.x, disc.y) + 1.0 > disc.radius) discs.push_back(disc);
+  }
+}
+
 void ReferenceSphereModel::map(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
                                std::span<SensorHit> hits) const {
   const FirstOrderSample fo = camera_.first_order(wavelength_nm);
@@ -33,13 +84,41 @@ void ReferenceSphereModel::map(const ScenePoint& point, double wavelength_nm, st
   const double r_exit = fo.exit_pupil_radius_mm * camera_.pupil_orientation();
   const double z_exit = fo.z_exit_pupil_mm;
   const double z_sensor = camera_.z_sensor_mm();
+  // Radiometric weights from the paraxial entrance pupil: the solid angle each pupil element
+  // subtends at the scene point, relative to the on-axis point of the focus plane (SensorHit).
+  // The ideal thin lens has none.
+  const bool weighted = kind_ != RayModelKind::Thin;
+  const double z_persp = camera_.z_perspective_mm();
+  const double r_entrance = fo.entrance_pupil_radius_mm;
+  const double weight_scale =
+      weighted ? 1.0 / (mean_axial_patch_solid_angle(inverse_per_mm(camera_.focus_distance_mm()), z_persp, r_entrance,
+                                                     fo.z_entrance_pupil_mm) *
+                        axial_passing_share_)
+               : 1.0;
+  auto weight = [&](const PupilPoint& q) {
+    return weighted ? weight_scale * patch_solid_angle(point, z_persp, r_entrance * q.x, r_entrance * q.y, fo.z_entrance_pupil_mm)
+                    : 1.0;
+  };
+
+  // First-order clear-aperture vignetting (clip_discs): a ray passes inside every disc.
+  thread_local std::vector<PupilDisc> discs;
+  clip_discs(point, discs);
+  auto clearance = [&](const PupilPoint& q) {
+    double c = 1.0;
+    for (const PupilDisc& d : discs) c = std::min(c, 1.0 - std::hypot(q.x - d.x, q.y - d.y) / d.radius);
+    return c;
+  };
+  auto hit = [&](double x_mm, double y_mm, const PupilPoint& q) {
+    const double c = clearance(q);
+    return SensorHit{x_mm, y_mm, c >= 0.0, true, weight(q), c};
+  };
 
   if (kind_ != RayModelKind::Seidel) {
     // Straight line from the exit-pupil point through the Gaussian image point to the sensor.
     const double t = (z_sensor - z_exit) / (g.z_mm - z_exit);
     for (std::size_t i = 0; i < pupil.size(); ++i) {
       const double px = r_exit * pupil[i].x, py = r_exit * pupil[i].y;
-      hits[i] = {px + (g.x_mm - px) * t, py + (g.y_mm - py) * t, true, true};
+      hits[i] = hit(px + (g.x_mm - px) * t, py + (g.y_mm - py) * t, pupil[i]);
     }
     return;
   }
@@ -77,7 +156,7 @@ void ReferenceSphereModel::map(const ScenePoint& point, double wavelength_nm, st
     const double qx = g.x_mm + ux * scale, qy = g.y_mm + uy * scale, qz = g.z_mm + uz * scale;
     const double d_x = p1x - qx, d_y = p1y - qy, d_z = g.z_mm - qz;
     const double s = (z_sensor - g.z_mm) / d_z;
-    hits[i] = {p1x + d_x * s, p1y + d_y * s, true, true};
+    hits[i] = hit(p1x + d_x * s, p1y + d_y * s, pupil[i]);
   }
 }
 

@@ -24,7 +24,6 @@ namespace lensmith {
 namespace {
 
 // Half-diagonal of a 36 x 24 mm frame (mm).
-constexpr double kFullFrameHalfDiagonalMm = 21.6333;
 // A surface joins the clipping set when its clear aperture cuts at least this fraction of the
 // training rays (fewer would not change a rendered image).
 constexpr double kClipFraction = 5e-4;
@@ -325,7 +324,7 @@ LensFit LensFit::fit(const Prescription& lens, const LensFitOptions& options,
   fit.lens_hash_ = prescription_hash(lens);
   fit.options_ = options;
   fit.sensor_z_mm_ = tracer.image_plane_z_mm();
-  fit.image_radius_mm_ = options.image_radius_mm.value_or(1.15 * kFullFrameHalfDiagonalMm);
+  fit.image_radius_mm_ = options.image_radius_mm.value_or(LensFitOptions::kDefaultImageRadiusMm);
   if (fit.sensor_z_mm_ <= lens.vertex_z_mm(lens.surfaces.size() - 1)) {
     throw FitError("lens fit: the paraxial focus (z = " + format_number(fit.sensor_z_mm_) +
                    " mm) is not behind the last surface: the sensor-side plane must lie in air after the lens");
@@ -524,11 +523,11 @@ FitTrace LensFit::evaluate(const RotationalMap& map, const RotationalMap& clip, 
   t.ray = PlaneRay{ray[0], ray[1], ray[2], ray[3]};
   t.stop_x_mm = at[0];
   t.stop_y_mm = at[1];
-  t.passes = t.ray.dx * t.ray.dx + t.ray.dy * t.ray.dy < 1.0;
   for (std::size_t q = 0; q < k; ++q) {
     const double limit = q == 0 && stop_radius_mm ? *stop_radius_mm : clip_[q].semi_diameter_mm;
-    t.passes = t.passes && at[2 * q] * at[2 * q] + at[2 * q + 1] * at[2 * q + 1] <= limit * limit;
+    t.clearance = std::min(t.clearance, 1.0 - std::hypot(at[2 * q], at[2 * q + 1]) / limit);
   }
+  t.passes = t.ray.dx * t.ray.dx + t.ray.dy * t.ray.dy < 1.0 && t.clearance >= 0.0;
   return t;
 }
 

@@ -37,7 +37,7 @@ constexpr double kPxPerGridCell = 1.5;
 // Returns false, depositing nothing, when a ray is lost or the rings are not nested (a fold or
 // caustic): the caller then uses the triangles.
 bool deposit_ring_polygons(const PupilMesh& mesh, const std::vector<SensorHit>& hits, const std::vector<Point2f>& points,
-                           const std::array<float, 4>& value, SplatBuffer& buffer, std::vector<double>& areas) {
+                           const std::array<float, 4>& value, bool weighted, SplatBuffer& buffer, std::vector<double>& areas) {
   for (const SensorHit& h : hits) {
     if (!h.ok) return false;
   }
@@ -58,22 +58,65 @@ bool deposit_ring_polygons(const PupilMesh& mesh, const std::vector<SensorHit>& 
     if (!(area > areas[static_cast<std::size_t>(k) - 1] + 1e-3 * std::max(area, 1e-9))) return false;
     areas[static_cast<std::size_t>(k)] = area;
   }
-  // Densities d_k per unit of value, then one deposit per ring polygon.
-  auto density = [&](int k) {
-    if (k > rings) return 0.0;
-    const double share = static_cast<double>(2 * k - 1) / (static_cast<double>(rings) * rings);
-    return share / (areas[static_cast<std::size_t>(k)] - areas[static_cast<std::size_t>(k) - 1]);
+  // The mean radiometric weight of the rays bounding each annulus (the centre ray for the first).
+  auto ring_weight = [&](int k) {
+    if (k == 0) return hits[0].weight;
+    double sum = 0.0;
+    for (int j = 0; j < sectors; ++j) sum += hits[1 + static_cast<std::size_t>(k - 1) * sectors + static_cast<std::size_t>(j)].weight;
+    return sum / sectors;
   };
+  // Light densities d_k per unit of value and coverage densities c_k (the annulus's share of the
+  // pupil, without the weights), then one deposit per ring polygon.
+  auto share = [&](int k) { return static_cast<double>(2 * k - 1) / (static_cast<double>(rings) * rings); };
+  auto area = [&](int k) { return areas[static_cast<std::size_t>(k)] - areas[static_cast<std::size_t>(k) - 1]; };
+  auto light = [&](int k) {
+    if (k > rings) return 0.0;
+    const double weight = weighted ? 0.5 * (ring_weight(k - 1) + ring_weight(k)) : 1.0;
+    return share(k) * weight / area(k);
+  };
+  auto coverage = [&](int k) { return k > rings ? 0.0 : share(k) / area(k); };
   for (int k = 1; k <= rings; ++k) {
-    const double factor = areas[static_cast<std::size_t>(k)] * (density(k) - density(k + 1));
+    const auto f = static_cast<float>(areas[static_cast<std::size_t>(k)] * (light(k) - light(k + 1)));
+    const auto c = static_cast<float>(areas[static_cast<std::size_t>(k)] * (coverage(k) - coverage(k + 1)));
     const std::span<const Point2f> ring(points.data() + 1 + static_cast<std::size_t>(k - 1) * sectors, static_cast<std::size_t>(sectors));
-    const auto f = static_cast<float>(factor);
-    buffer.add_polygon(ring, {value[0] * f, value[1] * f, value[2] * f, value[3] * f});
+    buffer.add_polygon(ring, {value[0] * f, value[1] * f, value[2] * f, value[3] * c});
   }
   return true;
 }
 
+// The share of a triangle's area where a function linear over it, with values a, b, c at the
+// corners, is >= 0: with one corner on the positive side the small triangle cut off there has the
+// share p^2 / ((p - q)(p - r)) of the area (similar triangles along its two edges).
+double positive_share(double a, double b, double c) {
+  const int positive = (a >= 0.0) + (b >= 0.0) + (c >= 0.0);
+  if (positive == 3) return 1.0;
+  if (positive == 0) return 0.0;
+  // Order so that `lone` is the corner alone on its side.
+  double lone = a, u = b, v = c;
+  const bool lone_positive = positive == 1;
+  if ((b >= 0.0) == lone_positive) {
+    lone = b, u = a, v = c;
+  } else if ((c >= 0.0) == lone_positive) {
+    lone = c, u = a, v = b;
+  }
+  const double corner = lone * lone / ((lone - u) * (lone - v));
+  return lone_positive ? corner : 1.0 - corner;
+}
+
 }  // namespace
+
+double FootprintScatter::passing_share(FootprintScratch& scratch) const {
+  // The finest outline: a coarse one would misjudge how much of the circle a disc cuts off.
+  const std::vector<PupilPoint>& outline = meshes_.outline(PupilMeshTable::kFinestOutline);
+  clip_pupil_polygon(outline, scratch.discs, scratch.clipped, scratch.clip_work);
+  return scratch.clipped.size() < 3 ? 0.0 : pupil_polygon_area(scratch.clipped) / pupil_polygon_area(outline);
+}
+
+std::array<float, 4> FootprintScatter::lit(const std::array<float, 4>& value, double weight) const {
+  if (!options_.vignetting) return value;
+  const auto w = static_cast<float>(weight);
+  return {value[0] * w, value[1] * w, value[2] * w, value[3]};
+}
 
 FootprintScatter::FootprintScatter(const RayModel& model, const Aperture& aperture, const SpectralGroups& groups,
                                    const PupilMeshTable& meshes, const BokehOptions& options)
@@ -99,15 +142,17 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
   hits.resize(pupil.size());
   const std::array<double, 3> lambdas{camera_.reference_wavelength_nm(), groups_.lowest_nm(), groups_.highest_nm()};
   std::array<std::array<PixelPoint, 9>, 3> px{};
-  std::array<std::array<bool, 9>, 3> ok{};
+  std::array<std::array<bool, 9>, 3> ok{};  // where the ray lands is known (it passes, or would)
+  bool any_clipped = false;
   double x_min = kInfinity, x_max = -kInfinity, y_min = kInfinity, y_max = -kInfinity;
   // Without dispersion (a thin lens, or colour off) one wavelength tells all.
   const std::size_t wavelengths = camera_.is_thin_lens() || !options_.spectral ? 1 : 3;
   for (std::size_t l = 0; l < wavelengths; ++l) {
     model_.map(point, lambdas[l], pupil, hits);
     for (std::size_t i = 0; i < 9; ++i) {
-      ok[l][i] = hits[i].ok;
-      if (!hits[i].ok) continue;
+      ok[l][i] = hits[i].ok || hits[i].unclipped;
+      any_clipped = any_clipped || !hits[i].ok;
+      if (!ok[l][i]) continue;
       px[l][i] = camera_.output_pixel(hits[i].x_mm, hits[i].y_mm);
       x_min = std::min(x_min, px[l][i].x);
       x_max = std::max(x_max, px[l][i].x);
@@ -138,6 +183,9 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
     }
     near_affine = worst < kAffineTolerancePx;
   }
+  // A clipped beam is one polygon only where the model describes its clipping as pupil discs.
+  model_.clip_discs(point, scratch.discs);
+  if (any_clipped && scratch.discs.empty()) near_affine = false;
   double spread = 0.0;
   for (std::size_t i = 0; i < 9; ++i) {
     if (ok[1][i] && ok[2][i]) spread = std::max(spread, std::hypot(px[1][i].x - px[2][i].x, px[1][i].y - px[2][i].y));
@@ -149,7 +197,7 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
   p.y_min = static_cast<float>(y_min - margin);
   p.y_max = static_cast<float>(y_max + margin);
   const int sector_step = PupilMeshTable::sector_step(size);
-  const bool all_pass = std::all_of(ok[0].begin(), ok[0].end(), [](bool b) { return b; });
+  const bool all_pass = !any_clipped;
   if (size < kPointFootprintPx && all_pass) {
     p.outline = FootprintPlan::kPoint;
   } else if (near_affine) {
@@ -157,7 +205,7 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
   } else if (aperture_.kind() == Aperture::Kind::Mask) {
     p.mesh = PupilMeshTable::grid_mesh(size / kPxPerGridCell);
   } else {
-    const bool clips = model_.kind() == RayModelKind::Exact || model_.kind() == RayModelKind::Poly;
+    const bool clips = any_clipped || model_.kind() == RayModelKind::Exact || model_.kind() == RayModelKind::Poly;
     const double rings = clips ? std::max(kMinClippingRings, size / kPxPerClippingRing) : size / kPxPerRing;
     p.mesh = PupilMeshTable::polar_mesh(rings, sector_step);
   }
@@ -170,6 +218,7 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
   std::vector<Point2f>& points = scratch.points;
   const Tangents t = camera_.frame().tangents_at({s.x + 0.5, s.y + 0.5});
   const ScenePoint point{t.x, t.y, s.inverse_depth_per_mm};
+  model_.clip_discs(point, scratch.discs);
   for (const SpectralGroup& g : groups_.split(p.groups)) {
     std::array<float, 4> value{};
     for (std::size_t c = 0; c < 3; ++c) value[c] = g.m[c][0] * s.rgb[0] + g.m[c][1] * s.rgb[1] + g.m[c][2] * s.rgb[2];
@@ -180,24 +229,36 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
       model_.map(point, g.wavelength_nm, kCentre, std::span<SensorHit>(hits.data(), 1));
       if (!hits[0].ok) continue;
       const PixelPoint c = camera_.output_pixel(hits[0].x_mm, hits[0].y_mm);
-      buffer.add_point({static_cast<float>(c.x), static_cast<float>(c.y)}, value);
+      buffer.add_point({static_cast<float>(c.x), static_cast<float>(c.y)}, lit(value, hits[0].weight));
       continue;
     }
     if (p.mesh < 0) {
-      // Affine model, uniform convex aperture: the outline mapped by the affine map of three rays.
+      // Affine model, uniform convex aperture: the outline, less what first-order vignetting cuts
+      // off, mapped by the affine map of three rays; it keeps the share of the light that passes.
       static constexpr std::array<PupilPoint, 3> kBasis{{{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}}};
       hits.resize(3);
       model_.map(point, g.wavelength_nm, kBasis, std::span<SensorHit>(hits.data(), 3));
       const PixelPoint o = camera_.output_pixel(hits[0].x_mm, hits[0].y_mm);
       const PixelPoint ex = camera_.output_pixel(hits[1].x_mm, hits[1].y_mm);
       const PixelPoint ey = camera_.output_pixel(hits[2].x_mm, hits[2].y_mm);
-      const std::vector<PupilPoint>& outline = meshes_.outline(p.outline);
-      points.resize(outline.size());
-      for (std::size_t i = 0; i < outline.size(); ++i) {
-        points[i] = {static_cast<float>(o.x + (ex.x - o.x) * outline[i].x + (ey.x - o.x) * outline[i].y),
-                     static_cast<float>(o.y + (ex.y - o.y) * outline[i].x + (ey.y - o.y) * outline[i].y)};
+      const std::vector<PupilPoint>* outline = &meshes_.outline(p.outline);
+      double passing = 1.0;
+      if (!scratch.discs.empty()) {
+        passing = passing_share(scratch);
+        clip_pupil_polygon(*outline, scratch.discs, scratch.clipped, scratch.clip_work);
+        if (scratch.clipped.size() < 3 || !(passing > 0.0)) continue;  // the whole beam is stopped
+        outline = &scratch.clipped;
       }
-      buffer.add_polygon(points, value);
+      points.resize(outline->size());
+      for (std::size_t i = 0; i < outline->size(); ++i) {
+        const PupilPoint& q = (*outline)[i];
+        points[i] = {static_cast<float>(o.x + (ex.x - o.x) * q.x + (ey.x - o.x) * q.y),
+                     static_cast<float>(o.y + (ex.y - o.y) * q.x + (ey.y - o.y) * q.y)};
+      }
+      std::array<float, 4> v = lit(value, hits[0].weight);
+      const auto light = static_cast<float>(options_.vignetting ? passing : 1.0);
+      for (std::size_t c = 0; c < 3; ++c) v[c] *= light;
+      buffer.add_polygon(points, v);
       continue;
     }
     const PupilMesh& mesh = meshes_.mesh(p.mesh);
@@ -209,25 +270,32 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
       const PixelPoint q = camera_.output_pixel(hits[i].x_mm, hits[i].y_mm);
       points[i] = {static_cast<float>(q.x), static_cast<float>(q.y)};
     }
-    if (mesh.sectors > 0 && deposit_ring_polygons(mesh, hits, points, value, buffer, scratch.areas)) continue;
-    // A triangle whose corners a clear aperture partly stops (the exact model) passes the fraction
-    // of its corners that get through, in place: the beam's edge falls inside it, to first order.
+    if (mesh.sectors > 0 && deposit_ring_polygons(mesh, hits, points, value, options_.vignetting, buffer, scratch.areas)) continue;
+    // A triangle whose corners a clear aperture partly stops (exact, poly) passes the part of its
+    // area where the linear interpolation of their clearances is >= 0, in place: the beam's edge
+    // falls inside it, to first order.
     auto passing = [&hits](const PupilTriangle& tri) {
-      if (!(hits[tri.a].ok || hits[tri.a].unclipped) || !(hits[tri.b].ok || hits[tri.b].unclipped) ||
-          !(hits[tri.c].ok || hits[tri.c].unclipped)) {
-        return 0.0;
-      }
-      return ((hits[tri.a].ok ? 1.0 : 0.0) + (hits[tri.b].ok ? 1.0 : 0.0) + (hits[tri.c].ok ? 1.0 : 0.0)) / 3.0;
+      const SensorHit& a = hits[static_cast<std::size_t>(tri.a)];
+      const SensorHit& b = hits[static_cast<std::size_t>(tri.b)];
+      const SensorHit& c = hits[static_cast<std::size_t>(tri.c)];
+      if (!(a.ok || a.unclipped) || !(b.ok || b.unclipped) || !(c.ok || c.unclipped)) return 0.0;
+      return positive_share(a.clearance, b.clearance, c.clearance);
     };
-    // Colour carries the transmitted fraction (vignetting darkens); coverage is normalised over the
-    // light that passes, so a vignetted point is still an opaque surface.
+    // Colour carries the transmitted fraction and the rays' radiometric weights (vignetting darkens);
+    // coverage is normalised over the light that passes, so a vignetted point is still an opaque
+    // surface. Without vignetting the colour is normalised the same way.
     double passed = 0.0;
     for (const PupilTriangle& tri : mesh.triangles) passed += tri.weight * passing(tri);
     if (!(passed > 0.0)) continue;
+    // Where the model describes its clipping as discs, the light that passes is known exactly (the
+    // outline less the discs); the triangles' linear interpolation only distributes it.
+    const double exact_share = !scratch.discs.empty() && aperture_.is_uniform_convex() ? passing_share(scratch) : passed;
+    const double unlit = options_.vignetting ? exact_share / passed : 1.0 / passed;
     for (const PupilTriangle& tri : mesh.triangles) {
       const double fraction = passing(tri);
       if (fraction == 0.0) continue;
-      const auto w = static_cast<float>(tri.weight * fraction);
+      const double ray_weight = options_.vignetting ? (hits[tri.a].weight + hits[tri.b].weight + hits[tri.c].weight) / 3.0 : 1.0;
+      const auto w = static_cast<float>(tri.weight * fraction * ray_weight * unlit);
       fine.add_triangle(points[static_cast<std::size_t>(tri.a)], points[static_cast<std::size_t>(tri.b)],
                         points[static_cast<std::size_t>(tri.c)],
                         {value[0] * w, value[1] * w, value[2] * w, static_cast<float>(value[3] * tri.weight * fraction / passed)});

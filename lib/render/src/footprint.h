@@ -36,6 +36,9 @@ struct FootprintScratch {
   std::vector<SensorHit> hits;
   std::vector<Point2f> points;
   std::vector<double> areas;
+  std::vector<PupilDisc> discs;     // the model's first-order clipping of the current point
+  std::vector<PupilPoint> clipped;  // the aperture's outline less what they cut off
+  std::vector<PupilPoint> clip_work;
 };
 
 // Everything a footprint depends on besides its source; one per render, shared by the threads.
@@ -51,6 +54,12 @@ class FootprintScatter {
                FootprintScratch& scratch, std::size_t& triangles) const;
 
  private:
+  // `value` with its light (not its coverage) scaled by a ray's radiometric weight (SensorHit), when
+  // BokehOptions::vignetting is on.
+  std::array<float, 4> lit(const std::array<float, 4>& value, double weight) const;
+  // The share of the aperture that passes scratch.discs (the model's first-order vignetting).
+  double passing_share(FootprintScratch& scratch) const;
+
   const RayModel& model_;
   const Camera& camera_;
   const Aperture& aperture_;

@@ -22,6 +22,7 @@ class PupilMeshTable {
   // Mesh index of a grid with at least `cells` cells per side (capped); aperture pictures only.
   static int grid_mesh(double cells);
 
+  static constexpr int kFinestOutline = 8;  // the sector step with the most vertices (128)
   const PupilMesh& mesh(int index) const { return meshes_[static_cast<std::size_t>(index)]; }
   // The outline for a sector step (blades: their corners only).
   const std::vector<PupilPoint>& outline(int sector_step) const { return outlines_[static_cast<std::size_t>(sector_step)]; }

@@ -170,7 +170,24 @@ struct Node {
   double z_exit_pupil_mm = 0.0;
   double sampled_radius_mm = 0.0;  // enlarged exit-pupil radius
   Rgb rgb_weight{1.0, 1.0, 1.0};   // spectral: rgb_weights(i) / probability
+  // Sampled disc area / on-axis projected solid angle of the real beam (mm^2 / sr): times cos^4 / D^2
+  // of a sample, the share of the centre's irradiance that sample stands for.
+  double weight_scale = 1.0;
 };
+
+// Polar midpoint grid of the on-axis irradiance integral (rings x sectors over the sampled disc):
+// the beam's edge falls within 1/512 of the disc's radius.
+constexpr int kAxisRings = 512;
+constexpr int kAxisSectors = 8;
+
+// cos^4 of the angle between `towards` (from the sensor point to a point of the exit-pupil plane)
+// and the axis, over the squared axial distance D^2: the projected solid angle per unit area of the
+// plane, cos(theta_sensor) cos(theta_pupil) / d^2 with d = D / cos(theta) (pbrt-v4 RealisticCamera).
+double projected_solid_angle_density(const Eigen::Vector3d& towards) {
+  const double d2 = towards.squaredNorm();
+  const double cos2 = towards.z() * towards.z() / d2;
+  return cos2 * cos2 / (towards.z() * towards.z());
+}
 
 }  // namespace
 
@@ -247,8 +264,36 @@ LensRender render_through_lens(const Scene& scene, const Camera& camera, const L
   } else {
     nodes.push_back(node_at(camera.reference_wavelength_nm()));
   }
-  // Each sample stands for the enlarged disc's area over the nominal pupil's.
-  const double area_ratio = kPupilEnlargement * kPupilEnlargement;
+  // Irradiance is radiance times the projected solid angle of the beam that reaches the sensor
+  // point: each sample stands for (disc area) cos^4 / D^2 of it. Normalised by the on-axis value of
+  // the real beam at each wavelength, so that a uniform surface in focus renders to its radiance at
+  // the centre of the frame and falls off towards the edges as the lens's relative illumination
+  // (cos^4-type falloff, vignetting, pupil aberration; `lensmith analyze --what illumination`).
+  const double z_sensor_axis = camera.z_sensor_mm();
+  for (Node& n : nodes) {
+    const double disc = n.sampled_radius_mm;
+    double on_axis = 0.0;
+    for (int i = 0; i < kAxisRings; ++i) {
+      const double r = disc * (i + 0.5) / kAxisRings;
+      const double ring_cell = r * (disc / kAxisRings) * (2.0 * kPi / kAxisSectors);
+      for (int j = 0; j < kAxisSectors; ++j) {
+        const double phi = 2.0 * kPi * (j + 0.5) / kAxisSectors;
+        Eigen::Vector3d towards(r * std::cos(phi), r * std::sin(phi), n.z_exit_pupil_mm - z_sensor_axis);
+        if (towards.z() > 0.0) towards = -towards;
+        if (!(towards.z() < 0.0)) continue;
+        Ray ray;
+        ray.position_mm = Eigen::Vector3d(0.0, 0.0, z_sensor_axis);
+        ray.direction = towards.normalized();
+        ray.wavelength_nm = n.wavelength_nm;
+        if (tracer.trace_backward(ray).ok()) on_axis += projected_solid_angle_density(towards) * ring_cell;
+      }
+    }
+    if (!(on_axis > 0.0)) {
+      throw ComputationError("no ray from the centre of the sensor passes the lens at " + format_number(n.wavelength_nm) +
+                             " nm: the stop or a clear aperture closes the beam");
+    }
+    n.weight_scale = kPi * disc * disc / on_axis;
+  }
 
   const CameraBasis basis = scene.camera.basis();
   const Eigen::Vector3d position_m = scene.camera.position_m;
@@ -285,9 +330,9 @@ LensRender render_through_lens(const Scene& scene, const Camera& camera, const L
     const Eigen::Vector3d direction = (d.x() * basis.right + d.y() * basis.up - d.z() * basis.forward).normalized();
     const std::optional<SceneHit> hit = intersect(scene, SceneRay{origin_m, direction});
     const Rgb radiance = hit ? hit->radiance : scene.background;
-    if (!spectrum) return {area_ratio * radiance, SampleFate::ReachedScene};
-    return {(area_ratio * spectrum->spectrum_value(radiance, node.wavelength_nm)) * node.rgb_weight,
-            SampleFate::ReachedScene};
+    const double weight = node.weight_scale * projected_solid_angle_density(towards);
+    if (!spectrum) return {weight * radiance, SampleFate::ReachedScene};
+    return {(weight * spectrum->spectrum_value(radiance, node.wavelength_nm)) * node.rgb_weight, SampleFate::ReachedScene};
   };
   return render_progressive(camera, options, sample);
 }

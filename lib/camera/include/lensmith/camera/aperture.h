@@ -5,6 +5,7 @@
 #pragma once
 
 #include <ostream>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,25 @@ struct PupilMesh {
   int sectors = 0;  // polar meshes: vertices per ring
   std::string to_string() const;
 };
+
+// A disc of the normalised pupil (centre and radius in pupil units): the pupil points whose rays
+// pass one clear aperture, to first order (RayModel::clip_discs).
+struct PupilDisc {
+  double x = 0.0;
+  double y = 0.0;
+  double radius = 0.0;
+};
+
+// Area of a simple polygon of the pupil (shoelace formula), either winding.
+double pupil_polygon_area(const std::vector<PupilPoint>& polygon);
+
+// `convex` (a convex pupil polygon, either winding) less what lies outside any of `discs`, into
+// `out` (empty when nothing is left): each disc cuts in turn, in O(vertices) — vertices inside it
+// stay, an edge that leaves it ends where it crosses the circle, and the circle's arc inside the
+// polygon (which, both being convex, runs from that exit to the next entry) is drawn in chords of
+// at most 0.1 rad, within 1/800 of its radius. `work` is scratch space.
+void clip_pupil_polygon(const std::vector<PupilPoint>& convex, std::span<const PupilDisc> discs, std::vector<PupilPoint>& out,
+                        std::vector<PupilPoint>& work);
 
 class Aperture {
  public:

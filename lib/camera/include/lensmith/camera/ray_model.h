@@ -19,6 +19,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "lensmith/camera/aperture.h"
 #include "lensmith/camera/camera.h"
@@ -36,11 +37,28 @@ RayModelKind parse_ray_model_kind(std::string_view text);
 // Where a ray meets the sensor plane (mm, lens frame). ok = false when it does not get there; then
 // `unclipped` says whether x, y still hold where it would land if no clear aperture stopped it (the
 // exact model), so callers can place the edge of a vignetted beam between rays.
+//
+// `weight` is the ray's radiometric weight: the light it carries, per unit of normalised pupil
+// area, relative to the rays of the on-axis point of the focus plane, whose mean over the unit
+// pupil is 1. It is the étendue of the pixel's patch of scene through that part of the pupil: the
+// patch's area seen from the perspective centre (cos theta of the pinhole framing) times the solid
+// angle the pupil element subtends at the point (cos^3 theta for a distant point, more off axis where
+// the real entrance pupil grows), so that a uniform surface falls off across the frame as the
+// lens's relative illumination (cos^4-type) times its clear-aperture vignetting. The thin lens, the
+// ideal camera of path tracers, has weight 1 everywhere.
+//
+// `clearance` is how far inside the tightest clear aperture the ray passes, as a fraction of that
+// aperture's radius: min over the clipping surfaces of 1 - r / R, >= 0 when it passes (ok) and
+// < 0 when it is stopped (then `unclipped` holds where it would land). Between two rays the edge
+// of the beam lies, to first order, where the linear interpolation of their clearances is 0.
+// Models that clip nothing give 1.
 struct SensorHit {
   double x_mm = 0.0;
   double y_mm = 0.0;
   bool ok = false;
   bool unclipped = false;
+  double weight = 1.0;
+  double clearance = 1.0;
 };
 
 class RayModel {
@@ -55,6 +73,11 @@ class RayModel {
   // `hits` has the size of `pupil`. Thread-safe; allocates nothing per call once warm.
   virtual void map(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
                    std::span<SensorHit> hits) const = 0;
+  // First-order models' clear-aperture vignetting of one scene point: the pupil points that pass are
+  // those inside every disc of `discs` (cleared first; none: nothing clips). Models that clip rays
+  // by tracing them (exact, poly) report it through map()'s `ok` and `clearance` and leave this
+  // empty. Thread-safe.
+  virtual void clip_discs(const ScenePoint& /*point*/, std::vector<PupilDisc>& discs) const { discs.clear(); }
   const Camera& camera() const { return camera_; }
   virtual std::string to_string() const;
   friend std::ostream& operator<<(std::ostream& os, const RayModel& m) { return os << m.to_string(); }
@@ -74,6 +97,11 @@ struct RayModelOptions {
   std::shared_ptr<const LensFit> fit;
   void validate() const;             // throws OptionsError
 };
+
+// The options of a fit that serves `camera` (a prescription camera): its f-number, and a sensor
+// radius covering its frame with the default's 15 % margin (at least the default's), so that a fit
+// made for a render covers what is rendered.
+LensFitOptions lens_fit_options_for(const Camera& camera);
 
 // Thin needs a thin-lens camera; the others a camera made from a prescription. Throws OptionsError
 // for a mismatch (poly: a fit of another lens, a stop wider than the fit's, a frame or wavelength

@@ -58,9 +58,12 @@ struct LensFitOptions {
   std::uint64_t seed = 2016;   // training stream; the test stream is derived from it
   double min_wavelength_nm = 380.0;
   double max_wavelength_nm = 780.0;
-  // Radius (mm) on the sensor plane the fit covers. Empty: 1.15 x the half-diagonal of a 36 x 24 mm
-  // frame (24.9 mm), enough for a full-frame sensor refocused to about f^2 / 10 mm behind the plane.
+  // Radius (mm) on the sensor plane the fit covers. Empty: kDefaultImageRadiusMm, 1.15 x the
+  // half-diagonal of a 36 x 24 mm frame, enough for a full-frame sensor refocused to about
+  // f^2 / 10 mm behind the plane.
   std::optional<double> image_radius_mm;
+  static constexpr double kFullFrameHalfDiagonalMm = 21.6333;
+  static constexpr double kDefaultImageRadiusMm = 1.15 * kFullFrameHalfDiagonalMm;
   // Widest f-number the fit serves (a camera's iris opened beyond the prescription's stop); empty:
   // the lens's own. The fitted beam fills the stop at the wider of the two.
   std::optional<double> f_number;
@@ -124,6 +127,9 @@ struct FitTrace {
   double stop_x_mm = 0.0;
   double stop_y_mm = 0.0;
   bool passes = false;
+  // min over the clipping surfaces of 1 - r / R (r the fitted radius of the crossing, R the clear
+  // semi-diameter, the stop's as clipped): >= 0 where the ray passes every one of them.
+  double clearance = 1.0;
   std::string to_string() const;
   friend std::ostream& operator<<(std::ostream& os, const FitTrace& t) { return os << t.to_string(); }
 };
@@ -262,11 +268,12 @@ class LensFit {
     friend bool operator==(const FrontSurface&, const FrontSurface&) = default;
   };
   const FrontSurface& front_surface() const { return front_; }
+  // Sag of the front surface at r^2 (mm^2): its z (mm, from its vertex) and optionally dz / d(r^2);
+  // empty beyond the conic's domain.
+  std::optional<double> front_sag(double r2, double* dz_dr2) const;
 
  private:
   LensFit() = default;
-  // Sag of the front surface at r^2 (mm) and optionally dz / d(r^2); empty beyond the conic's domain.
-  std::optional<double> front_sag(double r2, double* dz_dr2) const;
   // outer_ray_from_object's ray with the derivatives of its direction in the surface point's x, y.
   struct OuterLine {
     PlaneRay ray;

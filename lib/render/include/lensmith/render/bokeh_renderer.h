@@ -49,6 +49,11 @@ struct BokehOptions {
   int max_layers = 64;                   // cap; the spacing grows when the blur range needs more (1..1024)
   HiddenSurfaces hidden = HiddenSurfaces::Extend;
   bool split_edge_pixels = true;         // split anti-aliased depth-edge pixels between their two surfaces
+  // true: a point is as bright as the lens makes it (the rays' radiometric weights: cos^4-type
+  // falloff, the growth of the real pupil off axis; clear apertures that clip a beam darken it).
+  // false: every point as bright as on the axis, for those who want only the blur; a clipped beam
+  // keeps its cat's-eye shape but not the loss of light.
+  bool vignetting = true;
   bool spectral = true;                  // false: every ray at the reference wavelength, RGB as given
   int spectral_samples = 16;             // wavelength nodes of the quadrature (3..64)
   double chromatic_tolerance_px = 0.5;   // largest colour separation left unresolved within a pixel's bokeh

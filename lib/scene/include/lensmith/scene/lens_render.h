@@ -10,10 +10,14 @@
 // lens-frame direction (l, m, n) is (l, m, -n), as the bokeh models place scene points
 // (exact_model.cpp, ray_towards).
 //
-// Normalisation: every sample that reaches the scene carries (enlarged pupil disc area / nominal
-// exit-pupil disc area) times the radiance it sees, so an unvignetted on-axis point of a uniform
-// surface renders to exactly its radiance. No cos^4 falloff is applied: the bokeh models do not
-// apply it either, so a comparison measures the ray model alone.
+// Radiometry: the irradiance of a sensor point is the radiance of each ray times the projected solid
+// angle it stands for, cos^4(theta) / D^2 per unit area of the sampled exit-pupil plane at axial
+// distance D (pbrt-v4 RealisticCamera's weight). It is normalised, per wavelength, by the projected
+// solid angle of the real on-axis beam of the sensor's centre, so a uniform surface in focus renders
+// to exactly its radiance at the centre and falls off across the frame as the lens's relative
+// illumination (cos^4-type falloff, clear-aperture vignetting, pupil aberration), as `lensmith
+// analyze --what illumination` computes it. The thin lens, like path tracers' thin-lens cameras,
+// has no falloff: every pixel of a uniform surface renders to its radiance.
 #pragma once
 
 #include <cstdint>

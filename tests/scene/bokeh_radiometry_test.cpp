@@ -1,0 +1,133 @@
+// Brightness across the frame against outside truth. The ground truth through the lens weights each
+// ray by the projected solid angle it stands for (pbrt-v4's RealisticCamera weight) and must agree
+// with an independent method, the relative illumination of lensmith analyze (Rimmer, Proc. SPIE
+// 655, 99 (1986): the area of the image-space beam in direction-cosine space). Every ray model of
+// the bokeh renderer must then render a flat white wall as bright as that ground truth, from the
+// centre of the frame to corners where the lens keeps 15 % of the light.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "lensmith/analysis/relative_illumination.h"
+#include "lensmith/core/units.h"
+#include "lensmith/prescription/lens_library.h"
+#include "lensmith/render/bokeh_renderer.h"
+#include "lensmith/scene/lens_render.h"
+#include "lensmith/scene/pinhole_render.h"
+
+using namespace lensmith;
+
+namespace {
+
+Scene white_wall(double z_m) {
+  Scene s;
+  s.name = "white wall";
+  s.background = Rgb{1.0, 1.0, 1.0};
+  SceneObject wall;
+  wall.name = "wall";
+  wall.shape = Plane{Eigen::Vector3d(0.0, 0.0, z_m), Eigen::Vector3d(0.0, 0.0, -1.0), std::nullopt};
+  wall.material.albedo = ConstantTexture{Rgb{1.0, 1.0, 1.0}};
+  s.objects.push_back(wall);
+  return s;
+}
+
+// Mean of channel 1 over the w x h patch at (x, y).
+double patch_mean(const Image& img, int x, int y, int w, int h) {
+  double sum = 0.0;
+  for (int j = y; j < y + h; ++j) {
+    for (int i = x; i < x + w; ++i) sum += img.at(i, j, 1);
+  }
+  return sum / (w * h);
+}
+
+Prescription lens_at(const std::string& name) { return LensLibrary::load_path_or_name(name).prescription; }
+
+}  // namespace
+
+TEST_CASE("The ground truth through the lens falls off across the field as the relative illumination of lensmith analyze",
+          "[scene][radiometry]") {
+  // The 100 mm double Gauss of pbrt's lens set (f/2, 22 deg half field) at its own f-number, a
+  // wall 10 km away, focus at infinity: the object of the relative-illumination analysis. A 72 mm
+  // wide frame of 96 px puts field angles of up to 19 deg on the middle row.
+  const Prescription lens = lens_at(std::string(LENSMITH_TEST_DATA_DIR) + "/pbrt/dgauss.dat");
+  const int w = 96, h = 64;
+  CameraOptions co;
+  co.focus_distance_m = kInfinity;
+  co.framing.sensor_width_mm = 72.0;
+  const Camera camera = Camera::from_lens(lens, co, w, h);
+  LensRenderOptions ro;
+  ro.spp = 1024;
+  ro.spectral = false;
+  const LensRender truth = render_through_lens(white_wall(1.0e4), camera, ro);
+
+  IlluminationOptions io;
+  io.field_samples = 12;  // 0, 2, 4, ... 22 deg
+  const RelativeIllumination ri = compute_relative_illumination(AnalysisContext(lens), io);
+  const double centre = patch_mean(truth.rgb, w / 2 - 2, h / 2 - 2, 4, 4);
+  // Monte-Carlo noise of a 3 x 6 patch at 1024 spp: about 0.8 %; the pupil grid of the analysis
+  // (64 x 64) and the 0.3 degrees a patch spans: about 1 %.
+  constexpr double kTolerance = 0.03;
+  for (const IlluminationPoint& p : ri.points) {
+    const double x_px = 0.5 * w + std::tan(rad_from_deg(p.field_value)) * camera.frame().focal_length_px();
+    if (x_px + 2.0 > w || p.field_value == 0.0) continue;
+    const double at_field = patch_mean(truth.rgb, static_cast<int>(x_px) - 1, h / 2 - 3, 3, 6) / centre;
+    INFO(p.field_value << " deg: ground truth " << at_field << " of the centre, relative illumination " << p.relative_illumination);
+    CHECK(at_field == Approx(p.relative_illumination).margin(kTolerance));
+  }
+}
+
+TEST_CASE("Every ray model renders a flat white wall through a vignetting lens as bright as the ground truth, centre to corner",
+          "[scene][radiometry]") {
+  // pbrt's 50 mm double Gauss opened to f/2 and focused on a white wall at 2 m, on a 36 mm frame: its
+  // clear apertures and the cos^4-type falloff leave 15 % of the centre's light in the corners.
+  const Prescription lens = lens_at("pbrt-dgauss-50mm");
+  const int w = 64, h = 48;
+  CameraOptions co;
+  co.focus_distance_m = 2.0;
+  co.f_number = 2.0;
+  const Camera camera = Camera::from_lens(lens, co, w, h);
+  const Scene scene = white_wall(2.0);
+  LensRenderOptions ro;
+  ro.spp = 2048;
+  ro.spectral = false;
+  const LensRender truth = render_through_lens(scene, camera, ro);
+  const PinholeRender input = render_pinhole(scene, camera.frame());
+
+  RayModelOptions mo;
+  mo.nearest_depth_m = 1.0;
+  LensFitOptions fo = lens_fit_options_for(camera);
+  fo.training_rays = 8000;  // a quick fit: its errors are microns, far below what brightness shows
+  fo.test_rays = 1000;
+  mo.fit = std::make_shared<const LensFit>(LensFit::fit(lens, fo));
+  // Tolerances, relative to the truth's value at each patch (its noise: about 1 %). The exact model
+  // and the fit see the real pupil, but take the area of a beam's pupil element per unit stop area
+  // from one Jacobian per beam: 5 % dark in the corners, where the beam is a narrow cat's eye.
+  // Paraxial and Seidel take vignetting and the pupil's solid angle from first-order optics, which
+  // the real pupil's aberration departs from by up to 9 % there.
+  const std::vector<std::pair<RayModelKind, double>> models{
+      {RayModelKind::Exact, 0.07}, {RayModelKind::Poly, 0.07}, {RayModelKind::Paraxial, 0.1}, {RayModelKind::Seidel, 0.1}};
+  BokehOptions bo;
+  bo.spectral = false;
+  for (const auto& [kind, tolerance] : models) {
+    const auto model = make_ray_model(kind, camera, mo);
+    const Image out = render_bokeh(input.rgb, input.depth, *model, Aperture::circular(), bo);
+    // Along the diagonal, 4 x 4 patches from 4 px inside the corner to the centre.
+    for (int x = 4; x <= w / 2 - 4; x += 6) {
+      const int y = x * h / w;
+      const double expected = patch_mean(truth.rgb, x, y, 4, 4);
+      const double got = patch_mean(out, x, y, 4, 4);
+      INFO(to_string(kind) << " at (" << x << ", " << y << "): " << got << ", ground truth " << expected);
+      CHECK(got == Approx(expected).epsilon(tolerance));
+    }
+    const double centre = patch_mean(out, w / 2 - 2, h / 2 - 2, 4, 4);
+    INFO(to_string(kind) << " centre " << centre << ", ground truth " << patch_mean(truth.rgb, w / 2 - 2, h / 2 - 2, 4, 4));
+    CHECK(centre == Approx(patch_mean(truth.rgb, w / 2 - 2, h / 2 - 2, 4, 4)).epsilon(0.015));
+    // Without vignetting, every point as bright as the centre.
+    BokehOptions flat = bo;
+    flat.vignetting = false;
+    const Image unlit = render_bokeh(input.rgb, input.depth, *model, Aperture::circular(), flat);
+    CHECK(patch_mean(unlit, 4, 3, 4, 4) == Approx(1.0).epsilon(1e-3));
+  }
+}
