@@ -193,7 +193,8 @@ void clip_pupil_polygon(const std::vector<PupilPoint>& convex, std::span<const P
     work.clear();
     const std::size_t n = out.size();
     if (n < 3) break;
-    auto inside = [&d](const PupilPoint& q) { return std::hypot(q.x - d.x, q.y - d.y) <= d.radius; };
+    const double r2 = d.radius * d.radius;
+    auto inside = [&d, r2](const PupilPoint& q) { return (q.x - d.x) * (q.x - d.x) + (q.y - d.y) * (q.y - d.y) <= r2; };
     // Where the segment a -> b crosses the circle (the root in [0, 1] of |a + t (b - a) - c| = R).
     auto crossing = [&d](const PupilPoint& a, const PupilPoint& b, bool entering) {
       const double ex = b.x - a.x, ey = b.y - a.y, fx = a.x - d.x, fy = a.y - d.y;
@@ -216,9 +217,14 @@ void clip_pupil_polygon(const std::vector<PupilPoint>& convex, std::span<const P
         while (sweep > 0.0) sweep -= 2.0 * kPi;
       }
       const int steps = static_cast<int>(std::ceil(std::abs(sweep) / kArcStepRad));
+      // Rotate the radius vector step by step (no trigonometry per point).
+      const double c = std::cos(sweep / steps), sn = std::sin(sweep / steps);
+      double vx = from.x - d.x, vy = from.y - d.y;
       for (int k = 1; k < steps; ++k) {
-        const double a = a0 + sweep * k / steps;
-        work.push_back({d.x + d.radius * std::cos(a), d.y + d.radius * std::sin(a)});
+        const double nx = c * vx - sn * vy;
+        vy = sn * vx + c * vy;
+        vx = nx;
+        work.push_back({d.x + vx, d.y + vy});
       }
     };
     // Start at a vertex inside, if any; a polygon wholly outside the disc may still contain it.
@@ -236,7 +242,8 @@ void clip_pupil_polygon(const std::vector<PupilPoint>& convex, std::span<const P
         const PupilPoint& b = out[(i + 1) % n];
         const double ex = b.x - a.x, ey = b.y - a.y;
         const double t = std::clamp(((d.x - a.x) * ex + (d.y - a.y) * ey) / (ex * ex + ey * ey), 0.0, 1.0);
-        any_crossing = std::hypot(a.x + t * ex - d.x, a.y + t * ey - d.y) <= d.radius;
+        const double gx = a.x + t * ex - d.x, gy = a.y + t * ey - d.y;
+        any_crossing = gx * gx + gy * gy <= r2;
       }
       if (!any_crossing) {
         // Disjoint, or the disc lies inside the polygon: then the disc itself is what passes.
@@ -282,7 +289,8 @@ void clip_pupil_polygon(const std::vector<PupilPoint>& convex, std::span<const P
         // Both outside: the edge may still pass through the disc.
         const double ex = b.x - a.x, ey = b.y - a.y;
         const double t = std::clamp(((d.x - a.x) * ex + (d.y - a.y) * ey) / (ex * ex + ey * ey), 0.0, 1.0);
-        if (std::hypot(a.x + t * ex - d.x, a.y + t * ey - d.y) < d.radius) {
+        const double gx = a.x + t * ex - d.x, gy = a.y + t * ey - d.y;
+        if (gx * gx + gy * gy < r2) {
           const PupilPoint entry = crossing(a, b, true);
           if (exit) {
             work.push_back(*exit);

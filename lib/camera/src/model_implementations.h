@@ -118,8 +118,13 @@ class ReferenceSphereModel final : public RayModel {
   void map(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
            std::span<SensorHit> hits) const override;
   void clip_discs(const ScenePoint& point, std::vector<PupilDisc>& discs) const override;
+  void map_passing(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
+                   std::span<SensorHit> hits) const override;
 
  private:
+  // map() with or without the clearance of each ray (first-order vignetting).
+  void map_with(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil, std::span<SensorHit> hits,
+                bool clearance) const;
   // A clear aperture as the paraxial optics sees it: the height at its vertex plane of the paraxial
   // ray that crosses the entrance-pupil plane at height y with slope u is a y + b u (reference
   // wavelength); it passes while that height is at most `radius` (mm).

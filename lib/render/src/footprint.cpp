@@ -25,11 +25,115 @@ constexpr double kMeshMarginFraction = 0.25;
 constexpr double kMinClippingRings = 4.0;
 constexpr double kPxPerClippingRing = 6.0;
 constexpr double kPxPerRing = 16.0;
+// Adjacent rings of a mapped pupil mesh whose light densities differ by less than this share of the
+// largest are deposited as one (a 2 % step in a large disc is below what a picture shows).
+constexpr double kRingMergeTolerance = 0.02;
 // Grid cells of an aperture-picture mesh per pixel of footprint size.
 constexpr double kPxPerGridCell = 1.5;
 
-// A polar mesh mapped without folds deposits as nested rings: annulus k (between mapped rings k-1
-// and k) carries its share of the pupil, (2k - 1) / R^2, spread evenly over its mapped area. As the
+// Whether the pupil's centre (the chief ray) passes every disc: the passing region, an intersection
+// of convex sets around it, is then star-shaped about it.
+bool centre_passes(const std::vector<PupilDisc>& discs) {
+  for (const PupilDisc& d : discs) {
+    if (d.x * d.x + d.y * d.y >= d.radius * d.radius) return false;
+  }
+  return true;
+}
+
+// For each vertex direction u of `outline` (from the centre), how far along u the discs' intersection
+// reaches: min over the discs of the root s > 0 of |s u - c| = rho. The centre must pass every disc.
+void disc_reach(const std::vector<PupilPoint>& outline, const std::vector<PupilDisc>& discs, std::vector<double>& reach) {
+  reach.resize(outline.size());
+  for (std::size_t j = 0; j < outline.size(); ++j) {
+    const double len = std::sqrt(outline[j].x * outline[j].x + outline[j].y * outline[j].y);
+    const double ux = outline[j].x / len, uy = outline[j].y / len;
+    double s = kInfinity;
+    for (const PupilDisc& d : discs) {
+      const double b = ux * d.x + uy * d.y;
+      s = std::min(s, b + std::sqrt(b * b - (d.x * d.x + d.y * d.y) + d.radius * d.radius));
+    }
+    reach[j] = s / len;  // in units of the vertex's own distance
+  }
+}
+
+// The outline scaled by `scale`, less what lies beyond the discs' reach along each vertex direction:
+// with the centre inside every disc, the passing part of a star-shaped outline is star-shaped too,
+// and its radius along each direction is the smaller of the two.
+void reach_clip(const std::vector<PupilPoint>& outline, double scale, const std::vector<double>& reach, std::vector<PupilPoint>& out) {
+  out.resize(outline.size());
+  for (std::size_t j = 0; j < outline.size(); ++j) {
+    const double f = std::min(scale, reach[j]);
+    out[j] = {outline[j].x * f, outline[j].y * f};
+  }
+}
+
+// Nested ring polygons of any vertex counts (rings[k - 1], mapped to the output) with the pupil
+// areas they enclose (pupil_areas[k], pupil_areas[0] = 0) and their rays' mean radiometric weights
+// (ring_weights[k], [0] the centre ray's): annulus k carries the light of its pupil area over
+// `full_pupil_area` (so what first-order vignetting cuts off is missing) and the coverage of its
+// pupil area over the ring set's (an opaque point, however vignetted), spread evenly over its mapped
+// area. Rings are merged where the densities differ by less than kRingMergeTolerance. Returns false,
+// depositing nothing, where the mapped rings are not nested (a fold or caustic).
+bool deposit_nested_rings(const std::vector<std::span<const Point2f>>& rings, const std::vector<double>& pupil_areas,
+                          const std::vector<double>& ring_weights, double full_pupil_area, const std::array<float, 4>& value,
+                          bool weighted, SplatBuffer& buffer, std::vector<double>& areas) {
+  const int count = static_cast<int>(rings.size());
+  areas.assign(static_cast<std::size_t>(count) + 1, 0.0);
+  double orientation = 0.0;
+  for (int k = 1; k <= count; ++k) {
+    const std::span<const Point2f> ring = rings[static_cast<std::size_t>(k - 1)];
+    double twice = 0.0;
+    for (std::size_t j = 0; j < ring.size(); ++j) {
+      const Point2f& a = ring[j];
+      const Point2f& b = ring[(j + 1) % ring.size()];
+      twice += static_cast<double>(a.x) * b.y - static_cast<double>(b.x) * a.y;
+    }
+    if (k == 1) orientation = twice < 0.0 ? -1.0 : 1.0;
+    const double area = 0.5 * twice * orientation;
+    if (!(area > areas[static_cast<std::size_t>(k) - 1] + 1e-3 * std::max(area, 1e-9))) return false;
+    areas[static_cast<std::size_t>(k)] = area;
+  }
+  const double pupil_total = pupil_areas[static_cast<std::size_t>(count)];
+  auto pupil = [&](int k) { return pupil_areas[static_cast<std::size_t>(k)] - pupil_areas[static_cast<std::size_t>(k) - 1]; };
+  auto area = [&](int k) { return areas[static_cast<std::size_t>(k)] - areas[static_cast<std::size_t>(k) - 1]; };
+  auto light = [&](int k) {
+    const double weight = weighted ? 0.5 * (ring_weights[static_cast<std::size_t>(k) - 1] + ring_weights[static_cast<std::size_t>(k)]) : 1.0;
+    return pupil(k) / (weighted ? full_pupil_area : pupil_total) * weight / area(k);
+  };
+  auto coverage = [&](int k) { return pupil(k) / pupil_total / area(k); };
+  double max_light = 0.0, max_coverage = 0.0;
+  for (int k = 1; k <= count; ++k) {
+    max_light = std::max(max_light, std::abs(light(k)));
+    max_coverage = std::max(max_coverage, coverage(k));
+  }
+  int outer = count;
+  double group_light = light(count) * area(count), group_coverage = coverage(count) * area(count);
+  double next_light = 0.0, next_coverage = 0.0;
+  for (int k = count - 1; k >= 0; --k) {
+    const double group_area = areas[static_cast<std::size_t>(outer)] - areas[static_cast<std::size_t>(k)];
+    const double dl = group_light / group_area, dc = group_coverage / group_area;
+    if (k > 0 && std::abs(light(k) - dl) <= kRingMergeTolerance * max_light &&
+        std::abs(coverage(k) - dc) <= kRingMergeTolerance * max_coverage) {
+      group_light += light(k) * area(k);
+      group_coverage += coverage(k) * area(k);
+      continue;
+    }
+    const auto f = static_cast<float>(areas[static_cast<std::size_t>(outer)] * (dl - next_light));
+    const auto c = static_cast<float>(areas[static_cast<std::size_t>(outer)] * (dc - next_coverage));
+    buffer.add_polygon(rings[static_cast<std::size_t>(outer) - 1], {value[0] * f, value[1] * f, value[2] * f, value[3] * c});
+    next_light = dl;
+    next_coverage = dc;
+    if (k > 0) {
+      outer = k;
+      group_light = light(k) * area(k);
+      group_coverage = coverage(k) * area(k);
+    }
+  }
+  return true;
+}
+
+// A polar mesh mapped without folds deposits as nested rings (deposit_nested_rings): annulus k
+// carries its share of the pupil, (2k - 1) / R^2, spread evenly over its mapped area. As the
 // scatter is linear, annulus k is ring polygon k at density d_k minus ring polygon k-1 at d_k, so
 // ring polygon k is deposited once with area * (d_k - d_(k+1)): R polygons at O(height) each
 // instead of 2 R S small triangles. The radial light distribution (spherical aberration's bright
@@ -37,51 +141,25 @@ constexpr double kPxPerGridCell = 1.5;
 // Returns false, depositing nothing, when a ray is lost or the rings are not nested (a fold or
 // caustic): the caller then uses the triangles.
 bool deposit_ring_polygons(const PupilMesh& mesh, const std::vector<SensorHit>& hits, const std::vector<Point2f>& points,
-                           const std::array<float, 4>& value, bool weighted, SplatBuffer& buffer, std::vector<double>& areas) {
+                           const std::array<float, 4>& value, bool weighted, SplatBuffer& buffer, FootprintScratch& scratch) {
   for (const SensorHit& h : hits) {
     if (!h.ok) return false;
   }
-  const int rings = mesh.rings, sectors = mesh.sectors;
-  areas.assign(static_cast<std::size_t>(rings) + 1, 0.0);
-  double orientation = 0.0;
+  const int rings = mesh.rings;
+  const auto sectors = static_cast<std::size_t>(mesh.sectors);
+  scratch.ring_spans.clear();
+  scratch.pupil_areas.assign(1, 0.0);
+  scratch.ring_weights.assign(1, hits[0].weight);
   for (int k = 1; k <= rings; ++k) {
-    const std::span<const Point2f> ring(points.data() + 1 + static_cast<std::size_t>(k - 1) * sectors, static_cast<std::size_t>(sectors));
-    double twice = 0.0;
-    for (int j = 0; j < sectors; ++j) {
-      const Point2f& a = ring[static_cast<std::size_t>(j)];
-      const Point2f& b = ring[static_cast<std::size_t>((j + 1) % sectors)];
-      twice += static_cast<double>(a.x) * b.y - static_cast<double>(b.x) * a.y;
-    }
-    if (k == 1) orientation = twice < 0.0 ? -1.0 : 1.0;
-    const double area = 0.5 * twice * orientation;
-    // Nested: each ring encloses clearly more than the one inside it.
-    if (!(area > areas[static_cast<std::size_t>(k) - 1] + 1e-3 * std::max(area, 1e-9))) return false;
-    areas[static_cast<std::size_t>(k)] = area;
-  }
-  // The mean radiometric weight of the rays bounding each annulus (the centre ray for the first).
-  auto ring_weight = [&](int k) {
-    if (k == 0) return hits[0].weight;
+    const std::size_t begin = 1 + static_cast<std::size_t>(k - 1) * sectors;
+    scratch.ring_spans.emplace_back(points.data() + begin, sectors);
+    scratch.pupil_areas.push_back(static_cast<double>(k) * k / (static_cast<double>(rings) * rings));
     double sum = 0.0;
-    for (int j = 0; j < sectors; ++j) sum += hits[1 + static_cast<std::size_t>(k - 1) * sectors + static_cast<std::size_t>(j)].weight;
-    return sum / sectors;
-  };
-  // Light densities d_k per unit of value and coverage densities c_k (the annulus's share of the
-  // pupil, without the weights), then one deposit per ring polygon.
-  auto share = [&](int k) { return static_cast<double>(2 * k - 1) / (static_cast<double>(rings) * rings); };
-  auto area = [&](int k) { return areas[static_cast<std::size_t>(k)] - areas[static_cast<std::size_t>(k) - 1]; };
-  auto light = [&](int k) {
-    if (k > rings) return 0.0;
-    const double weight = weighted ? 0.5 * (ring_weight(k - 1) + ring_weight(k)) : 1.0;
-    return share(k) * weight / area(k);
-  };
-  auto coverage = [&](int k) { return k > rings ? 0.0 : share(k) / area(k); };
-  for (int k = 1; k <= rings; ++k) {
-    const auto f = static_cast<float>(areas[static_cast<std::size_t>(k)] * (light(k) - light(k + 1)));
-    const auto c = static_cast<float>(areas[static_cast<std::size_t>(k)] * (coverage(k) - coverage(k + 1)));
-    const std::span<const Point2f> ring(points.data() + 1 + static_cast<std::size_t>(k - 1) * sectors, static_cast<std::size_t>(sectors));
-    buffer.add_polygon(ring, {value[0] * f, value[1] * f, value[2] * f, value[3] * c});
+    for (std::size_t i = begin; i < begin + sectors; ++i) sum += hits[i].weight;
+    scratch.ring_weights.push_back(sum / static_cast<double>(sectors));
   }
-  return true;
+  return deposit_nested_rings(scratch.ring_spans, scratch.pupil_areas, scratch.ring_weights, 1.0, value, weighted, buffer,
+                              scratch.areas);
 }
 
 // The share of a triangle's area where a function linear over it, with values a, b, c at the
@@ -105,11 +183,55 @@ double positive_share(double a, double b, double c) {
 
 }  // namespace
 
-double FootprintScatter::passing_share(FootprintScratch& scratch) const {
-  // The finest outline: a coarse one would misjudge how much of the circle a disc cuts off.
-  const std::vector<PupilPoint>& outline = meshes_.outline(PupilMeshTable::kFinestOutline);
-  clip_pupil_polygon(outline, scratch.discs, scratch.clipped, scratch.clip_work);
-  return scratch.clipped.size() < 3 ? 0.0 : pupil_polygon_area(scratch.clipped) / pupil_polygon_area(outline);
+bool FootprintScatter::clip_rings(const FootprintPlan& p, FootprintScratch& scratch) const {
+  const PupilMesh& mesh = meshes_.mesh(p.mesh);
+  const std::vector<PupilPoint>& outline = meshes_.dense_outline(PupilMeshTable::sector_step_of_mesh(p.mesh));
+  const int rings = mesh.rings;
+  // The rings of the pupil mesh (the outline scaled by k / R) less what the discs cut off, with the
+  // centre first; each ring's vertices follow one another in scratch.ring_pupil.
+  std::vector<PupilPoint>& pupil = scratch.ring_pupil;
+  pupil.assign(1, PupilPoint{0.0, 0.0});
+  scratch.ring_offsets.assign(1, 1);
+  scratch.pupil_areas.assign(1, 0.0);
+  // Rings must nest around the centre: a centre ray that is cut off (the beam's pupil off the axis)
+  // leaves it to the triangles. Otherwise ring k reaches the smaller of k / R and the discs' reach
+  // along each vertex direction.
+  if (!centre_passes(scratch.discs)) return false;
+  disc_reach(outline, scratch.discs, scratch.reach);
+  for (int k = 1; k <= rings; ++k) {
+    reach_clip(outline, static_cast<double>(k) / rings, scratch.reach, scratch.clipped);
+    pupil.insert(pupil.end(), scratch.clipped.begin(), scratch.clipped.end());
+    scratch.ring_offsets.push_back(pupil.size());
+    scratch.pupil_areas.push_back(pupil_polygon_area(scratch.clipped));
+  }
+  return true;
+}
+
+bool FootprintScatter::deposit_clipped_rings(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p,
+                                             const std::array<float, 4>& value, SplatBuffer& buffer, FootprintScratch& scratch) const {
+  const int rings = meshes_.mesh(p.mesh).rings;
+  const std::vector<PupilPoint>& outline = meshes_.dense_outline(PupilMeshTable::sector_step_of_mesh(p.mesh));
+  const std::vector<PupilPoint>& pupil = scratch.ring_pupil;
+  std::vector<SensorHit>& hits = scratch.hits;
+  hits.resize(pupil.size());
+  model_.map_passing(point, wavelength_nm, pupil, hits);
+  std::vector<Point2f>& points = scratch.points;
+  points.resize(pupil.size());
+  for (std::size_t i = 0; i < pupil.size(); ++i) {
+    const PixelPoint q = camera_.output_pixel(hits[i].x_mm, hits[i].y_mm);
+    points[i] = {static_cast<float>(q.x), static_cast<float>(q.y)};
+  }
+  scratch.ring_spans.clear();
+  scratch.ring_weights.assign(1, hits[0].weight);
+  for (int k = 1; k <= rings; ++k) {
+    const std::size_t begin = scratch.ring_offsets[static_cast<std::size_t>(k) - 1], end = scratch.ring_offsets[static_cast<std::size_t>(k)];
+    scratch.ring_spans.emplace_back(points.data() + begin, end - begin);
+    double sum = 0.0;
+    for (std::size_t i = begin; i < end; ++i) sum += hits[i].weight;
+    scratch.ring_weights.push_back(sum / static_cast<double>(end - begin));
+  }
+  return deposit_nested_rings(scratch.ring_spans, scratch.pupil_areas, scratch.ring_weights, pupil_polygon_area(outline), value,
+                              options_.vignetting, buffer, scratch.areas);
 }
 
 std::array<float, 4> FootprintScatter::lit(const std::array<float, 4>& value, double weight) const {
@@ -205,7 +327,10 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
   } else if (aperture_.kind() == Aperture::Kind::Mask) {
     p.mesh = PupilMeshTable::grid_mesh(size / kPxPerGridCell);
   } else {
-    const bool clips = any_clipped || model_.kind() == RayModelKind::Exact || model_.kind() == RayModelKind::Poly;
+    // Models that clip rays one by one (exact, poly) need rings fine enough for a vignetted beam's
+    // edge; where the model's clipping is pupil discs the rings themselves are clipped.
+    const bool clips = (any_clipped && scratch.discs.empty()) || model_.kind() == RayModelKind::Exact ||
+                       model_.kind() == RayModelKind::Poly;
     const double rings = clips ? std::max(kMinClippingRings, size / kPxPerClippingRing) : size / kPxPerRing;
     p.mesh = PupilMeshTable::polar_mesh(rings, sector_step);
   }
@@ -218,7 +343,40 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
   std::vector<Point2f>& points = scratch.points;
   const Tangents t = camera_.frame().tangents_at({s.x + 0.5, s.y + 0.5});
   const ScenePoint point{t.x, t.y, s.inverse_depth_per_mm};
+  // First-order vignetting (the model's pupil discs, the same at every wavelength): for the single
+  // polygon, the outline less what they cut off, and the share of the aperture that passes.
   model_.clip_discs(point, scratch.discs);
+  double passing = 1.0;
+  const std::vector<PupilPoint>* outline = p.outline >= 0 ? &meshes_.outline(p.outline) : nullptr;
+  if (!scratch.discs.empty() && aperture_.is_uniform_convex()) {
+    // Measured on an outline of at least kShareSectorStep's vertices: a coarse one would misjudge
+    // how much of the circle a disc cuts off (an octagon by up to 10 %). With the chief ray inside
+    // every disc the cut is radial (cheap); otherwise the polygon is clipped disc by disc.
+    const bool radial = centre_passes(scratch.discs);
+    const std::vector<PupilPoint>& share_outline = meshes_.dense_outline(std::max(p.outline, PupilMeshTable::kShareSectorStep));
+    if (radial) {
+      disc_reach(share_outline, scratch.discs, scratch.reach);
+      reach_clip(share_outline, 1.0, scratch.reach, scratch.clipped);
+    } else {
+      clip_pupil_polygon(share_outline, scratch.discs, scratch.clipped, scratch.clip_work);
+    }
+    passing = scratch.clipped.size() < 3 ? 0.0 : pupil_polygon_area(scratch.clipped) / pupil_polygon_area(share_outline);
+    if (!(passing > 0.0)) return;  // the whole beam is stopped
+    if (p.mesh < 0 && p.outline >= 0) {
+      const std::vector<PupilPoint>& own = meshes_.dense_outline(p.outline);
+      if (radial) {
+        disc_reach(own, scratch.discs, scratch.reach);
+        reach_clip(own, 1.0, scratch.reach, scratch.clipped);
+      } else {
+        clip_pupil_polygon(own, scratch.discs, scratch.clipped, scratch.clip_work);
+      }
+      if (scratch.clipped.size() < 3) return;
+    }
+    outline = &scratch.clipped;
+  }
+  // A polar mesh of a model that clips by discs: its rings clipped once for every wavelength.
+  const bool rings_clipped = p.mesh >= 0 && !scratch.discs.empty() && meshes_.mesh(p.mesh).sectors > 0 &&
+                             aperture_.is_uniform_convex() && clip_rings(p, scratch);
   for (const SpectralGroup& g : groups_.split(p.groups)) {
     std::array<float, 4> value{};
     for (std::size_t c = 0; c < 3; ++c) value[c] = g.m[c][0] * s.rgb[0] + g.m[c][1] * s.rgb[1] + g.m[c][2] * s.rgb[2];
@@ -237,18 +395,10 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
       // off, mapped by the affine map of three rays; it keeps the share of the light that passes.
       static constexpr std::array<PupilPoint, 3> kBasis{{{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}}};
       hits.resize(3);
-      model_.map(point, g.wavelength_nm, kBasis, std::span<SensorHit>(hits.data(), 3));
+      model_.map_passing(point, g.wavelength_nm, kBasis, std::span<SensorHit>(hits.data(), 3));
       const PixelPoint o = camera_.output_pixel(hits[0].x_mm, hits[0].y_mm);
       const PixelPoint ex = camera_.output_pixel(hits[1].x_mm, hits[1].y_mm);
       const PixelPoint ey = camera_.output_pixel(hits[2].x_mm, hits[2].y_mm);
-      const std::vector<PupilPoint>* outline = &meshes_.outline(p.outline);
-      double passing = 1.0;
-      if (!scratch.discs.empty()) {
-        passing = passing_share(scratch);
-        clip_pupil_polygon(*outline, scratch.discs, scratch.clipped, scratch.clip_work);
-        if (scratch.clipped.size() < 3 || !(passing > 0.0)) continue;  // the whole beam is stopped
-        outline = &scratch.clipped;
-      }
       points.resize(outline->size());
       for (std::size_t i = 0; i < outline->size(); ++i) {
         const PupilPoint& q = (*outline)[i];
@@ -262,6 +412,7 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
       continue;
     }
     const PupilMesh& mesh = meshes_.mesh(p.mesh);
+    if (rings_clipped && deposit_clipped_rings(point, g.wavelength_nm, p, value, buffer, scratch)) continue;
     hits.resize(mesh.points.size());
     model_.map(point, g.wavelength_nm, mesh.points, hits);
     points.resize(mesh.points.size());
@@ -270,11 +421,11 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
       const PixelPoint q = camera_.output_pixel(hits[i].x_mm, hits[i].y_mm);
       points[i] = {static_cast<float>(q.x), static_cast<float>(q.y)};
     }
-    if (mesh.sectors > 0 && deposit_ring_polygons(mesh, hits, points, value, options_.vignetting, buffer, scratch.areas)) continue;
+    if (mesh.sectors > 0 && deposit_ring_polygons(mesh, hits, points, value, options_.vignetting, buffer, scratch)) continue;
     // A triangle whose corners a clear aperture partly stops (exact, poly) passes the part of its
     // area where the linear interpolation of their clearances is >= 0, in place: the beam's edge
     // falls inside it, to first order.
-    auto passing = [&hits](const PupilTriangle& tri) {
+    auto triangle_passing = [&hits](const PupilTriangle& tri) {
       const SensorHit& a = hits[static_cast<std::size_t>(tri.a)];
       const SensorHit& b = hits[static_cast<std::size_t>(tri.b)];
       const SensorHit& c = hits[static_cast<std::size_t>(tri.c)];
@@ -285,14 +436,14 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
     // coverage is normalised over the light that passes, so a vignetted point is still an opaque
     // surface. Without vignetting the colour is normalised the same way.
     double passed = 0.0;
-    for (const PupilTriangle& tri : mesh.triangles) passed += tri.weight * passing(tri);
+    for (const PupilTriangle& tri : mesh.triangles) passed += tri.weight * triangle_passing(tri);
     if (!(passed > 0.0)) continue;
     // Where the model describes its clipping as discs, the light that passes is known exactly (the
     // outline less the discs); the triangles' linear interpolation only distributes it.
-    const double exact_share = !scratch.discs.empty() && aperture_.is_uniform_convex() ? passing_share(scratch) : passed;
+    const double exact_share = !scratch.discs.empty() && aperture_.is_uniform_convex() ? passing : passed;
     const double unlit = options_.vignetting ? exact_share / passed : 1.0 / passed;
     for (const PupilTriangle& tri : mesh.triangles) {
-      const double fraction = passing(tri);
+      const double fraction = triangle_passing(tri);
       if (fraction == 0.0) continue;
       const double ray_weight = options_.vignetting ? (hits[tri.a].weight + hits[tri.b].weight + hits[tri.c].weight) / 3.0 : 1.0;
       const auto w = static_cast<float>(tri.weight * fraction * ray_weight * unlit);

@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstddef>
+#include <span>
 #include <vector>
 
 #include "lensmith/camera/ray_model.h"
@@ -39,6 +40,12 @@ struct FootprintScratch {
   std::vector<PupilDisc> discs;     // the model's first-order clipping of the current point
   std::vector<PupilPoint> clipped;  // the aperture's outline less what they cut off
   std::vector<PupilPoint> clip_work;
+  std::vector<double> reach;  // the discs' reach along an outline's vertex directions
+  std::vector<PupilPoint> ring_pupil;     // clipped rings' vertices, the centre first
+  std::vector<std::size_t> ring_offsets;  // clipped rings: where each ring's vertices end in `pupil`
+  std::vector<double> pupil_areas;
+  std::vector<double> ring_weights;
+  std::vector<std::span<const Point2f>> ring_spans;
 };
 
 // Everything a footprint depends on besides its source; one per render, shared by the threads.
@@ -54,11 +61,14 @@ class FootprintScatter {
                FootprintScratch& scratch, std::size_t& triangles) const;
 
  private:
+  // A polar mesh's rings clipped by scratch.discs (first-order vignetting), mapped and deposited as
+  // nested rings; false, depositing nothing, where they do not nest.
+  bool clip_rings(const FootprintPlan& p, FootprintScratch& scratch) const;  // into scratch.ring_pupil; false: do not nest
+  bool deposit_clipped_rings(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p,
+                             const std::array<float, 4>& value, SplatBuffer& buffer, FootprintScratch& scratch) const;
   // `value` with its light (not its coverage) scaled by a ray's radiometric weight (SensorHit), when
   // BokehOptions::vignetting is on.
   std::array<float, 4> lit(const std::array<float, 4>& value, double weight) const;
-  // The share of the aperture that passes scratch.discs (the model's first-order vignetting).
-  double passing_share(FootprintScratch& scratch) const;
 
   const RayModel& model_;
   const Camera& camera_;

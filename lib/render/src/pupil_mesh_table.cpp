@@ -35,6 +35,7 @@ PupilMeshTable::PupilMeshTable(const Aperture& aperture) {
   }
   for (int sectors : kSectorSteps) {
     outlines_.push_back(aperture.outline(aperture.kind() == Aperture::Kind::Blades ? aperture.blade_count() : sectors));
+    dense_outlines_.push_back(aperture.outline(sectors));
   }
 }
 
@@ -47,6 +48,8 @@ int PupilMeshTable::sector_step(double diameter_px) {
 int PupilMeshTable::polar_mesh(double rings, int sector_step) {
   return step_index(kRingSteps, rings) * static_cast<int>(kSectorSteps.size()) + sector_step;
 }
+
+int PupilMeshTable::sector_step_of_mesh(int mesh_index) { return mesh_index % static_cast<int>(kSectorSteps.size()); }
 
 int PupilMeshTable::grid_mesh(double cells) { return step_index(kGridSteps, cells); }
 

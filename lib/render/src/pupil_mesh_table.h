@@ -19,17 +19,23 @@ class PupilMeshTable {
   static int sector_step(double diameter_px);
   // Mesh index of a polar mesh with at least `rings` rings (capped) and the sectors of `sector_step`.
   static int polar_mesh(double rings, int sector_step);
+  // The sector step of a polar mesh index.
+  static int sector_step_of_mesh(int mesh_index);
   // Mesh index of a grid with at least `cells` cells per side (capped); aperture pictures only.
   static int grid_mesh(double cells);
 
-  static constexpr int kFinestOutline = 8;  // the sector step with the most vertices (128)
+  static constexpr int kShareSectorStep = 4;  // 32 sectors: a polygon within 0.6 % of the circle's area
   const PupilMesh& mesh(int index) const { return meshes_[static_cast<std::size_t>(index)]; }
   // The outline for a sector step (blades: their corners only).
   const std::vector<PupilPoint>& outline(int sector_step) const { return outlines_[static_cast<std::size_t>(sector_step)]; }
+  // The outline with the sector step's vertex count, blades' edges included point by point (for
+  // cutting it along vertex directions).
+  const std::vector<PupilPoint>& dense_outline(int sector_step) const { return dense_outlines_[static_cast<std::size_t>(sector_step)]; }
 
  private:
   std::vector<PupilMesh> meshes_;                  // polar: ring step * sector steps + sector step; masks: grid steps
   std::vector<std::vector<PupilPoint>> outlines_;  // per sector step
+  std::vector<std::vector<PupilPoint>> dense_outlines_;
 };
 
 }  // namespace lensmith::render_detail

@@ -302,8 +302,9 @@ void SplatBuffer::add_polygon(std::span<const Point2f> vertices, const std::arra
     const double lower_weight = subrow_lower_weight_[static_cast<std::size_t>(m)];
     for (int r = 0; r < 2; ++r) {
       const int row = upper + r;
-      if (row < row_begin_ || row >= row_end_) continue;
       const double row_weight = r == 0 ? 1.0 - lower_weight : lower_weight;
+      // One sub-row per pixel row samples the row's centre, which the tent gives wholly to it.
+      if (row < row_begin_ || row >= row_end_ || row_weight == 0.0) continue;
       double coef[kChannels];
       for (int c = 0; c < kChannels; ++c) coef[c] = row_weight * unit[c];
       double* row_diff = diff_.data() + static_cast<std::size_t>(row - row_begin_) * width_ * kChannels;

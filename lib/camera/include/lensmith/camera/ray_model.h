@@ -73,6 +73,13 @@ class RayModel {
   // `hits` has the size of `pupil`. Thread-safe; allocates nothing per call once warm.
   virtual void map(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
                    std::span<SensorHit> hits) const = 0;
+  // map() for pupil points the caller already knows to pass (inside clip_discs): where they land
+  // and their weights; `ok` is set and `clearance` left at 1 without being computed. The default
+  // calls map().
+  virtual void map_passing(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
+                           std::span<SensorHit> hits) const {
+    map(point, wavelength_nm, pupil, hits);
+  }
   // First-order models' clear-aperture vignetting of one scene point: the pupil points that pass are
   // those inside every disc of `discs` (cleared first; none: nothing clips). Models that clip rays
   // by tracing them (exact, poly) report it through map()'s `ok` and `clearance` and leave this
