@@ -72,8 +72,9 @@ void ReferenceSphereModel::clip_discs(const ScenePoint& point, std::vector<Pupil
     const double scale = entrance_pupil_radius_mm_ * (k.a + k.b * w / d);
     if (!(std::abs(scale) > 0.0)) continue;
     const PupilDisc disc{k.b / d * point.tan_x / scale, k.b / d * point.tan_y / scale, k.radius_mm / std::abs(scale)};
-    // Only discs that cut the unit pupil matter.
-    if (std::sqrt(disc.x * disc.x + disc.y * disc.y) + 1.0 > disc.radius) discs.push_back(disc);
+    // Only discs that cut the unit pupil matter: |c| + 1 > rho.
+    const double inner = disc.radius - 1.0;
+    if (inner < 0.0 || disc.x * disc.x + disc.y * disc.y > inner * inner) discs.push_back(disc);
   }
   // A disc that holds another wholly cuts nothing the other does not: drop it (the apertures of
   // one element's two faces are often nested so).

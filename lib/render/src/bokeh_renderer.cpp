@@ -42,6 +42,8 @@ using render_detail::ScatterSource;
 // a tall footprint's top and bottom rows see the y sampling.
 constexpr float kMediumFootprintPx = 20.0f;
 constexpr float kTallFootprintPx = 68.0f;
+// Splat grids: full resolution, 2 x 2 and 4 x 4 px cells (FootprintPlan::level).
+constexpr int kLevels = 3;
 // Bands of rows per thread: each band scatters the footprints that reach it.
 constexpr int kBandsPerThread = 4;
 // Hidden sources reach half the blur of the layer and of the nearer ones, plus this margin (px): the
@@ -114,18 +116,25 @@ Image render(const Image& image, const DepthMap& depth, const RayModel& model, c
       for (int b = 0; b < bands; ++b) {
         const int row_begin = b * h / bands, row_end = (b + 1) * h / bands;
         if (row_begin == row_end) continue;
-        // A buffer is made only for the sub-row classes this band meets in this layer; light and
-        // (Stretch) the coverage of hidden sources apart.
-        std::array<std::array<std::optional<SplatBuffer>, 3>, 2> buffers;
+        // A buffer is made only for the grids and sub-row classes this band meets in this layer;
+        // light and (Stretch) the coverage of hidden sources apart.
+        std::array<std::array<std::array<std::optional<SplatBuffer>, 3>, kLevels>, 2> buffers;
         for (std::size_t i = 0; i < layer.size(); ++i) {
           if (plans[i].y_max < static_cast<float>(row_begin) - 1.0f || plans[i].y_min > static_cast<float>(row_end) + 1.0f) continue;
-          const float height = plans[i].y_max - plans[i].y_min;
+          const int level = plans[i].level;
+          const float height = (plans[i].y_max - plans[i].y_min) / static_cast<float>(1 << level);
           const int kind = height < kMediumFootprintPx ? 0 : height < kTallFootprintPx ? 1 : 2;
-          auto& set = buffers[layer[i].coverage_only ? 1 : 0];
+          auto& set = buffers[layer[i].coverage_only ? 1 : 0][static_cast<std::size_t>(level)];
+          auto make = [&](std::optional<SplatBuffer>& slot, int subrow_kind) {
+            if (slot) return;
+            SplatOptions o = subrow_options(options.splat, 1 << subrow_kind);
+            o.downsample = 1 << level;
+            slot.emplace(w, row_begin, row_end, o);
+          };
           std::optional<SplatBuffer>& buffer = set[static_cast<std::size_t>(kind)];
-          if (!buffer) buffer.emplace(w, row_begin, row_end, subrow_options(options.splat, 1 << kind));
+          make(buffer, kind);
           std::optional<SplatBuffer>& fine = set[0];
-          if (plans[i].mesh >= 0 && !fine) fine.emplace(w, row_begin, row_end, subrow_options(options.splat, 1));
+          if (plans[i].mesh >= 0) make(fine, 0);
           scatter.deposit(layer[i], plans[i], *buffer, plans[i].mesh >= 0 ? *fine : *buffer, scratch, local_triangles);
           local_footprints += static_cast<std::size_t>(plans[i].groups);
         }
@@ -134,10 +143,12 @@ Image render(const Image& image, const DepthMap& depth, const RayModel& model, c
           std::vector<float>& target = set == 0 ? layer_rgba : hole_rgba;
           float* rows = target.data() + static_cast<std::size_t>(row_begin) * w * 4;
           std::fill(rows, rows + static_cast<std::size_t>(row_end - row_begin) * w * 4, 0.0f);
-          for (const std::optional<SplatBuffer>& buffer : buffers[static_cast<std::size_t>(set)]) {
-            if (!buffer) continue;
-            buffer->resolve_into(target.data());
-            any = true;
+          for (const auto& level : buffers[static_cast<std::size_t>(set)]) {
+            for (const std::optional<SplatBuffer>& buffer : level) {
+              if (!buffer) continue;
+              buffer->resolve_into(target.data());
+              any = true;
+            }
           }
         }
         if (!any) continue;  // nothing of this layer reaches these rows: the result is unchanged

@@ -28,6 +28,11 @@ constexpr double kPxPerRing = 16.0;
 // Adjacent rings of a mapped pupil mesh whose light densities differ by less than this share of the
 // largest are deposited as one (a 2 % step in a large disc is below what a picture shows).
 constexpr double kRingMergeTolerance = 0.02;
+// Footprint sizes (px) from which the deposit goes to a grid of 2 x 2 and of 4 x 4 px cells: the
+// cost of a polygon falls with the cells per side, and its edge, softened to about two cells, stays
+// under 5 % of its size, invisible in a disc that large (bench/blender's scenes: within 0.1 dB).
+constexpr double kHalfResolutionPx = 40.0;
+constexpr double kQuarterResolutionPx = 96.0;
 // Grid cells of an aperture-picture mesh per pixel of footprint size.
 constexpr double kPxPerGridCell = 1.5;
 
@@ -40,20 +45,24 @@ bool centre_passes(const std::vector<PupilDisc>& discs) {
   return true;
 }
 
-// For each vertex direction u of `outline` (from the centre), how far along u the discs' intersection
-// reaches: min over the discs of the root s > 0 of |s u - c| = rho. The centre must pass every disc.
-void disc_reach(const std::vector<PupilPoint>& outline, const std::vector<PupilDisc>& discs, std::vector<double>& reach) {
-  reach.resize(outline.size());
-  for (std::size_t j = 0; j < outline.size(); ++j) {
-    const double len = std::sqrt(outline[j].x * outline[j].x + outline[j].y * outline[j].y);
-    const double ux = outline[j].x / len, uy = outline[j].y / len;
-    double s = kInfinity;
-    for (const PupilDisc& d : discs) {
-      const double b = ux * d.x + uy * d.y;
-      s = std::min(s, b + std::sqrt(b * b - (d.x * d.x + d.y * d.y) + d.radius * d.radius));
+// For each vertex direction u of an outline (from the centre), how far along u the discs'
+// intersection reaches, in units of the vertex's own distance: min over the discs of the root s > 0
+// of |s u - c| = rho. The centre must pass every disc. Disc by disc over all vertices, so that the
+// inner loop vectorises.
+void disc_reach(const PupilMeshTable::Directions& u, const std::vector<PupilDisc>& discs, std::vector<double>& reach) {
+  const std::size_t n = u.ux.size();
+  reach.assign(n, kInfinity);
+  const double* ux = u.ux.data();
+  const double* uy = u.uy.data();
+  double* r = reach.data();
+  for (const PupilDisc& d : discs) {
+    const double cx = d.x, cy = d.y, c = d.x * d.x + d.y * d.y - d.radius * d.radius;
+    for (std::size_t j = 0; j < n; ++j) {
+      const double b = ux[j] * cx + uy[j] * cy;
+      r[j] = std::min(r[j], b + std::sqrt(b * b - c));
     }
-    reach[j] = s / len;  // in units of the vertex's own distance
   }
+  for (std::size_t j = 0; j < n; ++j) r[j] *= u.inverse_length[j];
 }
 
 // The outline scaled by `scale`, less what lies beyond the discs' reach along each vertex direction:
@@ -197,7 +206,8 @@ bool FootprintScatter::clip_rings(const FootprintPlan& p, FootprintScratch& scra
   // leaves it to the triangles. Otherwise ring k reaches the smaller of k / R and the discs' reach
   // along each vertex direction.
   if (!centre_passes(scratch.discs)) return false;
-  disc_reach(outline, scratch.discs, scratch.reach);
+  if (scratch.reach_of != &outline) disc_reach(meshes_.dense_directions(PupilMeshTable::sector_step_of_mesh(p.mesh)), scratch.discs, scratch.reach);
+  scratch.reach_of = &outline;
   for (int k = 1; k <= rings; ++k) {
     reach_clip(outline, static_cast<double>(k) / rings, scratch.reach, scratch.clipped);
     pupil.insert(pupil.end(), scratch.clipped.begin(), scratch.clipped.end());
@@ -265,12 +275,19 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
   const std::array<double, 3> lambdas{camera_.reference_wavelength_nm(), groups_.lowest_nm(), groups_.highest_nm()};
   std::array<std::array<PixelPoint, 9>, 3> px{};
   std::array<std::array<bool, 9>, 3> ok{};  // where the ray lands is known (it passes, or would)
-  bool any_clipped = false;
   double x_min = kInfinity, x_max = -kInfinity, y_min = kInfinity, y_max = -kInfinity;
   // Without dispersion (a thin lens, or colour off) one wavelength tells all.
   const std::size_t wavelengths = camera_.is_thin_lens() || !options_.spectral ? 1 : 3;
+  // Where the model describes its clipping as pupil discs, those that cut the aperture say that the
+  // beam is clipped, and the probe maps without clipping (cheaper).
+  model_.clip_discs(point, scratch.discs);
+  bool any_clipped = !scratch.discs.empty();
   for (std::size_t l = 0; l < wavelengths; ++l) {
-    model_.map(point, lambdas[l], pupil, hits);
+    if (scratch.discs.empty()) {
+      model_.map(point, lambdas[l], pupil, hits);
+    } else {
+      model_.map_passing(point, lambdas[l], pupil, hits);
+    }
     for (std::size_t i = 0; i < 9; ++i) {
       ok[l][i] = hits[i].ok || hits[i].unclipped;
       any_clipped = any_clipped || !hits[i].ok;
@@ -306,7 +323,6 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
     near_affine = worst < kAffineTolerancePx;
   }
   // A clipped beam is one polygon only where the model describes its clipping as pupil discs.
-  model_.clip_discs(point, scratch.discs);
   if (any_clipped && scratch.discs.empty()) near_affine = false;
   double spread = 0.0;
   for (std::size_t i = 0; i < 9; ++i) {
@@ -315,11 +331,15 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
   const double size = std::max(x_max - x_min, y_max - y_min);
   // Coverage has no colour: one group carries it.
   p.groups = s.coverage_only ? 1 : std::clamp(static_cast<int>(std::ceil(spread / options_.chromatic_tolerance_px)), 1, groups_.max_count());
-  const double margin = near_affine ? kTentMarginPx : kTentMarginPx + kMeshMarginFraction * size;
+  p.level = size >= kQuarterResolutionPx ? 2 : size >= kHalfResolutionPx ? 1 : 0;
+  const double cell_px = 1 << p.level;
+  const double margin = kTentMarginPx * cell_px + (near_affine ? 0.0 : kMeshMarginFraction * size);
   p.y_min = static_cast<float>(y_min - margin);
   p.y_max = static_cast<float>(y_max + margin);
-  const int sector_step = PupilMeshTable::sector_step(size);
-  const bool all_pass = !any_clipped;
+  // The outline need only follow the circle to 0.1 of a cell.
+  const int sector_step = PupilMeshTable::sector_step(size / cell_px);
+  // A point stands for the whole beam where it all passes or where the discs say what share does.
+  const bool all_pass = !any_clipped || !scratch.discs.empty();
   if (size < kPointFootprintPx && all_pass) {
     p.outline = FootprintPlan::kPoint;
   } else if (near_affine) {
@@ -331,7 +351,9 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
     // edge; where the model's clipping is pupil discs the rings themselves are clipped.
     const bool clips = (any_clipped && scratch.discs.empty()) || model_.kind() == RayModelKind::Exact ||
                        model_.kind() == RayModelKind::Poly;
-    const double rings = clips ? std::max(kMinClippingRings, size / kPxPerClippingRing) : size / kPxPerRing;
+    // On a coarse grid a ring may span more pixels (as many cells as at full resolution at 2 x 2, half
+    // as many at 4 x 4): the grid smooths the radial profile by a cell anyway.
+    const double rings = clips ? std::max(kMinClippingRings, size / kPxPerClippingRing) : size / (kPxPerRing * std::max(1.0, 0.5 * cell_px));
     p.mesh = PupilMeshTable::polar_mesh(rings, sector_step);
   }
   return p;
@@ -346,6 +368,7 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
   // First-order vignetting (the model's pupil discs, the same at every wavelength): for the single
   // polygon, the outline less what they cut off, and the share of the aperture that passes.
   model_.clip_discs(point, scratch.discs);
+  scratch.reach_of = nullptr;
   double passing = 1.0;
   const std::vector<PupilPoint>* outline = p.outline >= 0 ? &meshes_.outline(p.outline) : nullptr;
   if (!scratch.discs.empty() && aperture_.is_uniform_convex()) {
@@ -353,9 +376,12 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
     // how much of the circle a disc cuts off (an octagon by up to 10 %). With the chief ray inside
     // every disc the cut is radial (cheap); otherwise the polygon is clipped disc by disc.
     const bool radial = centre_passes(scratch.discs);
-    const std::vector<PupilPoint>& share_outline = meshes_.dense_outline(std::max(p.outline, PupilMeshTable::kShareSectorStep));
+    const int own_step = p.mesh >= 0 ? PupilMeshTable::sector_step_of_mesh(p.mesh) : p.outline;
+    const int share_step = std::max(own_step, PupilMeshTable::kShareSectorStep);
+    const std::vector<PupilPoint>& share_outline = meshes_.dense_outline(share_step);
     if (radial) {
-      disc_reach(share_outline, scratch.discs, scratch.reach);
+      disc_reach(meshes_.dense_directions(share_step), scratch.discs, scratch.reach);
+      scratch.reach_of = &share_outline;
       reach_clip(share_outline, 1.0, scratch.reach, scratch.clipped);
     } else {
       clip_pupil_polygon(share_outline, scratch.discs, scratch.clipped, scratch.clip_work);
@@ -365,7 +391,8 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
     if (p.mesh < 0 && p.outline >= 0) {
       const std::vector<PupilPoint>& own = meshes_.dense_outline(p.outline);
       if (radial) {
-        disc_reach(own, scratch.discs, scratch.reach);
+        if (scratch.reach_of != &own) disc_reach(meshes_.dense_directions(p.outline), scratch.discs, scratch.reach);
+        scratch.reach_of = &own;
         reach_clip(own, 1.0, scratch.reach, scratch.clipped);
       } else {
         clip_pupil_polygon(own, scratch.discs, scratch.clipped, scratch.clip_work);
@@ -384,10 +411,18 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
     if (p.outline == FootprintPlan::kPoint) {
       static constexpr std::array<PupilPoint, 1> kCentre{{{0.0, 0.0}}};
       hits.resize(1);
-      model_.map(point, g.wavelength_nm, kCentre, std::span<SensorHit>(hits.data(), 1));
+      // With discs the passing share is known (a cat's eye may leave the chief ray out).
+      if (scratch.discs.empty()) {
+        model_.map(point, g.wavelength_nm, kCentre, std::span<SensorHit>(hits.data(), 1));
+      } else {
+        model_.map_passing(point, g.wavelength_nm, kCentre, std::span<SensorHit>(hits.data(), 1));
+      }
       if (!hits[0].ok) continue;
       const PixelPoint c = camera_.output_pixel(hits[0].x_mm, hits[0].y_mm);
-      buffer.add_point({static_cast<float>(c.x), static_cast<float>(c.y)}, lit(value, hits[0].weight));
+      std::array<float, 4> v = lit(value, hits[0].weight);
+      const auto light = static_cast<float>(options_.vignetting ? passing : 1.0);
+      for (std::size_t k = 0; k < 3; ++k) v[k] *= light;
+      buffer.add_point({static_cast<float>(c.x), static_cast<float>(c.y)}, v);
       continue;
     }
     if (p.mesh < 0) {

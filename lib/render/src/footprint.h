@@ -29,6 +29,7 @@ struct FootprintPlan {
   int groups = 1;      // wavelength groups
   int mesh = -1;       // PupilMeshTable mesh index, or -1 for the single-polygon and point paths
   int outline = 0;     // PupilMeshTable sector step (single polygon), or kPoint
+  int level = 0;       // the splat grid: 2^level output px per cell side (large footprints are coarse)
 };
 
 // Per-thread scratch space, so planning and deposits allocate nothing once warm.
@@ -41,6 +42,7 @@ struct FootprintScratch {
   std::vector<PupilPoint> clipped;  // the aperture's outline less what they cut off
   std::vector<PupilPoint> clip_work;
   std::vector<double> reach;  // the discs' reach along an outline's vertex directions
+  const std::vector<PupilPoint>* reach_of = nullptr;  // the outline `reach` is for (this source's discs)
   std::vector<PupilPoint> ring_pupil;     // clipped rings' vertices, the centre first
   std::vector<std::size_t> ring_offsets;  // clipped rings: where each ring's vertices end in `pupil`
   std::vector<double> pupil_areas;

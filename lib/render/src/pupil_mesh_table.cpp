@@ -36,6 +36,14 @@ PupilMeshTable::PupilMeshTable(const Aperture& aperture) {
   for (int sectors : kSectorSteps) {
     outlines_.push_back(aperture.outline(aperture.kind() == Aperture::Kind::Blades ? aperture.blade_count() : sectors));
     dense_outlines_.push_back(aperture.outline(sectors));
+    Directions d;
+    for (const PupilPoint& q : dense_outlines_.back()) {
+      const double len = std::hypot(q.x, q.y);
+      d.ux.push_back(q.x / len);
+      d.uy.push_back(q.y / len);
+      d.inverse_length.push_back(1.0 / len);
+    }
+    dense_directions_.push_back(std::move(d));
   }
 }
 

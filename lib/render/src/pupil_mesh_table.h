@@ -31,11 +31,18 @@ class PupilMeshTable {
   // The outline with the sector step's vertex count, blades' edges included point by point (for
   // cutting it along vertex directions).
   const std::vector<PupilPoint>& dense_outline(int sector_step) const { return dense_outlines_[static_cast<std::size_t>(sector_step)]; }
+  // A dense outline's vertex directions from the centre, as unit vectors and 1 / the vertex's
+  // distance (struct of arrays, for vectorised cuts along them).
+  struct Directions {
+    std::vector<double> ux, uy, inverse_length;
+  };
+  const Directions& dense_directions(int sector_step) const { return dense_directions_[static_cast<std::size_t>(sector_step)]; }
 
  private:
   std::vector<PupilMesh> meshes_;                  // polar: ring step * sector steps + sector step; masks: grid steps
   std::vector<std::vector<PupilPoint>> outlines_;  // per sector step
   std::vector<std::vector<PupilPoint>> dense_outlines_;
+  std::vector<Directions> dense_directions_;
 };
 
 }  // namespace lensmith::render_detail

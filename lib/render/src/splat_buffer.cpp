@@ -18,6 +18,7 @@ namespace {
 
 constexpr int kChannels = 4;
 constexpr int kMaxSubrows = 16;
+constexpr int kMaxDownsample = 8;
 // Below this rasterised area (px^2) a polygon is a point: the rounding of its span ends at 4K
 // coordinates (~1e-12 px), divided by A, would exceed 1e-4 of its value.
 constexpr double kPointArea = 1e-9;
@@ -114,13 +115,19 @@ double polygon_area(std::span<const Point2f> vertices) {
 }
 
 void SplatOptions::validate() const {
+  if (downsample < 1 || downsample > kMaxDownsample) {
+    throw OptionsError("SplatOptions::downsample = " + std::to_string(downsample) + ": must lie in [1, " +
+                       std::to_string(kMaxDownsample) + "]");
+  }
   if (subrows < 1 || subrows > kMaxSubrows) {
     throw OptionsError("SplatOptions::subrows = " + std::to_string(subrows) + ": must lie in [1, " +
                        std::to_string(kMaxSubrows) + "]");
   }
 }
 
-std::string SplatOptions::to_string() const { return "SplatOptions(subrows " + std::to_string(subrows) + ")"; }
+std::string SplatOptions::to_string() const {
+  return "SplatOptions(subrows " + std::to_string(subrows) + (downsample > 1 ? ", downsample " + std::to_string(downsample) : "") + ")";
+}
 
 SplatBuffer::SplatBuffer(int width_px, int row_begin, int row_end, const SplatOptions& options)
     : width_(width_px), row_begin_(row_begin), row_end_(row_end), options_(options) {
@@ -129,7 +136,16 @@ SplatBuffer::SplatBuffer(int width_px, int row_begin, int row_end, const SplatOp
     throw OptionsError("SplatBuffer: width " + std::to_string(width_px) + " px, rows [" + std::to_string(row_begin) +
                        ", " + std::to_string(row_end) + "): need width >= 1 and 0 <= row_begin <= row_end");
   }
-  diff_.assign(static_cast<std::size_t>(width_) * static_cast<std::size_t>(row_end_ - row_begin_) * kChannels, 0.0);
+  // The grid: 1 / downsample of the output's resolution, one cell more on each side than the
+  // output's band needs so that the bilinear upsampling of every band row has both neighbours.
+  const int k = options_.downsample;
+  scale_ = 1.0 / k;
+  x_offset_ = k > 1 ? 1.0 : 0.0;
+  grid_width_ = k > 1 ? (width_px + k - 1) / k + 2 : width_px;
+  grid_row_begin_ = k > 1 ? static_cast<int>(fast_floor((row_begin + 0.5) * scale_ - 0.5)) : row_begin;
+  grid_row_end_ = k > 1 ? static_cast<int>(fast_floor((row_end - 0.5) * scale_ - 0.5)) + 2 : row_end;
+  if (row_end == row_begin) grid_row_end_ = grid_row_begin_;
+  diff_.assign(static_cast<std::size_t>(grid_width_) * static_cast<std::size_t>(grid_row_end_ - grid_row_begin_) * kChannels, 0.0);
   const int s = options_.subrows;
   subrow_row_offset_.resize(static_cast<std::size_t>(s));
   subrow_lower_weight_.resize(static_cast<std::size_t>(s));
@@ -155,10 +171,14 @@ void SplatBuffer::add_point(Point2f p, const std::array<float, 4>& value) {
   deposit_point(p.x, p.y, value);
 }
 
-void SplatBuffer::deposit_point(double x_px, double y_px, const std::array<float, 4>& value) {
+void SplatBuffer::deposit_point(double x_out_px, double y_out_px, const std::array<float, 4>& value) {
+  deposit_grid_point(x_out_px * scale_ + x_offset_, y_out_px * scale_, value);
+}
+
+void SplatBuffer::deposit_grid_point(double x_px, double y_px, const std::array<float, 4>& value) {
   // Only rows whose centres lie within 1 of y receive anything; this also keeps floor() in int range.
-  if (!(y_px > row_begin_ - 0.5 && y_px < row_end_ + 0.5)) return;
-  const double x = clamp_end(x_px, width_);
+  if (!(y_px > grid_row_begin_ - 0.5 && y_px < grid_row_end_ + 0.5)) return;
+  const double x = clamp_end(x_px, grid_width_);
   // Bilinear weights: pixel i0 gets 1 - fx, i0 + 1 gets fx; as differences at i0 .. i0 + 2.
   const double i0 = fast_floor(x - 0.5);
   const double fx = x - 0.5 - i0;
@@ -168,10 +188,10 @@ void SplatBuffer::deposit_point(double x_px, double y_px, const std::array<float
   const int rows[2] = {static_cast<int>(j0), static_cast<int>(j0) + 1};
   const double row_weight[2] = {1.0 - fy, fy};
   for (int r = 0; r < 2; ++r) {
-    if (rows[r] < row_begin_ || rows[r] >= row_end_) continue;
+    if (rows[r] < grid_row_begin_ || rows[r] >= grid_row_end_) continue;
     double coef[kChannels];
     for (int c = 0; c < kChannels; ++c) coef[c] = row_weight[r] * value[static_cast<std::size_t>(c)];
-    add_weights(diff_.data() + static_cast<std::size_t>(rows[r] - row_begin_) * width_ * kChannels, width_,
+    add_weights(diff_.data() + static_cast<std::size_t>(rows[r] - grid_row_begin_) * grid_width_ * kChannels, grid_width_,
                 static_cast<int>(i0), q, coef);
   }
 }
@@ -218,7 +238,17 @@ void SplatBuffer::build_chains(std::span<const Point2f> vertices) {
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 __attribute__((target_clones("arch=x86-64-v3", "default")))
 #endif
-void SplatBuffer::add_polygon(std::span<const Point2f> vertices, const std::array<float, 4>& value) {
+void SplatBuffer::add_polygon(std::span<const Point2f> output_vertices, const std::array<float, 4>& value) {
+  std::span<const Point2f> vertices = output_vertices;
+  if (options_.downsample > 1) {
+    // To grid cells; float keeps 1e-6 of a cell's size at 4K / k.
+    scaled_.resize(output_vertices.size());
+    const auto scale = static_cast<float>(scale_), offset = static_cast<float>(x_offset_);
+    for (std::size_t i = 0; i < output_vertices.size(); ++i) {
+      scaled_[i] = {output_vertices[i].x * scale + offset, output_vertices[i].y * scale};
+    }
+    vertices = scaled_;
+  }
   const std::size_t n = vertices.size();
   bool finite = n > 0 && finite_value(value);
   double cx = 0.0;
@@ -235,7 +265,7 @@ void SplatBuffer::add_polygon(std::span<const Point2f> vertices, const std::arra
   cx /= static_cast<double>(n);
   cy /= static_cast<double>(n);
   if (n < 3) {
-    deposit_point(cx, cy, value);
+    deposit_grid_point(cx, cy, value);
     return;
   }
   build_chains(vertices);
@@ -262,7 +292,7 @@ void SplatBuffer::add_polygon(std::span<const Point2f> vertices, const std::arra
     return;
   }
   if (std::abs(area) < kPointArea) {
-    deposit_point(cx, cy, value);
+    deposit_grid_point(cx, cy, value);
     return;
   }
 
@@ -270,8 +300,8 @@ void SplatBuffer::add_polygon(std::span<const Point2f> vertices, const std::arra
   // row_end + 0.5) in y.
   const double subrow_top = forward_chain_.front().first_subrow;
   const double subrow_bottom = forward_chain_.back().first_subrow;  // exclusive
-  const double lo = std::max(subrow_top, fast_ceil((row_begin_ - 0.5) * s - 0.5));
-  const double hi = std::min(subrow_bottom, fast_ceil((row_end_ + 0.5) * s - 0.5));
+  const double lo = std::max(subrow_top, fast_ceil((grid_row_begin_ - 0.5) * s - 0.5));
+  const double hi = std::min(subrow_bottom, fast_ceil((grid_row_end_ + 0.5) * s - 0.5));
   if (!(lo < hi)) return;
 
   double unit[kChannels];  // deposit per unit span length of one sub-row
@@ -288,7 +318,7 @@ void SplatBuffer::add_polygon(std::span<const Point2f> vertices, const std::arra
   std::int64_t pixel_row = floor_div(s_lo, subrows);
   auto m = static_cast<int>(s_lo - pixel_row * subrows);
   const double inv_s = 1.0 / s;
-  const double w = width_;
+  const double w = grid_width_;
   for (std::int64_t sub = s_lo; sub < s_hi; ++sub) {
     const auto sub_d = static_cast<double>(sub);
     while (ef[1].first_subrow <= sub_d) ++ef;
@@ -304,12 +334,12 @@ void SplatBuffer::add_polygon(std::span<const Point2f> vertices, const std::arra
       const int row = upper + r;
       const double row_weight = r == 0 ? 1.0 - lower_weight : lower_weight;
       // One sub-row per pixel row samples the row's centre, which the tent gives wholly to it.
-      if (row < row_begin_ || row >= row_end_ || row_weight == 0.0) continue;
+      if (row < grid_row_begin_ || row >= grid_row_end_ || row_weight == 0.0) continue;
       double coef[kChannels];
       for (int c = 0; c < kChannels; ++c) coef[c] = row_weight * unit[c];
-      double* row_diff = diff_.data() + static_cast<std::size_t>(row - row_begin_) * width_ * kChannels;
-      add_weights(row_diff, width_, a.first, a.q, coef);
-      add_weights(row_diff, width_, b.first, minus_qb, coef);
+      double* row_diff = diff_.data() + static_cast<std::size_t>(row - grid_row_begin_) * grid_width_ * kChannels;
+      add_weights(row_diff, grid_width_, a.first, a.q, coef);
+      add_weights(row_diff, grid_width_, b.first, minus_qb, coef);
     }
     if (++m == subrows) {
       m = 0;
@@ -319,15 +349,55 @@ void SplatBuffer::add_polygon(std::span<const Point2f> vertices, const std::arra
 }
 
 void SplatBuffer::resolve_into(float* rgba_full_image) const {
-  const std::size_t row_size = static_cast<std::size_t>(width_) * kChannels;
-  for (int row = row_begin_; row < row_end_; ++row) {
-    const double* d = diff_.data() + static_cast<std::size_t>(row - row_begin_) * row_size;
-    float* out = rgba_full_image + static_cast<std::size_t>(row) * row_size;
+  const std::size_t grid_row_size = static_cast<std::size_t>(grid_width_) * kChannels;
+  if (options_.downsample == 1) {
+    for (int row = row_begin_; row < row_end_; ++row) {
+      const double* d = diff_.data() + static_cast<std::size_t>(row - row_begin_) * grid_row_size;
+      float* out = rgba_full_image + static_cast<std::size_t>(row) * grid_row_size;
+      double sum[kChannels] = {0.0, 0.0, 0.0, 0.0};
+      for (std::size_t i = 0; i < grid_row_size; i += kChannels) {
+        for (int c = 0; c < kChannels; ++c) {
+          sum[c] += d[i + c];
+          out[i + c] += static_cast<float>(sum[c]);
+        }
+      }
+    }
+    return;
+  }
+  // Grid cells integrated, then each output pixel bilinearly between the four cells around its
+  // centre, divided by k^2: the weights of a cell over the output pixels sum to k^2 (k samples per
+  // unit of a tent with unit integral, per axis), so the energy is kept.
+  std::vector<double> cells(diff_.size());
+  for (std::size_t r = 0; r < diff_.size(); r += grid_row_size) {
     double sum[kChannels] = {0.0, 0.0, 0.0, 0.0};
-    for (std::size_t i = 0; i < row_size; i += kChannels) {
+    for (std::size_t i = 0; i < grid_row_size; i += kChannels) {
       for (int c = 0; c < kChannels; ++c) {
-        sum[c] += d[i + c];
-        out[i + c] += static_cast<float>(sum[c]);
+        sum[c] += diff_[r + i + static_cast<std::size_t>(c)];
+        cells[r + i + static_cast<std::size_t>(c)] = sum[c];
+      }
+    }
+  }
+  const double norm = scale_ * scale_;
+  const std::size_t out_row_size = static_cast<std::size_t>(width_) * kChannels;
+  for (int row = row_begin_; row < row_end_; ++row) {
+    const double gy = (row + 0.5) * scale_ - 0.5;
+    const double g0 = fast_floor(gy);
+    const double fy = gy - g0;
+    const std::size_t r0 = static_cast<std::size_t>(static_cast<int>(g0) - grid_row_begin_);
+    const double* top = cells.data() + r0 * grid_row_size;
+    const double* bottom = top + grid_row_size;
+    float* out = rgba_full_image + static_cast<std::size_t>(row) * out_row_size;
+    for (int x = 0; x < width_; ++x) {
+      const double gx = (x + 0.5) * scale_ - 0.5 + x_offset_;
+      const double c0 = fast_floor(gx);
+      const double fx = gx - c0;
+      const std::size_t i0 = static_cast<std::size_t>(c0) * kChannels;
+      const double w00 = (1.0 - fx) * (1.0 - fy) * norm, w01 = fx * (1.0 - fy) * norm;
+      const double w10 = (1.0 - fx) * fy * norm, w11 = fx * fy * norm;
+      for (int c = 0; c < kChannels; ++c) {
+        const std::size_t a = i0 + static_cast<std::size_t>(c);
+        out[static_cast<std::size_t>(x) * kChannels + static_cast<std::size_t>(c)] +=
+            static_cast<float>(w00 * top[a] + w01 * top[a + kChannels] + w10 * bottom[a] + w11 * bottom[a + kChannels]);
       }
     }
   }
@@ -344,6 +414,7 @@ void SplatBuffer::resolve_into(Image& rgba) const {
 std::string SplatBuffer::to_string() const {
   return "SplatBuffer(" + std::to_string(width_) + " px wide, rows [" + std::to_string(row_begin_) + ", " +
          std::to_string(row_end_) + "), " + std::to_string(options_.subrows) + " sub-rows, " +
+         (options_.downsample > 1 ? "1/" + std::to_string(options_.downsample) + " resolution, " : "") +
          std::to_string(skipped_) + " skipped)";
 }
 

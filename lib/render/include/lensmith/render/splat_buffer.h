@@ -37,6 +37,11 @@ struct SplatOptions {
   // grid, so a near-horizontal edge is placed to within 1 / (2 subrows) px (at 4, up to 8% of a
   // pixel's value along such an edge; 1% at 16). Energy is conserved at any count; cost grows with it.
   int subrows = 4;
+  // Output pixels per grid cell along each axis, in [1, 8]. Above 1 the buffer deposits into cells of
+  // downsample x downsample output pixels (coordinates stay in output px), with the tent one cell
+  // wide, and resolve_into upsamples bilinearly: the cost of a footprint falls by downsample per
+  // axis, its edges soften to about 2 downsample px, energy is kept. For large blur only.
+  int downsample = 1;
 
   // Throws OptionsError naming the field and the violated constraint.
   void validate() const;
@@ -106,13 +111,22 @@ class SplatBuffer {
   };
 
   void build_chains(std::span<const Point2f> vertices);
-  void deposit_point(double x_px, double y_px, const std::array<float, 4>& value);
+  void deposit_point(double x_out_px, double y_out_px, const std::array<float, 4>& value);
+  void deposit_grid_point(double x_px, double y_px, const std::array<float, 4>& value);  // grid cells
 
   int width_;
   int row_begin_;
   int row_end_;
   SplatOptions options_;
   std::size_t skipped_ = 0;
+  // The grid (output px with downsample 1): cells per row, its band of cell rows, and the map from
+  // output px: cell = px * scale_ (+ x_offset_ in x, a column left of the image for upsampling).
+  int grid_width_ = 0;
+  int grid_row_begin_ = 0;
+  int grid_row_end_ = 0;
+  double scale_ = 1.0;
+  double x_offset_ = 0.0;
+  std::vector<Point2f> scaled_;  // scratch: a polygon's vertices in cells
   // First differences along x, double: width_ x (row_end_ - row_begin_) x 4 channels, row-major.
   // double keeps a bright highlight's rounding from streaking along its row through the prefix sum.
   std::vector<double> diff_;
