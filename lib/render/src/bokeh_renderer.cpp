@@ -44,6 +44,12 @@ constexpr float kMediumFootprintPx = 20.0f;
 constexpr float kTallFootprintPx = 68.0f;
 // Splat grids: full resolution, 2 x 2 and 4 x 4 px cells (FootprintPlan::level).
 constexpr int kLevels = 3;
+// A thread's splat buffers by [light | hidden coverage][grid level][sub-row class], and which of
+// them the current band uses.
+struct BandBuffers {
+  std::array<std::array<std::array<std::optional<SplatBuffer>, 3>, kLevels>, 2> buffers;
+  std::array<std::array<std::array<bool, 3>, kLevels>, 2> used{};
+};
 // Bands of rows per thread: each band scatters the footprints that reach it.
 constexpr int kBandsPerThread = 4;
 // Hidden sources reach half the blur of the layer and of the nearer ones, plus this margin (px): the
@@ -80,6 +86,8 @@ Image render(const Image& image, const DepthMap& depth, const RayModel& model, c
   const int bands = std::max(1, std::min(h, threads * kBandsPerThread));
   std::size_t done = 0;
   std::atomic<std::size_t> footprints{0}, triangles{0};
+  // Per thread, its splat buffers, kept from band to band and layer to layer.
+  std::vector<BandBuffers> pools(static_cast<std::size_t>(threads));
 
   for (int l = 0; l < layers.count; ++l) {
     const auto u = static_cast<std::size_t>(l);
@@ -118,24 +126,33 @@ Image render(const Image& image, const DepthMap& depth, const RayModel& model, c
         if (row_begin == row_end) continue;
         // A buffer is made only for the grids and sub-row classes this band meets in this layer;
         // light and (Stretch) the coverage of hidden sources apart.
-        std::array<std::array<std::array<std::optional<SplatBuffer>, 3>, kLevels>, 2> buffers;
+        BandBuffers& buffers = pools[static_cast<std::size_t>(omp_get_thread_num())];
+        for (auto& set : buffers.used) {
+          for (auto& level : set) level.fill(false);
+        }
         for (std::size_t i = 0; i < layer.size(); ++i) {
           if (plans[i].y_max < static_cast<float>(row_begin) - 1.0f || plans[i].y_min > static_cast<float>(row_end) + 1.0f) continue;
           const int level = plans[i].level;
           const float height = (plans[i].y_max - plans[i].y_min) / static_cast<float>(1 << level);
           const int kind = height < kMediumFootprintPx ? 0 : height < kTallFootprintPx ? 1 : 2;
-          auto& set = buffers[layer[i].coverage_only ? 1 : 0][static_cast<std::size_t>(level)];
-          auto make = [&](std::optional<SplatBuffer>& slot, int subrow_kind) {
-            if (slot) return;
-            SplatOptions o = subrow_options(options.splat, 1 << subrow_kind);
-            o.downsample = 1 << level;
-            slot.emplace(w, row_begin, row_end, o);
+          const std::size_t set = layer[i].coverage_only ? 1 : 0, lv = static_cast<std::size_t>(level);
+          // The thread's buffer for this grid and sub-row class, made once and reset for each band.
+          auto use = [&](int subrow_kind) -> SplatBuffer& {
+            std::optional<SplatBuffer>& slot = buffers.buffers[set][lv][static_cast<std::size_t>(subrow_kind)];
+            bool& used = buffers.used[set][lv][static_cast<std::size_t>(subrow_kind)];
+            if (!slot) {
+              SplatOptions o = subrow_options(options.splat, 1 << subrow_kind);
+              o.downsample = 1 << level;
+              slot.emplace(w, row_begin, row_end, o);
+            } else if (!used) {
+              slot->reset(row_begin, row_end);
+            }
+            used = true;
+            return *slot;
           };
-          std::optional<SplatBuffer>& buffer = set[static_cast<std::size_t>(kind)];
-          make(buffer, kind);
-          std::optional<SplatBuffer>& fine = set[0];
-          if (plans[i].mesh >= 0) make(fine, 0);
-          scatter.deposit(layer[i], plans[i], *buffer, plans[i].mesh >= 0 ? *fine : *buffer, scratch, local_triangles);
+          SplatBuffer& buffer = use(kind);
+          SplatBuffer& fine = plans[i].mesh >= 0 ? use(0) : buffer;
+          scatter.deposit(layer[i], plans[i], buffer, fine, scratch, local_triangles);
           local_footprints += static_cast<std::size_t>(plans[i].groups);
         }
         bool any = false;
@@ -143,10 +160,10 @@ Image render(const Image& image, const DepthMap& depth, const RayModel& model, c
           std::vector<float>& target = set == 0 ? layer_rgba : hole_rgba;
           float* rows = target.data() + static_cast<std::size_t>(row_begin) * w * 4;
           std::fill(rows, rows + static_cast<std::size_t>(row_end - row_begin) * w * 4, 0.0f);
-          for (const auto& level : buffers[static_cast<std::size_t>(set)]) {
-            for (const std::optional<SplatBuffer>& buffer : level) {
-              if (!buffer) continue;
-              buffer->resolve_into(target.data());
+          for (std::size_t lv = 0; lv < static_cast<std::size_t>(kLevels); ++lv) {
+            for (std::size_t kind = 0; kind < 3; ++kind) {
+              if (!buffers.used[static_cast<std::size_t>(set)][lv][kind]) continue;
+              buffers.buffers[static_cast<std::size_t>(set)][lv][kind]->resolve_into(target.data());
               any = true;
             }
           }

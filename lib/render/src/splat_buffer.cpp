@@ -130,22 +130,12 @@ std::string SplatOptions::to_string() const {
 }
 
 SplatBuffer::SplatBuffer(int width_px, int row_begin, int row_end, const SplatOptions& options)
-    : width_(width_px), row_begin_(row_begin), row_end_(row_end), options_(options) {
+    : width_(width_px), options_(options) {
   options_.validate();
-  if (width_px < 1 || row_begin < 0 || row_end < row_begin) {
-    throw OptionsError("SplatBuffer: width " + std::to_string(width_px) + " px, rows [" + std::to_string(row_begin) +
-                       ", " + std::to_string(row_end) + "): need width >= 1 and 0 <= row_begin <= row_end");
+  if (width_px < 1) {
+    throw OptionsError("SplatBuffer: width " + std::to_string(width_px) + " px: need width >= 1");
   }
-  // The grid: 1 / downsample of the output's resolution, one cell more on each side than the
-  // output's band needs so that the bilinear upsampling of every band row has both neighbours.
-  const int k = options_.downsample;
-  scale_ = 1.0 / k;
-  x_offset_ = k > 1 ? 1.0 : 0.0;
-  grid_width_ = k > 1 ? (width_px + k - 1) / k + 2 : width_px;
-  grid_row_begin_ = k > 1 ? static_cast<int>(fast_floor((row_begin + 0.5) * scale_ - 0.5)) : row_begin;
-  grid_row_end_ = k > 1 ? static_cast<int>(fast_floor((row_end - 0.5) * scale_ - 0.5)) + 2 : row_end;
-  if (row_end == row_begin) grid_row_end_ = grid_row_begin_;
-  diff_.assign(static_cast<std::size_t>(grid_width_) * static_cast<std::size_t>(grid_row_end_ - grid_row_begin_) * kChannels, 0.0);
+  reset(row_begin, row_end);
   const int s = options_.subrows;
   subrow_row_offset_.resize(static_cast<std::size_t>(s));
   subrow_lower_weight_.resize(static_cast<std::size_t>(s));
@@ -156,6 +146,27 @@ SplatBuffer::SplatBuffer(int width_px, int row_begin, int row_end, const SplatOp
     subrow_row_offset_[static_cast<std::size_t>(m)] = upper;
     subrow_lower_weight_[static_cast<std::size_t>(m)] = offset - upper;
   }
+}
+
+void SplatBuffer::reset(int row_begin, int row_end) {
+  if (row_begin < 0 || row_end < row_begin) {
+    throw OptionsError("SplatBuffer: width " + std::to_string(width_) + " px, rows [" + std::to_string(row_begin) +
+                       ", " + std::to_string(row_end) + "): need width >= 1 and 0 <= row_begin <= row_end");
+  }
+  row_begin_ = row_begin;
+  row_end_ = row_end;
+  // The grid: 1 / downsample of the output's resolution, one cell more on each side than the
+  // output's band needs so that the bilinear upsampling of every band row has both neighbours.
+  const int k = options_.downsample;
+  scale_ = 1.0 / k;
+  x_offset_ = k > 1 ? 1.0 : 0.0;
+  grid_width_ = k > 1 ? (width_ + k - 1) / k + 2 : width_;
+  grid_row_begin_ = k > 1 ? static_cast<int>(fast_floor((row_begin + 0.5) * scale_ - 0.5)) : row_begin;
+  grid_row_end_ = k > 1 ? static_cast<int>(fast_floor((row_end - 0.5) * scale_ - 0.5)) + 2 : row_end;
+  if (row_end == row_begin) grid_row_end_ = grid_row_begin_;
+  // assign keeps the capacity: a buffer reused band after band allocates (and faults in) once.
+  diff_.assign(static_cast<std::size_t>(grid_width_) * static_cast<std::size_t>(grid_row_end_ - grid_row_begin_) * kChannels, 0.0);
+  skipped_ = 0;
 }
 
 void SplatBuffer::clear() {

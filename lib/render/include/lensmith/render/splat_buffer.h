@@ -71,6 +71,9 @@ class SplatBuffer {
 
   // Zeroes the accumulated deposits (and the skipped count) without releasing memory.
   void clear();
+  // Zeroed for another band of rows of the same width and options, keeping its memory where it is
+  // large enough; throws OptionsError for row_begin < 0 or row_end < row_begin.
+  void reset(int row_begin, int row_end);
 
   // Convex polygon, either winding, vertices in px; value = (R, G, B, alpha) energy it deposits.
   // Polygons with no vertex, a non-finite vertex or a non-finite value are not deposited but counted
