@@ -27,8 +27,10 @@ ImageFormat detect_image_format(const std::filesystem::path& path);
 
 // The header of a picture file (the first part of a multi-part OpenEXR, the first page of a TIFF).
 // Throws IoError when the file cannot be opened or decoded, ImageFileError when it is a deep
-// OpenEXR image ("a deep image; lensmith reads flat images only") or its data window differs from
-// its display window (a crop or overscan would shift the picture against the pixels read).
+// OpenEXR image ("a deep image; lensmith reads flat images only"), its data window differs from
+// its display window (a crop or overscan would shift the picture against the pixels read) or its
+// samples are laid out in a way lensmith does not read (subsampled OpenEXR channels, a TIFF of
+// signed 16/32-bit or 64-bit samples).
 RasterInfo read_raster_info(const std::filesystem::path& path);
 
 // Decodes the channels of `info` (as read_raster_info gave it for `path`) listed in `channels`
@@ -41,9 +43,10 @@ Raster read_raster(const std::filesystem::path& path, const RasterInfo& info, st
 // OpenEXR attributes (comments as ImageDescription, capDate as DateTime, owner as Copyright, the
 // compression as "compression"; strings as stored, floats and doubles in the shortest text that
 // reads back exactly), PNG text chunks (Description as ImageDescription), TIFF's Software,
-// ImageDescription, DateTime, Artist, Copyright and DocumentName tags, the comment of a JPEG
-// (ImageDescription) and the header variables of a Radiance HDR file. Other formats have none.
-// Throws IoError.
+// ImageDescription, DateTime, Artist, Copyright and DocumentName tags and its compression, a
+// JPEG's Exif ImageDescription, Software, DateTime, Artist and Copyright (its comment as the
+// ImageDescription when Exif has none), and the NAME=value header lines of a Radiance HDR file
+// (SOFTWARE as Software). PFM, BMP, TGA and PNM have none. Throws IoError.
 std::vector<std::pair<std::string, std::string>> read_image_metadata_pairs(const std::filesystem::path& path);
 
 // One item of metadata to write: text, or a number that formats with typed attributes (OpenEXR)
@@ -72,8 +75,9 @@ void write_exr(const std::filesystem::path& path, const PixelsView<float>& pixel
 // one tEXt chunk per attribute (ImageDescription as the standard keyword "Description").
 void write_png(const std::filesystem::path& path, const PixelsView<std::uint8_t>& pixels,
                const std::vector<ImageAttribute>& attributes);
-// Baseline 8-bit JPEG of 1 or 3 channels at `quality` (1 to 100); the ImageDescription attribute
-// becomes the file's comment (a COM segment), others are dropped (JPEG keeps no free attributes).
+// Baseline 8-bit JPEG of 1 or 3 channels at `quality` (1 to 100; above 90 without chroma
+// subsampling); Software and ImageDescription become Exif tags and the description also the file's
+// comment (a COM segment), as OpenImageIO wrote them; others are dropped (no free attributes).
 void write_jpeg(const std::filesystem::path& path, const PixelsView<std::uint8_t>& pixels, int quality,
                 const std::vector<ImageAttribute>& attributes);
 // 16-bit TIFF of 1 to 4 channels, deflate (ZIP) compression with horizontal differencing; the
@@ -81,7 +85,8 @@ void write_jpeg(const std::filesystem::path& path, const PixelsView<std::uint8_t
 void write_tiff(const std::filesystem::path& path, const PixelsView<std::uint16_t>& pixels,
                 const std::vector<ImageAttribute>& attributes);
 // Radiance RGBE of 3 channels (run-length encoded scanlines); each attribute becomes a header line
-// NAME=value (names and values on one line; ImageDescription is written as a # comment too).
+// NAME=value (Software as Radiance's SOFTWARE; line breaks in values become spaces; a name with '='
+// is an OptionsError).
 void write_hdr(const std::filesystem::path& path, const PixelsView<float>& rgb, const std::vector<ImageAttribute>& attributes);
 
 }  // namespace lensmith
