@@ -11,6 +11,7 @@ export DEBIAN_FRONTEND=noninteractive
 apt-get update -qq
 apt-get install -y -qq --no-install-recommends \
   ca-certificates cmake ninja-build g++ pkg-config \
-  libeigen3-dev libceres-dev libopenimageio-dev openimageio-tools nlohmann-json3-dev libcli11-dev catch2 libbenchmark-dev \
+  libeigen3-dev libceres-dev libopenexr-dev libimath-dev libtiff-dev libpng-dev libstb-dev \
+  nlohmann-json3-dev libcli11-dev catch2 libbenchmark-dev \
   clang libclang-rt-14-dev fonts-dejavu-core >/dev/null
 echo "install-deps.sh: dependencies installed"

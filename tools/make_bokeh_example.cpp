@@ -2,16 +2,24 @@
 // pinhole view (36 mm wide sensor, 50 mm focal length) of fronto-parallel planes at known depths with
 // HDR point lights, as linear half RGB plus a float planar-depth channel Z in metres (as Blender writes).
 // Build and run from the repository root (examples/README.md describes the scene):
-//   g++ -O2 -std=c++20 tools/make_bokeh_example.cpp $(pkg-config --cflags --libs OpenImageIO) -o /tmp/make_bokeh_example
+//   g++ -O2 -std=c++20 tools/make_bokeh_example.cpp $(pkg-config --cflags --libs OpenEXR) -o /tmp/make_bokeh_example
 //   /tmp/make_bokeh_example examples/bokeh-scene.exr
 // Everything is deterministic: textures come from an integer hash of their coordinates, not an RNG.
-#include <OpenImageIO/imageio.h>
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFloatAttribute.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStringAttribute.h>
+
+#include <Imath/half.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <exception>
 #include <limits>
 #include <string>
 #include <vector>
@@ -311,24 +319,38 @@ int main(int argc, char** argv) {
     }
   }
 
-  using namespace OIIO;
-  ImageSpec spec(kWidthPx, kHeightPx, 4, TypeDesc::HALF);
-  spec.channelnames = {"R", "G", "B", "Z"};
-  spec.channelformats = {TypeDesc::HALF, TypeDesc::HALF, TypeDesc::HALF, TypeDesc::FLOAT};
-  spec.z_channel = 3;
-  spec.attribute("compression", "zip");
-  spec.attribute("ImageDescription",
-                 "lensmith bokeh example: all-in-focus pinhole view, 36 mm sensor width, 50 mm focal length; "
-                 "linear Rec.709 RGB; Z = planar depth in metres (inf = sky). See examples/README.md.");
-  spec.attribute("Software", "lensmith tools/make_bokeh_example.cpp");
-  // A fixed date keeps the file byte-identical from run to run (the EXR writer adds one otherwise).
-  spec.attribute("DateTime", "2025:01:01 00:00:00");
-  spec.attribute("lensmith:sensor_width_mm", static_cast<float>(kSensorWidthMm));
-  spec.attribute("lensmith:focal_length_mm", static_cast<float>(kFocalLengthMm));
-  auto out = ImageOutput::create(argv[1]);
-  if (!out || !out->open(argv[1], spec) || !out->write_image(TypeDesc::FLOAT, pixels.data()) || !out->close()) {
-    std::fprintf(stderr, "make_bokeh_example: cannot write %s: %s\n", argv[1],
-                 out ? out->geterror().c_str() : OIIO::geterror().c_str());
+  // RGB as half (OpenEXR converts the floats, rounding to nearest), Z as float; ZIP compression.
+  Imf::Header header(kWidthPx, kHeightPx);
+  header.compression() = Imf::ZIP_COMPRESSION;
+  header.insert("comments", Imf::StringAttribute(
+                                "lensmith bokeh example: all-in-focus pinhole view, 36 mm sensor width, 50 mm focal length; "
+                                "linear Rec.709 RGB; Z = planar depth in metres (inf = sky). See examples/README.md."));
+  header.insert("Software", Imf::StringAttribute("lensmith tools/make_bokeh_example.cpp"));
+  // A fixed capture date, as the file has always carried one: the output stays byte-identical.
+  header.insert("capDate", Imf::StringAttribute("2025:01:01 00:00:00"));
+  header.insert("lensmith:sensor_width_mm", Imf::FloatAttribute(static_cast<float>(kSensorWidthMm)));
+  header.insert("lensmith:focal_length_mm", Imf::FloatAttribute(static_cast<float>(kFocalLengthMm)));
+  std::vector<Imath::half> rgb(static_cast<std::size_t>(kWidthPx) * kHeightPx * 3);
+  std::vector<float> z(static_cast<std::size_t>(kWidthPx) * kHeightPx);
+  for (std::size_t p = 0; p < z.size(); ++p) {
+    for (std::size_t c = 0; c < 3; ++c) rgb[p * 3 + c] = Imath::half(pixels[p * 4 + c]);
+    z[p] = pixels[p * 4 + 3];
+  }
+  Imf::FrameBuffer frame;
+  const char* names[3] = {"R", "G", "B"};
+  for (std::size_t c = 0; c < 3; ++c) {
+    header.channels().insert(names[c], Imf::Channel(Imf::HALF));
+    frame.insert(names[c], Imf::Slice::Make(Imf::HALF, rgb.data() + c, header.dataWindow(), 3 * sizeof(Imath::half),
+                                            kWidthPx * 3 * sizeof(Imath::half)));
+  }
+  header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
+  frame.insert("Z", Imf::Slice::Make(Imf::FLOAT, z.data(), header.dataWindow(), sizeof(float), kWidthPx * sizeof(float)));
+  try {
+    Imf::OutputFile out(argv[1], header);
+    out.setFrameBuffer(frame);
+    out.writePixels(kHeightPx);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "make_bokeh_example: cannot write %s: %s\n", argv[1], e.what());
     return 1;
   }
   std::printf("wrote %s (%d x %d, R G B half + Z float); point lights: %d at 20 m, %d at 3 m, %d at 1.2 m\n", argv[1],

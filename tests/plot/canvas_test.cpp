@@ -1,10 +1,11 @@
-// The plot canvas: coverage-based anti-aliasing conserves area, text lands where it is measured, and
-// PNG files round-trip through OpenImageIO and are written through a temporary file.
+// The plot canvas: coverage-based anti-aliasing conserves area, text lands where it is measured and
+// has the font's own widths, and PNG files round-trip and are written through a temporary file.
 #include "lensmith/plot/canvas.h"
 
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <unistd.h>
 
 #include "lensmith/core/errors.h"
@@ -87,6 +88,33 @@ TEST_CASE("text draws inside its measured width, and draws nothing without a fon
   no_font.text({10.0, 40.0}, "hidden", 20.0, kBlack);
   CHECK(ink(no_font) == 0.0);
   CHECK(no_font.text_width("hidden", 20.0) == 0.0);
+}
+
+TEST_CASE("text is as wide as the font's advances: 4 digits of DejaVu Sans are 4 x 1303 / 2048 em", "[plot][canvas][text]") {
+  const auto font = Canvas::find_default_font();
+  if (!font) {
+    WARN("DejaVuSans.ttf not found: the text checks are skipped (install fonts-dejavu-core)");
+    return;
+  }
+  // DejaVu Sans 2.37: unitsPerEm 2048 (head), every digit advances 1303 units (hmtx, glyph 19 for '0'),
+  // and digits are not kerned. A size is the em height in pixels.
+  constexpr double kDigitAdvanceEm = 1303.0 / 2048.0;
+  constexpr double kFloatScale = 1e-6;  // the font scale is a float
+  Canvas c(10, 10);
+  c.set_font(font);
+  CHECK_THAT(c.text_width("0000", 20.0), WithinRel(4.0 * kDigitAdvanceEm * 20.0, kFloatScale));
+  CHECK_THAT(c.text_width("0000", 2048.0), WithinRel(4.0 * 1303.0, kFloatScale));
+}
+
+TEST_CASE("a font file that cannot be read or is not a font is an IoError naming it", "[plot][canvas][text]") {
+  const auto dir = scratch_folder();
+  Canvas c(10, 10);
+  CHECK_THROWS_AS(c.set_font((dir / "no-such-font.ttf").string()), IoError);
+  const auto junk = dir / "junk.ttf";
+  std::ofstream(junk) << "not a font";
+  CHECK_THROWS_AS(c.set_font(junk.string()), IoError);
+  CHECK_THROWS_WITH(c.set_font(junk.string()), Catch::Contains("junk.ttf") && Catch::Contains("not a TrueType"));
+  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("write_png writes a PNG that reads back with its size and colours, and leaves no temporary file", "[plot][canvas][io]") {

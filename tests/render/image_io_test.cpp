@@ -1,12 +1,30 @@
 // Image and depth input/output: the sRGB curve against IEC 61966-2-1:1999 (5.2, 5.3), exact float
 // round trips through OpenEXR, depth conventions (planar z, Euclidean distance, inverse depth) against
-// their defining formulas, and the errors a user sees for bad files.
+// their defining formulas, and the errors a user sees for bad files. Inputs in the formats lensmith
+// reads are made here with OpenEXR, libpng and libtiff directly, or byte by byte from the format's
+// specification (PFM, Radiance RGBE), never with the code under test.
 #include "lensmith/render/image_io.h"
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfDeepFrameBuffer.h>
+#include <OpenEXR/ImfDeepScanLineOutputFile.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfPartType.h>
+#include <OpenEXR/ImfTiledOutputFile.h>
+#include <png.h>
+#include <tiffio.h>
+
+#include <Imath/half.h>
 
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -28,8 +46,8 @@ namespace {
 constexpr double kIecBreakpointRounding = 3e-6;
 // srgb_encode/decode compute in double and round once to float: a round trip keeps ~1 float ulp.
 constexpr double kFloatRoundTrip = 1e-6;
-// OpenImageIO turns a code value into a float within a few ulps (6e-8 each) of code / 255; near the
-// threshold the highlight factor magnifies that by 1 / (1 - threshold) = 50 times the smoothstep slope.
+// A code value becomes the float code / 255 within an ulp (6e-8); near the threshold the highlight
+// factor magnifies that by 1 / (1 - threshold) = 50 times the smoothstep slope.
 constexpr double kHighlightFactorFromFloatCode = 2e-5;
 // One code value of a 16-bit channel (the TIFF output).
 constexpr double kOne16BitStep = 1.0 / 65535.0;
@@ -94,6 +112,75 @@ std::string value_of(const std::vector<std::pair<std::string, std::string>>& met
 
 // 4 x 3 pixels, focal length 2 px: wide enough that the corner direction is far off axis.
 PinholeFrame small_frame() { return PinholeFrame(4, 3, 2.0); }
+
+// Channels of float or half samples for the OpenEXR writers below, one name per channel.
+struct ExrChannels {
+  std::vector<std::string> names;
+  Imf::PixelType type = Imf::FLOAT;
+};
+
+// Writes `values` (interleaved, width x height x names.size()) to an OpenEXR file with the
+// OpenEXR library itself; tiled with tile_px x tile_px tiles when tile_px > 0.
+void write_exr_directly(const fs::path& path, int width, int height, const ExrChannels& channels, const std::vector<float>& values,
+                        int tile_px = 0) {
+  Imf::Header header(width, height);
+  if (tile_px > 0) header.setTileDescription(Imf::TileDescription(static_cast<unsigned>(tile_px), static_cast<unsigned>(tile_px)));
+  const std::size_t stride = channels.names.size();
+  std::vector<Imath::half> halves(values.begin(), values.end());
+  Imf::FrameBuffer frame;
+  for (std::size_t c = 0; c < stride; ++c) {
+    header.channels().insert(channels.names[c], Imf::Channel(channels.type));
+    const bool half = channels.type == Imf::HALF;
+    const std::size_t size = half ? sizeof(Imath::half) : sizeof(float);
+    const void* base = half ? static_cast<const void*>(halves.data() + c) : static_cast<const void*>(values.data() + c);
+    frame.insert(channels.names[c], Imf::Slice::Make(channels.type, base, header.dataWindow(), stride * size,
+                                                     static_cast<std::size_t>(width) * stride * size));
+  }
+  if (tile_px > 0) {
+    Imf::TiledOutputFile out(path.c_str(), header);
+    out.setFrameBuffer(frame);
+    out.writeTiles(0, out.numXTiles() - 1, 0, out.numYTiles() - 1);
+  } else {
+    Imf::OutputFile out(path.c_str(), header);
+    out.setFrameBuffer(frame);
+    out.writePixels(height);
+  }
+}
+
+// A 4 x 3 x 3 ramp whose every sample differs: (x, y, c) -> x + 10 y + 100 c + 0.5.
+std::vector<float> ramp_4x3x3() {
+  std::vector<float> values;
+  for (int y = 0; y < 3; ++y) {
+    for (int x = 0; x < 4; ++x) {
+      for (int c = 0; c < 3; ++c) values.push_back(static_cast<float>(x + 10 * y + 100 * c) + 0.5f);
+    }
+  }
+  return values;
+}
+
+// Writes one row of `width` pixels with libpng's simplified writer (`format` a PNG_FORMAT_* value;
+// 8-bit formats are marked sRGB, PNG_FORMAT_FLAG_LINEAR ones 16-bit with gAMA 1.0). False on failure.
+bool write_png_directly(const fs::path& path, png_uint_32 width, png_uint_32 format, const void* samples) {
+  png_image image{};
+  image.version = PNG_IMAGE_VERSION;
+  image.width = width;
+  image.height = 1;
+  image.format = format;
+  return png_image_write_to_file(&image, path.c_str(), 0, samples, 0, nullptr) != 0;
+}
+
+std::string little_endian_float(float v) {
+  const auto bits = std::bit_cast<std::uint32_t>(v);
+  std::string out;
+  for (int shift = 0; shift < 32; shift += 8) out += static_cast<char>((bits >> shift) & 0xFFu);
+  return out;
+}
+
+std::string big_endian_float(float v) {
+  std::string out = little_endian_float(v);
+  std::reverse(out.begin(), out.end());
+  return out;
+}
 
 }  // namespace
 
@@ -559,4 +646,271 @@ TEST_CASE("writing leaves only the finished file behind, also when it replaces o
   // A folder that does not exist: the writer fails and leaves nothing anywhere.
   CHECK_THROWS_AS(write_output_image(dir.path / "missing" / "render.exr", gradient_rgb(), {}), IoError);
   CHECK(dir.names() == std::vector<std::string>{"render.exr", "render.png"});
+}
+
+// ---- formats read through lensmith::imageio -------------------------------------------------------
+
+TEST_CASE("a tiled OpenEXR reads sample for sample like the scanline file, partial edge tiles included", "[render][image_io]") {
+  TempDir dir;
+  const std::vector<float> ramp = ramp_4x3x3();
+  // 3 x 3 tiles over 4 x 3 pixels: the right column of tiles is one pixel wide.
+  write_exr_directly(dir / "tiled.exr", 4, 3, {{"R", "G", "B"}}, ramp, 3);
+  const Image read = read_radiance_image(dir / "tiled.exr");
+  REQUIRE(read.width == 4);
+  REQUIRE(read.height == 3);
+  CHECK(read.data == ramp);
+}
+
+TEST_CASE("half-float OpenEXR channels read as the IEEE 754 binary16 values they hold", "[render][image_io]") {
+  TempDir dir;
+  // binary16 has a 10-bit fraction: 0.1 is stored as 1638 / 16384 = 0.0999755859375; 65504 is its largest finite value.
+  std::vector<float> values(4 * 3 * 3, 0.5f);
+  values[0] = 0.1f;
+  values[1] = 65504.0f;
+  write_exr_directly(dir / "half.exr", 4, 3, {{"R", "G", "B"}, Imf::HALF}, values);
+  const Image read = read_radiance_image(dir / "half.exr");
+  CHECK(read.at(0, 0, 0) == 0.0999755859375f);
+  CHECK(read.at(0, 0, 1) == 65504.0f);
+  CHECK(read.at(3, 2, 2) == 0.5f);
+  // Half depth is float depth: read_depth takes it.
+  write_exr_directly(dir / "half_z.exr", 4, 3, {{"Z"}, Imf::HALF}, std::vector<float>(12, 2.5f));
+  CHECK(read_depth(DepthSource{dir / "half_z.exr", ""}, {}, small_frame()).at(3, 2) == 2.5f);
+}
+
+TEST_CASE("an OpenEXR whose data window is not its display window is refused", "[render][image_io]") {
+  TempDir dir;
+  // Display window 4 x 3 at (0, 0); pixels stored for the 2 x 3 columns 1 and 2 only (a crop).
+  const Imath::Box2i display(Imath::V2i(0, 0), Imath::V2i(3, 2));
+  const Imath::Box2i data(Imath::V2i(1, 0), Imath::V2i(2, 2));
+  Imf::Header header(display, data);
+  header.channels().insert("Y", Imf::Channel(Imf::FLOAT));
+  const std::vector<float> values(6, 1.0f);
+  Imf::FrameBuffer frame;
+  frame.insert("Y", Imf::Slice::Make(Imf::FLOAT, values.data(), data, sizeof(float), 2 * sizeof(float)));
+  {
+    Imf::OutputFile out((dir / "crop.exr").c_str(), header);
+    out.setFrameBuffer(frame);
+    out.writePixels(3);
+  }
+  CHECK_THROWS_AS(read_radiance_image(dir / "crop.exr"), ImageFileError);
+  CHECK_THROWS_WITH(read_radiance_image(dir / "crop.exr"),
+                    Contains("data window 2 x 3 at (1, 0) differs from the display window 4 x 3 at (0, 0)") &&
+                        Contains("without a crop or overscan"));
+}
+
+TEST_CASE("a deep OpenEXR is refused: lensmith reads flat images only", "[render][image_io]") {
+  TempDir dir;
+  const fs::path deep = dir / "deep.exr";
+  {
+    // Two pixels with one depth sample each, written through OpenEXR's deep scanline API.
+    Imf::Header header(2, 1);
+    header.setType(Imf::DEEPSCANLINE);
+    header.compression() = Imf::ZIPS_COMPRESSION;
+    header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
+    Imf::DeepScanLineOutputFile out(deep.c_str(), header);
+    unsigned int counts[2] = {1, 1};
+    float z[2] = {1.0f, 2.0f};
+    float* samples[2] = {&z[0], &z[1]};
+    Imf::DeepFrameBuffer frame;
+    frame.insertSampleCountSlice(Imf::Slice(Imf::UINT, reinterpret_cast<char*>(counts), sizeof(unsigned int), 2 * sizeof(unsigned int)));
+    frame.insert("Z", Imf::DeepSlice(Imf::FLOAT, reinterpret_cast<char*>(samples), sizeof(float*), 2 * sizeof(float*), sizeof(float)));
+    out.setFrameBuffer(frame);
+    out.writePixels(1);
+  }
+  CHECK_THROWS_AS(read_radiance_image(deep), ImageFileError);
+  CHECK_THROWS_WITH(read_radiance_image(deep), Contains("deep.exr: a deep image; lensmith reads flat images only"));
+  CHECK_THROWS_WITH(read_depth(DepthSource{deep, ""}, {}, PinholeFrame(2, 1, 2.0)), Contains("a deep image"));
+}
+
+TEST_CASE("an OpenEXR depth stored as 32-bit unsigned integers is refused like any integer depth", "[render][image_io][depth]") {
+  TempDir dir;
+  Imf::Header header(4, 3);
+  header.channels().insert("Z", Imf::Channel(Imf::UINT));
+  const std::vector<std::uint32_t> ids(12, 7u);
+  Imf::FrameBuffer frame;
+  frame.insert("Z", Imf::Slice::Make(Imf::UINT, ids.data(), header.dataWindow(), sizeof(std::uint32_t), 4 * sizeof(std::uint32_t)));
+  {
+    Imf::OutputFile out((dir / "ids.exr").c_str(), header);
+    out.setFrameBuffer(frame);
+    out.writePixels(3);
+  }
+  CHECK_THROWS_WITH(read_depth(DepthSource{dir / "ids.exr", ""}, {}, small_frame()), Contains("uint32") && Contains("store depth as float"));
+}
+
+TEST_CASE("a 16-bit PNG keeps its 16 bits, and its gAMA of 1.0 makes it linear", "[render][image_io]") {
+  TempDir dir;
+  // libpng's simplified writer stores linear 16-bit data with gAMA 1.0 and no sRGB chunk.
+  std::vector<png_uint_16> codes(2 * 1 * 3, 0);
+  codes[0] = 32768;  // 16-bit precision: 8 bits would give 128 / 255 = 0.50196
+  codes[4] = 65535;
+  const fs::path path = dir / "linear16.png";
+  REQUIRE(write_png_directly(path, 2, PNG_FORMAT_LINEAR_RGB, codes.data()));
+  const Image read = read_radiance_image(path);
+  CHECK_THAT(read.at(0, 0, 0), WithinAbs(32768.0 / 65535.0, kFloatRoundTrip));
+  CHECK(read.at(1, 0, 1) == 1.0f);
+  CHECK(read.at(0, 0, 1) == 0.0f);
+}
+
+TEST_CASE("an 8-bit gray PNG with an sRGB chunk is decoded and replicated to R = G = B", "[render][image_io]") {
+  TempDir dir;
+  // libpng's simplified writer marks 8-bit data as sRGB.
+  const std::uint8_t codes[2] = {128, 255};
+  const fs::path path = dir / "gray.png";
+  REQUIRE(write_png_directly(path, 2, PNG_FORMAT_GRAY, codes));
+  const Image read = read_radiance_image(path);
+  for (int c = 0; c < 3; ++c) {
+    CHECK_THAT(read.at(0, 0, c), WithinAbs(0.2158605, kFloatRoundTrip));  // ((128/255 + 0.055) / 1.055)^2.4
+    CHECK_THAT(read.at(1, 0, c), WithinAbs(1.0, kFloatRoundTrip));
+  }
+}
+
+// How write_tiff_directly lays out a 4 x 3 float TIFF.
+struct FloatTiffLayout {
+  int channels = 3;
+  int bits = 32;       // 32 (float) or 16 (IEEE half)
+  bool tiled = false;  // one 16 x 16 tile (the smallest TIFF allows), mostly outside the picture
+};
+
+// Writes 4 x 3 pixels of float samples (interleaved) with libtiff itself.
+void write_tiff_directly(const fs::path& path, const FloatTiffLayout& layout, const std::vector<float>& values) {
+  TIFF* t = TIFFOpen(path.c_str(), "w");
+  REQUIRE(t != nullptr);
+  TIFFSetField(t, TIFFTAG_IMAGEWIDTH, 4);
+  TIFFSetField(t, TIFFTAG_IMAGELENGTH, 3);
+  TIFFSetField(t, TIFFTAG_SAMPLESPERPIXEL, layout.channels);
+  TIFFSetField(t, TIFFTAG_BITSPERSAMPLE, layout.bits);
+  TIFFSetField(t, TIFFTAG_SAMPLEFORMAT, SAMPLEFORMAT_IEEEFP);
+  TIFFSetField(t, TIFFTAG_PHOTOMETRIC, layout.channels == 3 ? PHOTOMETRIC_RGB : PHOTOMETRIC_MINISBLACK);
+  TIFFSetField(t, TIFFTAG_PLANARCONFIG, PLANARCONFIG_CONTIG);
+  TIFFSetField(t, TIFFTAG_COMPRESSION, COMPRESSION_ADOBE_DEFLATE);
+  const auto row_samples = static_cast<std::size_t>(4 * layout.channels);
+  const std::size_t sample_bytes = static_cast<std::size_t>(layout.bits) / 8;
+  // The samples as the file stores them: floats, or the bits of IEEE halves.
+  std::vector<unsigned char> bytes(values.size() * sample_bytes);
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (layout.bits == 32) {
+      std::memcpy(bytes.data() + 4 * i, &values[i], 4);
+    } else {
+      const std::uint16_t bits = Imath::half(values[i]).bits();
+      std::memcpy(bytes.data() + 2 * i, &bits, 2);
+    }
+  }
+  if (layout.tiled) {
+    TIFFSetField(t, TIFFTAG_TILEWIDTH, 16);
+    TIFFSetField(t, TIFFTAG_TILELENGTH, 16);
+    std::vector<unsigned char> tile(16 * 16 * static_cast<std::size_t>(layout.channels) * sample_bytes, 0);
+    for (std::size_t y = 0; y < 3; ++y) {
+      std::copy_n(bytes.begin() + static_cast<std::ptrdiff_t>(y * row_samples * sample_bytes), row_samples * sample_bytes,
+                  tile.begin() + static_cast<std::ptrdiff_t>(y * 16 * static_cast<std::size_t>(layout.channels) * sample_bytes));
+    }
+    REQUIRE(TIFFWriteTile(t, tile.data(), 0, 0, 0, 0) > 0);
+  } else {
+    for (std::size_t y = 0; y < 3; ++y) {
+      std::vector<unsigned char> row(bytes.begin() + static_cast<std::ptrdiff_t>(y * row_samples * sample_bytes),
+                                     bytes.begin() + static_cast<std::ptrdiff_t>((y + 1) * row_samples * sample_bytes));
+      REQUIRE(TIFFWriteScanline(t, row.data(), static_cast<std::uint32_t>(y), 0) == 1);
+    }
+  }
+  TIFFClose(t);
+}
+
+TEST_CASE("a float TIFF reads its samples as stored, as a picture and as depth", "[render][image_io]") {
+  TempDir dir;
+  std::vector<float> ramp = ramp_4x3x3();
+  ramp[5] = 1234.5f;  // radiance far above display white
+  SECTION("32-bit, in strips") {
+    write_tiff_directly(dir / "float.tif", {}, ramp);
+    CHECK(read_radiance_image(dir / "float.tif").data == ramp);
+  }
+  SECTION("32-bit, in one tile larger than the picture") {
+    write_tiff_directly(dir / "tiled.tif", {3, 32, true}, ramp);
+    CHECK(read_radiance_image(dir / "tiled.tif").data == ramp);
+  }
+  SECTION("16-bit IEEE half: the plain ramp's values need at most 9 of a half's 11 significant bits") {
+    write_tiff_directly(dir / "half.tif", {3, 16, false}, ramp_4x3x3());
+    CHECK(read_radiance_image(dir / "half.tif").data == ramp_4x3x3());
+  }
+  SECTION("one channel as depth") {
+    std::vector<float> depth(12, 4.0f);
+    depth[6] = 0.75f;  // pixel (2, 1)
+    write_tiff_directly(dir / "depth.tif", {1, 32, false}, depth);
+    const DepthMap read = read_depth(DepthSource{dir / "depth.tif", ""}, {}, small_frame());
+    CHECK(read.at(2, 1) == 0.75f);
+    CHECK(read.at(0, 0) == 4.0f);
+  }
+}
+
+TEST_CASE("a PFM is read bottom row first, in the byte order the sign of its scale gives", "[render][image_io]") {
+  TempDir dir;
+  SECTION("PF (RGB), negative scale: little-endian") {
+    // 2 x 2 pixels; the file's first row is the picture's bottom row.
+    std::string bytes = "PF\n2 2\n-1.0\n";
+    for (const float v : {1.f, 2.f, 3.f, 4.f, 5.f, 6.f}) bytes += little_endian_float(v);     // bottom row
+    for (const float v : {7.f, 8.f, 9.f, 10.f, 11.f, 12.f}) bytes += little_endian_float(v);  // top row
+    std::ofstream(dir / "rgb.pfm", std::ios::binary) << bytes;
+    const Image read = read_radiance_image(dir / "rgb.pfm");
+    CHECK(read.at(0, 0, 0) == 7.0f);
+    CHECK(read.at(1, 0, 2) == 12.0f);
+    CHECK(read.at(0, 1, 0) == 1.0f);
+    CHECK(read.at(1, 1, 1) == 5.0f);
+  }
+  SECTION("Pf (gray), positive scale: big-endian, as depth") {
+    std::string bytes = "Pf\n4 3\n1.0\n";
+    for (int file_row = 0; file_row < 3; ++file_row) {
+      for (int x = 0; x < 4; ++x) bytes += big_endian_float(static_cast<float>(1 + x + 4 * (2 - file_row)));
+    }
+    std::ofstream(dir / "depth.pfm", std::ios::binary) << bytes;
+    const DepthMap depth = read_depth(DepthSource{dir / "depth.pfm", ""}, {}, small_frame());
+    CHECK(depth.at(0, 0) == 1.0f);
+    CHECK(depth.at(3, 2) == 12.0f);
+  }
+  SECTION("a truncated file is an IoError saying how many bytes are missing") {
+    std::ofstream(dir / "short.pfm", std::ios::binary) << "PF\n2 2\n-1.0\n" << little_endian_float(1.0f);
+    CHECK_THROWS_AS(read_radiance_image(dir / "short.pfm"), IoError);
+    CHECK_THROWS_WITH(read_radiance_image(dir / "short.pfm"), Contains("short.pfm") && Contains("48 expected"));
+  }
+}
+
+TEST_CASE("a Radiance RGBE pixel (128, 64, 32, exponent 129) reads as (1, 0.5, 0.25)", "[render][image_io]") {
+  // Ward, "Real Pixels" (Graphics Gems II): value = mantissa / 256 * 2^(exponent - 128). A width
+  // below 8 is stored flat, without run-length encoding.
+  TempDir dir;
+  std::string bytes = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 2\n";
+  bytes += std::string{'\x80', '\x40', '\x20', '\x81'};
+  bytes += std::string{'\x80', '\x80', '\x80', '\x80'};  // 0.5 grey
+  std::ofstream(dir / "flat.hdr", std::ios::binary) << bytes;
+  const Image read = read_radiance_image(dir / "flat.hdr");
+  REQUIRE(read.width == 2);
+  CHECK_THAT(read.at(0, 0, 0), WithinRel(1.0, kRgbeMantissa));
+  CHECK_THAT(read.at(0, 0, 1), WithinRel(0.5, kRgbeMantissa));
+  CHECK_THAT(read.at(0, 0, 2), WithinRel(0.25, kRgbeMantissa));
+  CHECK_THAT(read.at(1, 0, 1), WithinRel(0.5, kRgbeMantissa));
+}
+
+TEST_CASE("TIFF, JPEG and HDR outputs record Software and the ImageDescription", "[render][image_io]") {
+  TempDir dir;
+  OutputMetadata meta;
+  meta.lens = "triplet";
+  meta.f_number = 4.0;
+  meta.lensmith_version = "0.3.0";
+  for (const std::string name : {"render.tif", "render.jpg", "render.hdr"}) {
+    INFO(name);
+    write_output_image(dir / name, gradient_rgb(), meta);
+    const auto metadata = read_image_metadata(dir / name);
+    CHECK(value_of(metadata, "Software") == "lensmith 0.3.0");
+    CHECK_THAT(value_of(metadata, "ImageDescription"), Contains("lens triplet") && Contains("f/4"));
+  }
+  // Radiance headers keep free variables: the lensmith attributes too.
+  CHECK(value_of(read_image_metadata(dir / "render.hdr"), "lensmith:f_number") == "4");
+}
+
+TEST_CASE("a file in no format lensmith reads is an IoError naming it and listing the formats read", "[render][image_io]") {
+  TempDir dir;
+  const fs::path gif = dir / "picture.gif";
+  std::ofstream(gif, std::ios::binary) << "GIF89a" << std::string(32, '\0');
+  CHECK_THROWS_AS(read_radiance_image(gif), IoError);
+  CHECK_THROWS_WITH(read_radiance_image(gif), Contains("picture.gif") && Contains("OpenEXR") && Contains("TIFF") &&
+                                                  Contains("PNG") && Contains("JPEG") && Contains("Radiance HDR") &&
+                                                  Contains("PFM"));
+  CHECK_THROWS_AS(read_image_metadata(gif), IoError);
 }

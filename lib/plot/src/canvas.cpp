@@ -1,17 +1,17 @@
-// Raster primitives with coverage-based anti-aliasing and OpenImageIO text and PNG output.
+// Raster primitives with coverage-based anti-aliasing, TrueType text (stb_truetype) and PNG files
+// (lensmith::imageio).
 #include "lensmith/plot/canvas.h"
-
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <system_error>
 
 #include "lensmith/core/errors.h"
-#include "lensmith/core/text_file.h"
 #include "lensmith/core/units.h"
+#include "lensmith/imageio/image_file.h"
+#include "truetype_font.h"
 
 namespace lensmith::plot {
 
@@ -86,64 +86,15 @@ std::vector<std::pair<Point2, Point2>> dashed_pieces(std::span<const Point2> poi
   return pieces;
 }
 
-// A UTF-8 string as pieces the FreeType path can draw (ASCII) and glyphs drawn by hand.
-struct TextPiece {
-  enum class Kind { Ascii, Micro, Degree, Lambda, PlusMinus } kind = Kind::Ascii;
-  std::string ascii;
-};
-
-std::vector<TextPiece> split_text(std::string_view s) {
-  std::vector<TextPiece> out;
-  auto ascii = [&](char c) {
-    if (out.empty() || out.back().kind != TextPiece::Kind::Ascii) out.push_back({TextPiece::Kind::Ascii, {}});
-    out.back().ascii += c;
-  };
-  for (std::size_t i = 0; i < s.size();) {
-    const auto c = static_cast<unsigned char>(s[i]);
-    if (c < 0x80) {
-      ascii(static_cast<char>(c));
-      ++i;
-      continue;
-    }
-    std::size_t len = c >= 0xF0 ? 4 : c >= 0xE0 ? 3 : c >= 0xC0 ? 2 : 1;
-    const std::string_view seq = s.substr(i, len);
-    if (seq == "\xC2\xB5" || seq == "\xCE\xBC") {
-      out.push_back({TextPiece::Kind::Micro, {}});
-    } else if (seq == "\xC2\xB0") {
-      out.push_back({TextPiece::Kind::Degree, {}});
-    } else if (seq == "\xCE\xBB") {
-      out.push_back({TextPiece::Kind::Lambda, {}});
-    } else if (seq == "\xE2\x88\x92") {
-      ascii('-');
-    } else if (seq == "\xC2\xB1") {
-      out.push_back({TextPiece::Kind::PlusMinus, {}});
-    } else {
-      ascii('?');
-    }
-    i += len;
-  }
-  return out;
+// Width of a run of code points: the advances, with kerning between neighbours.
+double run_width(const TrueTypeFont& font, std::u32string_view text, double size_px) {
+  double width = 0.0;
+  for (std::size_t i = 0; i < text.size(); ++i) width += font.advance_px(text[i], i + 1 < text.size() ? text[i + 1] : 0, size_px);
+  return width;
 }
 
-// Advance width of ASCII text: the box of text + "x" minus the box of "x", so spaces count.
-double ascii_advance(const std::string& text, int size, const std::string& font) {
-  if (text.empty()) return 0.0;
-  const OIIO::ROI with = OIIO::ImageBufAlgo::text_size(text + "x", size, font);
-  const OIIO::ROI x = OIIO::ImageBufAlgo::text_size("x", size, font);
-  if (!with.defined() || !x.defined()) return 0.0;
-  return static_cast<double>(with.xend - x.xend);
-}
-
-double piece_advance(const TextPiece& p, int size, const std::string& font) {
-  switch (p.kind) {
-    case TextPiece::Kind::Ascii: return ascii_advance(p.ascii, size, font);
-    case TextPiece::Kind::Micro: return ascii_advance("u", size, font);
-    case TextPiece::Kind::Degree: return 0.42 * size;
-    case TextPiece::Kind::Lambda: return ascii_advance("v", size, font);
-    case TextPiece::Kind::PlusMinus: return ascii_advance("+", size, font);
-  }
-  return 0.0;
-}
+// Labels are drawn at whole pixel sizes, as they were when FreeType (through OpenImageIO) drew them.
+int font_size(double size_px) { return std::max(1, static_cast<int>(std::lround(size_px))); }
 
 }  // namespace
 
@@ -257,81 +208,47 @@ void Canvas::rect(Point2 top_left, Point2 bottom_right, const LineStyle& style) 
   polyline(points, style);
 }
 
+void Canvas::set_font(std::optional<std::string> font_path) {
+  face_ = font_path ? TrueTypeFont::load(*font_path) : nullptr;
+  font_ = std::move(font_path);
+}
+
 double Canvas::text_width(std::string_view utf8, double size_px) const {
-  if (!font_) return 0.0;
-  const int size = std::max(1, static_cast<int>(std::lround(size_px)));
-  double w = 0.0;
-  for (const TextPiece& p : split_text(utf8)) w += piece_advance(p, size, *font_);
-  return w;
+  if (!face_) return 0.0;
+  return run_width(*face_, decode_utf8(utf8), font_size(size_px));
 }
 
 void Canvas::text(Point2 anchor, std::string_view utf8, double size_px, Rgb colour, HAlign h, VAlign v, bool vertical) {
-  if (!font_ || utf8.empty()) return;
-  const int size = std::max(1, static_cast<int>(std::lround(size_px)));
-  const std::vector<TextPiece> pieces = split_text(utf8);
-  double total = 0.0;
-  for (const TextPiece& p : pieces) total += piece_advance(p, size, *font_);
+  if (!face_ || utf8.empty()) return;
+  const int size = font_size(size_px);
+  const std::u32string codepoints = decode_utf8(utf8);
+  const double total = run_width(*face_, codepoints, size);
   // Ascent and descent of the font at this size, from tall and deep letters.
-  const OIIO::ROI box = OIIO::ImageBufAlgo::text_size("Ahgjy", size, *font_);
-  if (!box.defined()) return;
-  const int ascent = -box.ybegin + 1;
-  const int descent = box.yend + 1;
+  const InkBox box = face_->ink_box(U"Ahgjy", size);
+  const int ascent = -box.y0 + 1;
+  const int descent = box.y1 + 1;
   const int pad = 2;
   const int mask_width = static_cast<int>(std::ceil(total)) + 2 * pad + size / 2;
   const int mask_height = ascent + descent + 2 * pad;
   std::vector<float> mask(static_cast<std::size_t>(mask_width) * static_cast<std::size_t>(mask_height), 0.0f);
-  {
-    OIIO::ImageBuf buffer(OIIO::ImageSpec(mask_width, mask_height, 1, OIIO::TypeDesc::FLOAT), mask.data());
-    const float white[1] = {1.0f};
-    const int baseline = pad + ascent;
-    double x = pad;
-    auto stroke = [&](Point2 a, Point2 b, double width) {
-      Mask m(0, 0, mask_width - 1, mask_height - 1, mask_width, mask_height);
-      m.add_segment(a, b, width);
-      for (std::size_t i = 0; i < mask.size(); ++i) mask[i] = std::max(mask[i], m.values[i]);
-    };
-    for (const TextPiece& p : pieces) {
-      const double advance = piece_advance(p, size, *font_);
-      switch (p.kind) {
-        case TextPiece::Kind::Ascii:
-          OIIO::ImageBufAlgo::render_text(buffer, static_cast<int>(std::lround(x)), baseline, p.ascii, size, *font_, white);
-          break;
-        case TextPiece::Kind::Micro: {
-          // A 'u' with a descender on its left stem: the micro sign.
-          OIIO::ImageBufAlgo::render_text(buffer, static_cast<int>(std::lround(x)), baseline, "u", size, *font_, white);
-          const OIIO::ROI u = OIIO::ImageBufAlgo::text_size("u", size, *font_);
-          const double stem_x = std::round(x) + u.xbegin + 0.055 * size;
-          stroke({stem_x, baseline - 0.3 * size}, {stem_x, baseline + 0.21 * size}, 0.095 * size);
-          break;
-        }
-        case TextPiece::Kind::Degree: {
-          const double r = 0.11 * size;
-          const Point2 c{x + 0.2 * size, baseline - 0.62 * size};
-          for (int i = 0; i < 24; ++i) {
-            const double a0 = 2.0 * kPi * i / 24, a1 = 2.0 * kPi * (i + 1) / 24;
-            stroke({c.x + r * std::cos(a0), c.y + r * std::sin(a0)}, {c.x + r * std::cos(a1), c.y + r * std::sin(a1)}, 0.07 * size);
-          }
-          break;
-        }
-        case TextPiece::Kind::Lambda: {
-          // Two strokes: the long one from the top left to the bottom right, a short leg to the left.
-          const double top = baseline - 0.74 * size, w = advance;
-          stroke({x + 0.12 * w, top}, {x + 0.9 * w, static_cast<double>(baseline)}, 0.085 * size);
-          stroke({x + 0.52 * w, baseline - 0.42 * size}, {x + 0.1 * w, static_cast<double>(baseline)}, 0.085 * size);
-          break;
-        }
-        case TextPiece::Kind::PlusMinus: {
-          // A plus raised a little, with a bar under it.
-          const OIIO::ROI plus = OIIO::ImageBufAlgo::text_size("+", size, *font_);
-          OIIO::ImageBufAlgo::render_text(buffer, static_cast<int>(std::lround(x)), baseline - static_cast<int>(std::lround(0.1 * size)), "+",
-                                          size, *font_, white);
-          const double bar_y = baseline - 0.03 * size;
-          stroke({std::round(x) + plus.xbegin, bar_y}, {std::round(x) + plus.xend, bar_y}, 0.075 * size);
-          break;
-        }
+  const int baseline = pad + ascent;
+  double pen = pad;
+  for (std::size_t i = 0; i < codepoints.size(); ++i) {
+    const double whole = std::floor(pen);
+    const GlyphMask glyph = face_->render(codepoints[i], size, pen - whole);
+    for (int gy = 0; gy < glyph.height; ++gy) {
+      const int my = baseline + glyph.top + gy;
+      if (my < 0 || my >= mask_height) continue;
+      for (int gx = 0; gx < glyph.width; ++gx) {
+        const int mx = static_cast<int>(whole) + glyph.left + gx;
+        if (mx < 0 || mx >= mask_width) continue;
+        // Neighbouring glyphs that touch a pixel cover it together: coverage composited "over".
+        float& m = mask[static_cast<std::size_t>(my * mask_width + mx)];
+        const float g = glyph.coverage[static_cast<std::size_t>(gy * glyph.width + gx)];
+        m += g * (1.0f - m);
       }
-      x += advance;
     }
+    pen += face_->advance_px(codepoints[i], i + 1 < codepoints.size() ? codepoints[i + 1] : 0, size);
   }
   // Place the mask: offsets of the anchor inside the mask, then rotate for vertical text.
   double ax = pad;
@@ -356,34 +273,31 @@ void Canvas::text(Point2 anchor, std::string_view utf8, double size_px, Rgb colo
 }
 
 Canvas Canvas::read_image(const std::string& path) {
-  OIIO::ImageBuf buffer(path);
-  if (!buffer.read(0, 0, true, OIIO::TypeDesc::FLOAT)) throw IoError(path + ": cannot read the image: " + buffer.geterror());
-  const OIIO::ImageSpec& spec = buffer.spec();
-  if (spec.width < 1 || spec.height < 1 || spec.width > 16384 || spec.height > 16384 || spec.nchannels < 1) {
-    throw IoError(path + ": image of " + std::to_string(spec.width) + " x " + std::to_string(spec.height) + " pixels and " +
-                  std::to_string(spec.nchannels) + " channels: not a picture lensmith can read");
-  }
-  Canvas canvas(spec.width, spec.height);
-  std::vector<float> pixel(static_cast<std::size_t>(spec.nchannels));
-  for (int y = 0; y < spec.height; ++y) {
-    for (int x = 0; x < spec.width; ++x) {
-      buffer.getpixel(spec.x + x, spec.y + y, pixel.data(), spec.nchannels);
-      const std::size_t i = (static_cast<std::size_t>(y) * static_cast<std::size_t>(spec.width) + static_cast<std::size_t>(x)) * 3;
-      for (std::size_t c = 0; c < 3; ++c) canvas.pixels_[i + c] = pixel[std::min(c, pixel.size() - 1)];
+  RasterInfo info;
+  Raster raster;
+  try {
+    info = read_raster_info(path);
+    if (info.width > 16384 || info.height > 16384) {
+      throw IoError(path + ": image of " + std::to_string(info.width) + " x " + std::to_string(info.height) +
+                    " pixels: larger than a canvas (16384 x 16384)");
     }
+    const int first_three[3] = {0, 1, 2}, grey[3] = {0, 0, 0};
+    raster = read_raster(path, info, info.channels.size() >= 3 ? first_three : grey);
+  } catch (const ImageFileError& e) {
+    throw IoError(e.what());  // a deep or cropped picture: for a canvas, a file it cannot read
   }
+  Canvas canvas(info.width, info.height);
+  canvas.pixels_ = std::move(raster.samples);
   return canvas;
 }
 
 void Canvas::write_png(const std::string& path) const {
-  // The temporary name ends in .png so OpenImageIO picks the format.
-  write_atomically(path, ".png", [&](const std::string& temporary) {
-    // OIIO only reads the buffer; the const_cast is for its wrapping constructor's signature.
-    OIIO::ImageBuf buffer(OIIO::ImageSpec(width_, height_, 3, OIIO::TypeDesc::FLOAT), const_cast<float*>(pixels_.data()));
-    if (!buffer.write(temporary, OIIO::TypeDesc::UINT8, "png")) {
-      throw IoError(path + ": cannot write the PNG image: " + buffer.geterror());
-    }
-  });
+  // Canvas values are display values: stored as 8-bit codes, rounded.
+  std::vector<std::uint8_t> codes(pixels_.size());
+  for (std::size_t i = 0; i < codes.size(); ++i) {
+    codes[i] = static_cast<std::uint8_t>(std::lround(std::clamp(static_cast<double>(pixels_[i]), 0.0, 1.0) * 255.0));
+  }
+  lensmith::write_png(path, PixelsView<std::uint8_t>{width_, height_, 3, codes}, {});
 }
 
 }  // namespace lensmith::plot

@@ -1,23 +1,18 @@
-// Image and depth input/output for the bokeh renderer through OpenImageIO; the sRGB curve of
-// IEC 61966-2-1:1999 (5.2 encoding, 5.3 decoding) and the temporary-file-and-rename write of core.
+// Image and depth input/output for the bokeh renderer on top of lensmith::imageio's file codecs; the
+// sRGB curve of IEC 61966-2-1:1999 (5.2 encoding, 5.3 decoding).
 #include "lensmith/render/image_io.h"
-
-#include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <array>
 #include <cctype>
-#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <memory>
-#include <sstream>
 #include <system_error>
 
 #include "lensmith/core/number_parsing.h"
-#include "lensmith/core/text_file.h"
 #include "lensmith/core/units.h"
+#include "lensmith/imageio/image_file.h"
 
 namespace lensmith {
 
@@ -42,53 +37,6 @@ std::string join(const std::vector<std::string>& items) {
 
 std::string pixel_text(int x, int y) { return "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ")"; }
 
-// The first subimage of a picture, opened for reading; IoError with OpenImageIO's message otherwise.
-std::unique_ptr<OIIO::ImageInput> open_input(const fs::path& path) {
-  auto input = OIIO::ImageInput::open(path.string());
-  if (!input) throw IoError(path.string() + ": cannot read the image: " + OIIO::geterror());
-  const OIIO::ImageSpec& spec = input->spec();
-  if (spec.deep) throw ImageFileError(path.string() + ": a deep image; lensmith reads flat images only");
-  if (spec.width < 1 || spec.height < 1 || spec.depth != 1 || spec.nchannels < 1) {
-    throw ImageFileError(path.string() + ": image of " + std::to_string(spec.width) + " x " + std::to_string(spec.height) +
-                         " x " + std::to_string(spec.depth) + " pixels and " + std::to_string(spec.nchannels) +
-                         " channels: not a 2-D picture");
-  }
-  // A crop or overscan would shift the picture against the pinhole frame, centred on the pixels read.
-  if (spec.full_width > 0 && spec.full_height > 0 &&
-      (spec.x != spec.full_x || spec.y != spec.full_y || spec.width != spec.full_width || spec.height != spec.full_height)) {
-    throw ImageFileError(path.string() + ": data window " + std::to_string(spec.width) + " x " + std::to_string(spec.height) +
-                         " at (" + std::to_string(spec.x) + ", " + std::to_string(spec.y) + ") differs from the display window " +
-                         std::to_string(spec.full_width) + " x " + std::to_string(spec.full_height) + " at (" +
-                         std::to_string(spec.full_x) + ", " + std::to_string(spec.full_y) +
-                         "): render or save the image without a crop or overscan");
-  }
-  return input;
-}
-
-// Channels [first, first + count) of every pixel as float (integers normalised to [0, 1]).
-std::vector<float> read_channels(OIIO::ImageInput& input, const fs::path& path, int first, int count) {
-  const OIIO::ImageSpec& spec = input.spec();
-  std::vector<float> values(static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height) *
-                            static_cast<std::size_t>(count));
-  if (!input.read_image(0, 0, first, first + count, OIIO::TypeDesc::FLOAT, values.data())) {
-    throw IoError(path.string() + ": cannot read the pixels: " + input.geterror());
-  }
-  return values;
-}
-
-int channel_index(const OIIO::ImageSpec& spec, const std::string& name) {
-  for (int c = 0; c < spec.nchannels; ++c) {
-    if (spec.channel_name(c) == name) return c;
-  }
-  return -1;
-}
-
-std::vector<std::string> channel_names(const OIIO::ImageSpec& spec) {
-  std::vector<std::string> names;
-  for (int c = 0; c < spec.nchannels; ++c) names.emplace_back(spec.channel_name(c));
-  return names;
-}
-
 double smoothstep(double u) { return u * u * (3.0 - 2.0 * u); }
 
 // The highlight factor of RadianceReadOptions for the largest encoded channel of a pixel.
@@ -111,6 +59,8 @@ double metres_from(double value, DepthUnit unit) {
 // The output formats by lower-case extension.
 enum class OutputFormat { Exr, Hdr, Png, Jpeg, Tiff };
 constexpr const char* kSupportedOutputs = ".exr, .hdr, .png, .jpg, .jpeg, .tif, .tiff";
+// Quality of JPEG output (libjpeg's 1-100 scale): high enough that a flat colour moves by a code value or two.
+constexpr int kJpegQuality = 95;
 
 OutputFormat output_format(const fs::path& path) {
   const std::string ext = lower(path.extension().string());
@@ -121,26 +71,6 @@ OutputFormat output_format(const fs::path& path) {
   if (ext == ".tif" || ext == ".tiff") return OutputFormat::Tiff;
   throw OptionsError(path.string() + ": unknown image extension '" + path.extension().string() +
                      "': supported are " + kSupportedOutputs);
-}
-
-// Opens, writes and closes one image through OpenImageIO; `pixels` holds spec.format values.
-void write_with_oiio(const fs::path& path, const std::string& temporary, const OIIO::ImageSpec& spec, const void* pixels) {
-  auto output = OIIO::ImageOutput::create(temporary);
-  if (!output) throw IoError(path.string() + ": no image writer for this format: " + OIIO::geterror());
-  if (!output->open(temporary, spec)) throw IoError(path.string() + ": cannot create the image: " + output->geterror());
-  if (!output->write_image(spec.format, pixels)) {
-    const std::string message = output->geterror();
-    output->close();
-    throw IoError(path.string() + ": cannot write the pixels: " + message);
-  }
-  if (!output->close()) throw IoError(path.string() + ": cannot finish the image: " + output->geterror());
-}
-
-// Writes through a temporary file in the same folder whose name ends in the real extension, so
-// OpenImageIO picks the format from it (as lensmith::plot's PNG output does).
-void write_image_atomically(const fs::path& path, const OIIO::ImageSpec& spec, const void* pixels) {
-  write_atomically(path.string(), lower(path.extension().string()),
-                   [&](const std::string& temporary) { write_with_oiio(path, temporary, spec, pixels); });
 }
 
 void check_no_nan(const fs::path& path, const Image& image) {
@@ -154,12 +84,6 @@ void check_no_nan(const fs::path& path, const Image& image) {
       }
     }
   }
-}
-
-std::string shortest_float(float value) {
-  std::array<char, 32> buffer{};
-  const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
-  return std::string(buffer.data(), result.ptr);
 }
 
 }  // namespace
@@ -198,41 +122,35 @@ std::string RadianceReadOptions::to_string() const {
 
 Image read_radiance_image(const fs::path& path, const RadianceReadOptions& options) {
   options.validate();
-  auto input = open_input(path);
-  const OIIO::ImageSpec& spec = input->spec();
+  const RasterInfo info = read_raster_info(path);
 
   std::array<int, 3> source{0, 0, 0};
-  const std::array<int, 3> named{channel_index(spec, "R"), channel_index(spec, "G"), channel_index(spec, "B")};
+  const std::array<int, 3> named{info.channel_index("R"), info.channel_index("G"), info.channel_index("B")};
   if (named[0] >= 0 && named[1] >= 0 && named[2] >= 0) {
     source = named;
-  } else if (spec.nchannels >= 3) {
+  } else if (info.channels.size() >= 3) {
     source = {0, 1, 2};
   }  // else gray (+ alpha): channel 0 three times
-  const int last = *std::max_element(source.begin(), source.end());
-  const std::vector<float> values = read_channels(*input, path, 0, last + 1);
-  const std::size_t stride = static_cast<std::size_t>(last) + 1;
+  const Raster values = read_raster(path, info, source);
 
-  const bool file_says_linear = lower(spec.get_string_attribute("oiio:ColorSpace")) == "linear";
   std::array<bool, 3> is_float{};
   std::array<bool, 3> decode{};
   for (std::size_t c = 0; c < 3; ++c) {
-    is_float[c] = spec.channelformat(source[c]).is_floating_point();
-    decode[c] = !is_float[c] && !file_says_linear;
+    is_float[c] = is_floating_point(info.channels[static_cast<std::size_t>(source[c])].type);
+    decode[c] = !is_float[c] && !info.integers_are_linear;
   }
   const bool any_integer = !is_float[0] || !is_float[1] || !is_float[2];
 
-  Image image(spec.width, spec.height, 3);
-  for (int y = 0; y < spec.height; ++y) {
-    for (int x = 0; x < spec.width; ++x) {
-      const std::size_t pixel = static_cast<std::size_t>(y) * static_cast<std::size_t>(spec.width) + static_cast<std::size_t>(x);
-      const std::size_t base = pixel * stride;
+  Image image(info.width, info.height, 3);
+  for (int y = 0; y < info.height; ++y) {
+    for (int x = 0; x < info.width; ++x) {
       double max_encoded = 0.0;
       for (std::size_t c = 0; c < 3; ++c) {
-        const float v = values[base + static_cast<std::size_t>(source[c])];
+        const float v = values.at(x, y, static_cast<int>(c));
         if (is_float[c]) {
           if (!(std::isfinite(v) && v >= 0.0f)) {
             throw ImageFileError(path.string() + ": " + pixel_text(x, y) + " channel " +
-                                 std::string(spec.channel_name(source[c])) + " = " + format_number(v) +
+                                 info.channels[static_cast<std::size_t>(source[c])].name + " = " + format_number(v) +
                                  ": a float image is read as linear radiance, which must be finite and >= 0; "
                                  "repair or clamp the file");
           }
@@ -333,43 +251,43 @@ std::string DepthReadOptions::to_string() const {
 
 DepthMap read_depth(const DepthSource& source, const DepthReadOptions& options, const PinholeFrame& frame) {
   const fs::path& path = source.file;
-  auto input = open_input(path);
-  const OIIO::ImageSpec& spec = input->spec();
+  const RasterInfo info = read_raster_info(path);
 
   int channel = -1;
   if (!source.channel.empty()) {
-    channel = channel_index(spec, source.channel);
+    channel = info.channel_index(source.channel);
     if (channel < 0) {
-      throw ImageFileError(path.string() + ": no channel '" + source.channel + "'; the file has " + join(channel_names(spec)));
+      throw ImageFileError(path.string() + ": no channel '" + source.channel + "'; the file has " + join(info.channel_names()));
     }
   } else {
-    channel = channel_index(spec, "Z");
-    if (channel < 0) channel = channel_index(spec, "depth.Z");
+    channel = info.channel_index("Z");
+    if (channel < 0) channel = info.channel_index("depth.Z");
     if (channel < 0) channel = 0;
   }
-  const std::string where = path.string() + " channel " + std::string(spec.channel_name(channel));
-  const OIIO::TypeDesc format = spec.channelformat(channel);
-  if (!format.is_floating_point()) {
-    throw ImageFileError(where + " is stored as " + std::string(format.c_str()) +
+  const RasterChannel& stored = info.channels[static_cast<std::size_t>(channel)];
+  const std::string where = path.string() + " channel " + stored.name;
+  if (!is_floating_point(stored.type)) {
+    throw ImageFileError(where + " is stored as " + to_string(stored.type) +
                          " integers, which image readers scale to [0, 1] and which carry no metric depth: "
                          "store depth as float (EXR, float TIFF or PFM)");
   }
-  if (spec.width != frame.width_px() || spec.height != frame.height_px()) {
-    throw ImageFileError(path.string() + ": depth map of " + std::to_string(spec.width) + " x " + std::to_string(spec.height) +
+  if (info.width != frame.width_px() || info.height != frame.height_px()) {
+    throw ImageFileError(path.string() + ": depth map of " + std::to_string(info.width) + " x " + std::to_string(info.height) +
                          " pixels, but the picture is " + std::to_string(frame.width_px()) + " x " +
                          std::to_string(frame.height_px()) + ": the depth map must have the picture's size");
   }
-  const std::vector<float> values = read_channels(*input, path, channel, 1);
+  const int channels[1] = {channel};
+  const std::vector<float> values = read_raster(path, info, channels).samples;
 
   constexpr float kFar = std::numeric_limits<float>::infinity();
-  DepthMap depth(spec.width, spec.height, kFar);
+  DepthMap depth(info.width, info.height, kFar);
   std::vector<bool> invalid(values.size(), false);
   std::size_t invalid_count = 0;
   std::size_t first_invalid = 0;
   float nearest_m = kFar;
-  for (int y = 0; y < spec.height; ++y) {
-    for (int x = 0; x < spec.width; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(spec.width) + static_cast<std::size_t>(x);
+  for (int y = 0; y < info.height; ++y) {
+    for (int x = 0; x < info.width; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(info.width) + static_cast<std::size_t>(x);
       const double v = values[i];
       double z_m = std::numeric_limits<double>::quiet_NaN();
       switch (options.kind) {
@@ -404,8 +322,8 @@ DepthMap read_depth(const DepthSource& source, const DepthReadOptions& options, 
   }
   if (invalid_count == 0) return depth;
 
-  const int bad_x = static_cast<int>(first_invalid % static_cast<std::size_t>(spec.width));
-  const int bad_y = static_cast<int>(first_invalid / static_cast<std::size_t>(spec.width));
+  const int bad_x = static_cast<int>(first_invalid % static_cast<std::size_t>(info.width));
+  const int bad_y = static_cast<int>(first_invalid / static_cast<std::size_t>(info.width));
   const std::string bad = where + ": " + pixel_text(bad_x, bad_y) + " = " + format_number(values[first_invalid]) +
                           (invalid_count > 1 ? " (and " + std::to_string(invalid_count - 1) + " more invalid pixels)" : "");
   const std::string expected = options.kind == DepthKind::Inverse
@@ -448,53 +366,43 @@ void write_output_image(const fs::path& path, const Image& linear_rgb, const Out
   }
   check_no_nan(path, linear_rgb);
 
-  OIIO::TypeDesc pixel_type = OIIO::TypeDesc::FLOAT;
-  if (format == OutputFormat::Png || format == OutputFormat::Jpeg) pixel_type = OIIO::TypeDesc::UINT8;
-  if (format == OutputFormat::Tiff) pixel_type = OIIO::TypeDesc::UINT16;
-  OIIO::ImageSpec spec(linear_rgb.width, linear_rgb.height, 3, pixel_type);
-  const std::string software = meta.lensmith_version.empty() ? "lensmith" : "lensmith " + meta.lensmith_version;
-  spec.attribute("Software", software);
-  spec.attribute("ImageDescription", "lensmith render: " + meta.to_string());
-  if (!meta.lens.empty()) spec.attribute("lensmith:lens", meta.lens);
-  if (!meta.model.empty()) spec.attribute("lensmith:model", meta.model);
-  if (!meta.lensmith_version.empty()) spec.attribute("lensmith:version", meta.lensmith_version);
-  if (meta.f_number > 0.0) spec.attribute("lensmith:f_number", OIIO::TypeDesc::DOUBLE, &meta.f_number);
-  if (meta.focus_m > 0.0) spec.attribute("lensmith:focus_m", OIIO::TypeDesc::DOUBLE, &meta.focus_m);
-  for (const auto& [key, value] : meta.extra) spec.attribute("lensmith:" + key, value);
+  std::vector<ImageAttribute> attributes{
+      {"Software", meta.lensmith_version.empty() ? "lensmith" : "lensmith " + meta.lensmith_version},
+      {"ImageDescription", "lensmith render: " + meta.to_string()}};
+  if (!meta.lens.empty()) attributes.push_back({"lensmith:lens", meta.lens});
+  if (!meta.model.empty()) attributes.push_back({"lensmith:model", meta.model});
+  if (!meta.lensmith_version.empty()) attributes.push_back({"lensmith:version", meta.lensmith_version});
+  if (meta.f_number > 0.0) attributes.push_back({"lensmith:f_number", meta.f_number});
+  if (meta.focus_m > 0.0) attributes.push_back({"lensmith:focus_m", meta.focus_m});
+  for (const auto& [key, value] : meta.extra) attributes.push_back({"lensmith:" + key, value});
 
-  switch (format) {
-    case OutputFormat::Exr:
-      spec.attribute("compression", "zip");
-      break;
-    case OutputFormat::Jpeg:
-      spec.attribute("Compression", "jpeg:95");
-      break;
-    case OutputFormat::Tiff:
-      spec.attribute("compression", "zip");
-      break;
-    case OutputFormat::Hdr:
-    case OutputFormat::Png:
-      break;
-  }
-
-  if (pixel_type == OIIO::TypeDesc::FLOAT) {
-    write_image_atomically(path, spec, linear_rgb.data.data());
+  const PixelsView<float> linear{linear_rgb.width, linear_rgb.height, 3, linear_rgb.data};
+  if (format == OutputFormat::Exr) {
+    write_exr(path, linear, {"R", "G", "B"}, attributes);
     return;
   }
-  spec.attribute("oiio:ColorSpace", "sRGB");
-  const auto quantise = [&](float linear, double full_scale) {
+  if (format == OutputFormat::Hdr) {
+    write_hdr(path, linear, attributes);
+    return;
+  }
+  const auto quantise = [&](float value, double full_scale) {
     // NaN was refused above; +inf clamps to full scale like any highlight.
-    const double encoded = std::clamp(static_cast<double>(srgb_encode(linear)), 0.0, 1.0);
+    const double encoded = std::clamp(static_cast<double>(srgb_encode(value)), 0.0, 1.0);
     return std::lround(encoded * full_scale);
   };
-  if (pixel_type == OIIO::TypeDesc::UINT8) {
-    std::vector<std::uint8_t> pixels(linear_rgb.data.size());
-    for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] = static_cast<std::uint8_t>(quantise(linear_rgb.data[i], 255.0));
-    write_image_atomically(path, spec, pixels.data());
+  if (format == OutputFormat::Tiff) {
+    std::vector<std::uint16_t> codes(linear_rgb.data.size());
+    for (std::size_t i = 0; i < codes.size(); ++i) codes[i] = static_cast<std::uint16_t>(quantise(linear_rgb.data[i], 65535.0));
+    write_tiff(path, PixelsView<std::uint16_t>{linear_rgb.width, linear_rgb.height, 3, codes}, attributes);
+    return;
+  }
+  std::vector<std::uint8_t> codes(linear_rgb.data.size());
+  for (std::size_t i = 0; i < codes.size(); ++i) codes[i] = static_cast<std::uint8_t>(quantise(linear_rgb.data[i], 255.0));
+  const PixelsView<std::uint8_t> encoded{linear_rgb.width, linear_rgb.height, 3, codes};
+  if (format == OutputFormat::Png) {
+    write_png(path, encoded, attributes);
   } else {
-    std::vector<std::uint16_t> pixels(linear_rgb.data.size());
-    for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] = static_cast<std::uint16_t>(quantise(linear_rgb.data[i], 65535.0));
-    write_image_atomically(path, spec, pixels.data());
+    write_jpeg(path, encoded, kJpegQuality, attributes);
   }
 }
 
@@ -505,33 +413,12 @@ void write_float_exr(const fs::path& path, const Image& image, const std::vector
   if (image.channels < 1 || static_cast<std::size_t>(image.channels) != channel_names.size()) {
     throw OptionsError(path.string() + ": " + std::to_string(channel_names.size()) + " channel names for " + image.to_string());
   }
-  OIIO::ImageSpec spec(image.width, image.height, image.channels, OIIO::TypeDesc::FLOAT);
-  spec.channelnames = channel_names;
-  spec.alpha_channel = -1;
-  spec.z_channel = -1;
-  spec.attribute("compression", "zip");
-  spec.attribute("Software", "lensmith");
-  write_image_atomically(path, spec, image.data.data());
+  write_exr(path, PixelsView<float>{image.width, image.height, image.channels, image.data}, channel_names,
+            {{"Software", "lensmith"}});
 }
 
 std::vector<std::pair<std::string, std::string>> read_image_metadata(const fs::path& path) {
-  auto input = OIIO::ImageInput::open(path.string());
-  if (!input) throw IoError(path.string() + ": cannot read the image: " + OIIO::geterror());
-  std::vector<std::pair<std::string, std::string>> metadata;
-  for (const OIIO::ParamValue& p : input->spec().extra_attribs) {
-    std::string value;
-    if (p.type() == OIIO::TypeString) {
-      value = p.get_string();
-    } else if (p.type() == OIIO::TypeDesc::DOUBLE) {
-      value = format_number(p.get<double>());
-    } else if (p.type() == OIIO::TypeFloat) {
-      value = shortest_float(p.get<float>());
-    } else {
-      value = OIIO::ImageSpec::metadata_val(p);
-    }
-    metadata.emplace_back(p.name().string(), value);
-  }
-  return metadata;
+  return read_image_metadata_pairs(path);
 }
 
 void ensure_not_an_input(const fs::path& output, const std::vector<fs::path>& inputs) {

@@ -1,5 +1,5 @@
 // libFuzzer target: the analytic-scene reader (lensmith-scene JSON). Inputs that name an image
-// texture are skipped: those read a file from disk, which is OpenImageIO's business, not the parser's.
+// texture are skipped: those read a file from disk, which is lensmith::imageio's business, not the parser's.
 #include <cstdint>
 #include <string_view>
 

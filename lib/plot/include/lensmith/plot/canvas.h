@@ -1,10 +1,11 @@
 // A small raster canvas for analysis plots: an RGB float image with anti-aliased thick lines
 // (coverage from the distance to each segment, so joints are not drawn twice), filled discs and
-// rectangles, and text through OpenImageIO's FreeType renderer (ImageBufAlgo::render_text). Pixel
+// rectangles, and anti-aliased TrueType text (stb_truetype, the font's own outlines). Pixel
 // coordinates: origin at the top-left corner, x to the right, y down; pixel (i, j) covers
 // [i, i + 1) x [j, j + 1). Written to PNG atomically (a temporary file in the same folder, renamed).
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -12,6 +13,8 @@
 #include <vector>
 
 namespace lensmith::plot {
+
+class TrueTypeFont;
 
 struct Rgb {
   float r = 0.0f;
@@ -47,8 +50,10 @@ class Canvas {
   int height() const { return height_; }
   Rgb pixel(int x, int y) const;  // for tests; x, y inside the canvas
 
-  // Font for text: a TrueType file. Empty: text calls draw nothing (pictures without labels).
-  void set_font(std::optional<std::string> font_path) { font_ = std::move(font_path); }
+  // Font for text: a TrueType (or OpenType) file, read here. Empty: text calls draw nothing (pictures
+  // without labels). Throws IoError naming the file when it cannot be read or is not such a font.
+  // The rasteriser (stb_truetype) trusts the font's tables: give it installed fonts, not untrusted files.
+  void set_font(std::optional<std::string> font_path);
   const std::optional<std::string>& font() const { return font_; }
   bool has_font() const { return font_.has_value(); }
   // DejaVu Sans from the usual system folders (Debian fonts-dejavu-core), or empty when not found.
@@ -62,9 +67,10 @@ class Canvas {
   void fill_rect(Point2 top_left, Point2 bottom_right, Rgb colour);
   void rect(Point2 top_left, Point2 bottom_right, const LineStyle& style);
 
-  // UTF-8 text; letters outside ASCII are drawn for the few a plot needs (micro, degree, plus-minus,
-  // minus sign, lambda) and replaced by '?' otherwise. `vertical`: rotated to read bottom to top,
-  // centred on `anchor` along its length. No-op without a font.
+  // UTF-8 text at size_px (the em height, rounded to whole pixels), kerned; any letter the font
+  // has is drawn (DejaVu Sans has micro, degree, plus-minus, the minus sign and lambda), others as
+  // '?'. `vertical`: rotated to read bottom to top, centred on `anchor` along its length. No-op
+  // without a font.
   void text(Point2 anchor, std::string_view utf8, double size_px, Rgb colour, HAlign h = HAlign::Left,
             VAlign v = VAlign::Baseline, bool vertical = false);
   // Width of `utf8` drawn at `size_px`, pixels (0 without a font).
@@ -73,8 +79,9 @@ class Canvas {
   // Writes an 8-bit sRGB-encoded PNG through a temporary file in the same folder and a rename.
   // Throws IoError naming the path.
   void write_png(const std::string& path) const;
-  // Reads an image file (any format OpenImageIO reads) as a canvas: the first three channels, a
-  // grey image repeated. For tests and reference pictures. Throws IoError naming the path.
+  // Reads an image file (any format lensmith::imageio reads: kReadableImageFormats) as a canvas:
+  // the first three channels, or the first one repeated for gray (+ alpha); integers by their full
+  // scale, no colour conversion. For tests and reference pictures. Throws IoError naming the path.
   static Canvas read_image(const std::string& path);
 
  private:
@@ -87,6 +94,7 @@ class Canvas {
   int height_ = 0;
   std::vector<float> pixels_;  // RGB, row-major, linear values in [0, 1] treated as display values
   std::optional<std::string> font_;
+  std::shared_ptr<const TrueTypeFont> face_;  // font_ parsed; shared by copies of the canvas
 };
 
 }  // namespace lensmith::plot

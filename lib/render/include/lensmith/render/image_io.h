@@ -1,5 +1,6 @@
 // Reading the renderer's inputs (an all-in-focus picture and its depth map) and writing its output,
-// through OpenImageIO. The sRGB transfer curve is the piecewise one of IEC 61966-2-1:1999, 5.2/5.3.
+// through lensmith::imageio (OpenEXR, libtiff, libpng, stb_image). The sRGB transfer curve is the
+// piecewise one of IEC 61966-2-1:1999, 5.2/5.3.
 // Pixel layout and units are those of image.h: linear float, row-major, top row first; depth in metres.
 #pragma once
 
@@ -11,17 +12,13 @@
 
 #include "lensmith/camera/pinhole_frame.h"
 #include "lensmith/core/errors.h"
+#include "lensmith/imageio/raster.h"
 #include "lensmith/render/image.h"
 
 namespace lensmith {
 
-// An image or depth file was read but its contents are not what lensmith can use (a NaN pixel,
-// a missing channel, integer depth, a size that does not match): the message names the file, the
-// pixel and value where there is one, and what to do. Files that cannot be opened at all are IoError.
-class ImageFileError : public Error {
- public:
-  using Error::Error;
-};
+// ImageFileError (a file read but not usable: a NaN pixel, a missing channel, integer depth, a size
+// that does not match, a deep or cropped image) is declared in lensmith/imageio/raster.h.
 
 // sRGB-encoded value in [0, 1] from linear light (IEC 61966-2-1: 12.92 l below l = 0.0031308, else
 // 1.055 l^(1/2.4) - 0.055). Not clamped: values outside [0, 1] follow the same formulas (negative
@@ -47,16 +44,21 @@ struct RadianceReadOptions {
   friend std::ostream& operator<<(std::ostream& os, const RadianceReadOptions& o) { return os << o.to_string(); }
 };
 
-// Reads any picture OpenImageIO reads (first subimage) as linear Rec.709 RGB, 3 channels.
+// Reads a picture as linear Rec.709 RGB, 3 channels: OpenEXR (scanline or tiled, the first part),
+// TIFF (the first page), PNG, JPEG, Radiance HDR, PFM, BMP, TGA or binary PNM, recognised by the
+// file's first bytes (kReadableImageFormats in lensmith/imageio/image_file.h).
 // - Float/half channels (EXR, HDR, float TIFF, PFM) are linear radiance as stored; a NaN, infinite
 //   or negative value is an ImageFileError naming the first such pixel, channel and value.
 // - 8/16-bit integer channels are sRGB-encoded and decoded by srgb_decode, unless the file says it
-//   is linear (OpenImageIO's "oiio:ColorSpace" = "Linear"), then taken as stored in [0, 1].
+//   is linear, then taken as stored in [0, 1]: an OpenEXR's integer channels (OpenEXR pixels are
+//   linear), or a PNG with a gAMA chunk of 1.0 and no sRGB chunk. Nothing else is consulted: TIFF,
+//   JPEG and the other formats are taken as sRGB, and no ICC profile is applied.
 // - Channels R, G, B by name when all three exist, else the first three; a 1- or 2-channel
 //   (gray, gray + alpha) picture is replicated to R = G = B. Alpha is ignored: premultiplied
 //   colours are taken as they are.
-// - The data window must be the display window (no crop or overscan).
-// Throws IoError (with OpenImageIO's message) when the file cannot be opened or read,
+// - The data window must be the display window (no crop or overscan); a deep OpenEXR is refused.
+// Throws IoError (with the decoder's message) when the file cannot be opened or read or is of
+// another format (the message lists the formats read), ImageFileError for the refusals above,
 // OptionsError for invalid options.
 Image read_radiance_image(const std::filesystem::path& path, const RadianceReadOptions& options = {});
 
@@ -110,6 +112,7 @@ struct DepthReadOptions {
 // (x, y) of the map belonging to pixel (x, y) of `frame`; Distance is converted with the frame's
 // tangents at pixel centres (x + 0.5, y + 0.5).
 // The channel is source.channel, or by default "Z", then "depth.Z", then the first channel.
+// Reads the formats read_radiance_image reads (float channels: OpenEXR, float TIFF, PFM, HDR).
 // Throws IoError when the file cannot be read, and ImageFileError when the channel is missing
 // (listing the file's channels), stored as integers (normalised integers carry no metric depth:
 // store float EXR, float TIFF or PFM), of another size than the frame, or holds an invalid depth
@@ -132,12 +135,16 @@ struct OutputMetadata {
 // Writes a linear RGB image (3 channels, else OptionsError; a NaN is a ComputationError naming the
 // pixel, since whatever made the image failed), the format chosen by the extension (any case):
 //   .exr             32-bit float RGB, ZIP compression, linear as given;
-//   .hdr             Radiance RGBE float, linear as given;
-//   .png .jpg .jpeg  8-bit sRGB (srgb_encode, clamped to [0, 1], rounded; JPEG quality 95);
-//   .tif .tiff       16-bit sRGB, the same way.
-// Every format gets "Software" = "lensmith <version>" and an ImageDescription from meta; EXR (and
-// any format that keeps free attributes) also "lensmith:lens", "lensmith:f_number",
-// "lensmith:focus_m", "lensmith:model", "lensmith:version" and "lensmith:<key>" for meta.extra.
+//   .hdr             Radiance RGBE float (run-length encoded), linear as given;
+//   .png .jpg .jpeg  8-bit sRGB (srgb_encode, clamped to [0, 1], rounded; PNG with an sRGB chunk,
+//                    JPEG quality 95 without chroma subsampling);
+//   .tif .tiff       16-bit sRGB, the same way (deflate compression).
+// Every format gets "Software" = "lensmith <version>" and an ImageDescription from meta (EXR:
+// string attributes, the description as the standard "comments"; PNG: text chunks; TIFF: its tags;
+// JPEG: Exif tags and the description as the JPEG comment; HDR: header lines, Software as SOFTWARE).
+// The formats that keep free attributes (EXR, PNG, HDR) also get "lensmith:lens",
+// "lensmith:f_number", "lensmith:focus_m" (EXR: doubles), "lensmith:model", "lensmith:version" and
+// "lensmith:<key>" for meta.extra.
 // The file is written to a temporary file beside `path` and renamed onto it, so a failure never
 // leaves a half-written picture. Throws OptionsError for another extension (listing the supported
 // ones) and IoError when writing fails.
@@ -149,8 +156,10 @@ void write_output_image(const std::filesystem::path& path, const Image& linear_r
 // match the channels, IoError when writing fails.
 void write_float_exr(const std::filesystem::path& path, const Image& image, const std::vector<std::string>& channel_names);
 
-// The metadata of an image file as (name, value) text pairs, in the order OpenImageIO lists them:
-// string attributes as stored, numbers in the shortest text that reads back exactly. Throws IoError.
+// The metadata of an image file as (name, value) text pairs, under OpenImageIO's names, in the
+// file's order (read_image_metadata_pairs in lensmith/imageio/image_file.h lists what each format
+// gives): string attributes as stored, numbers in the shortest text that reads back exactly.
+// Throws IoError.
 std::vector<std::pair<std::string, std::string>> read_image_metadata(const std::filesystem::path& path);
 
 // Throws OptionsError when `output` names the same file as one of `inputs` (the same file on disk

@@ -1,0 +1,92 @@
+// Reading and writing picture files without a general imaging library: OpenEXR for EXR, libtiff for
+// TIFF, libpng for PNG output and PNG text chunks, stb_image for decoding PNG, JPEG, Radiance HDR,
+// TGA, BMP and PNM, stb_image_write for JPEG and HDR output, and a reader of its own for PFM.
+// The format of an input is found from its first bytes; writers write through a temporary file in
+// the same folder that is renamed onto the target (core's write_atomically).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "lensmith/imageio/raster.h"
+
+namespace lensmith {
+
+// The formats read_raster_info recognises, for messages.
+inline constexpr const char* kReadableImageFormats =
+    "OpenEXR (scanline or tiled, flat), TIFF, PNG, JPEG, Radiance HDR, PFM, BMP, TGA and binary PNM (P5/P6)";
+
+// The format of a picture file from its first bytes. Throws IoError naming the file when it cannot
+// be opened or is none of kReadableImageFormats (the message lists them).
+ImageFormat detect_image_format(const std::filesystem::path& path);
+
+// The header of a picture file (the first part of a multi-part OpenEXR, the first page of a TIFF).
+// Throws IoError when the file cannot be opened or decoded, ImageFileError when it is a deep
+// OpenEXR image ("a deep image; lensmith reads flat images only"), its data window differs from
+// its display window (a crop or overscan would shift the picture against the pixels read) or its
+// samples are laid out in a way lensmith does not read (subsampled OpenEXR channels, a TIFF of
+// signed 16/32-bit or 64-bit samples).
+RasterInfo read_raster_info(const std::filesystem::path& path);
+
+// Decodes the channels of `info` (as read_raster_info gave it for `path`) listed in `channels`
+// (indices into info.channels, in the order wanted; repeats allowed). Integers are normalised to
+// [0, 1] by their full scale and otherwise left as stored (no colour conversion). Throws IoError
+// when decoding fails, OptionsError for an index out of range.
+Raster read_raster(const std::filesystem::path& path, const RasterInfo& info, std::span<const int> channels);
+
+// The metadata of a picture file as (name, value) text, under the names OpenImageIO used:
+// OpenEXR attributes (comments as ImageDescription, capDate as DateTime, owner as Copyright, the
+// compression as "compression"; strings as stored, floats and doubles in the shortest text that
+// reads back exactly), PNG text chunks (Description as ImageDescription), TIFF's Software,
+// ImageDescription, DateTime, Artist, Copyright and DocumentName tags and its compression, a
+// JPEG's Exif ImageDescription, Software, DateTime, Artist and Copyright (its comment as the
+// ImageDescription when Exif has none), and the NAME=value header lines of a Radiance HDR file
+// (SOFTWARE as Software). PFM, BMP, TGA and PNM have none. Throws IoError.
+std::vector<std::pair<std::string, std::string>> read_image_metadata_pairs(const std::filesystem::path& path);
+
+// One item of metadata to write: text, or a number that formats with typed attributes (OpenEXR)
+// keep as a double and others write as its shortest exact text.
+struct ImageAttribute {
+  std::string name;  // "Software", "ImageDescription", "lensmith:lens", ...
+  std::variant<std::string, double> value;
+};
+
+// Interleaved samples of `channels` channels, row-major, top row first.
+template <typename Sample>
+struct PixelsView {
+  int width = 0;
+  int height = 0;
+  int channels = 0;
+  std::span<const Sample> samples;  // width * height * channels values
+};
+
+// Writers. Each takes the final path, writes atomically, and throws IoError naming `path` when the
+// file cannot be written, OptionsError when the view's sizes do not match its samples.
+// OpenEXR, 32-bit float, ZIP compression, one channel per name; every attribute (ImageDescription
+// stored as the standard "comments", DateTime as "capDate").
+void write_exr(const std::filesystem::path& path, const PixelsView<float>& pixels, const std::vector<std::string>& channel_names,
+               const std::vector<ImageAttribute>& attributes);
+// 8-bit PNG (1 to 4 channels: Y, YA, RGB, RGBA) with an sRGB chunk (the samples are sRGB codes) and
+// one tEXt chunk per attribute (ImageDescription as the standard keyword "Description").
+void write_png(const std::filesystem::path& path, const PixelsView<std::uint8_t>& pixels,
+               const std::vector<ImageAttribute>& attributes);
+// Baseline 8-bit JPEG of 1 or 3 channels at `quality` (1 to 100; above 90 without chroma
+// subsampling); Software and ImageDescription become Exif tags and the description also the file's
+// comment (a COM segment), as OpenImageIO wrote them; others are dropped (no free attributes).
+void write_jpeg(const std::filesystem::path& path, const PixelsView<std::uint8_t>& pixels, int quality,
+                const std::vector<ImageAttribute>& attributes);
+// 16-bit TIFF of 1 to 4 channels, deflate (ZIP) compression with horizontal differencing; the
+// Software and ImageDescription attributes become those tags, others are dropped.
+void write_tiff(const std::filesystem::path& path, const PixelsView<std::uint16_t>& pixels,
+                const std::vector<ImageAttribute>& attributes);
+// Radiance RGBE of 3 channels (run-length encoded scanlines); each attribute becomes a header line
+// NAME=value (Software as Radiance's SOFTWARE; line breaks in values become spaces; a name with '='
+// is an OptionsError).
+void write_hdr(const std::filesystem::path& path, const PixelsView<float>& rgb, const std::vector<ImageAttribute>& attributes);
+
+}  // namespace lensmith

@@ -1,0 +1,194 @@
+// Picture files: the format from the first bytes (each format's published signature), dispatch to
+// the codec that reads or writes it, and the temporary-file-and-rename of core for every writer.
+#include "lensmith/imageio/image_file.h"
+
+#include <array>
+#include <cerrno>
+#include <charconv>
+#include <cstdio>
+#include <cstring>
+#include <functional>
+#include <memory>
+#include <string_view>
+
+#include "codecs.h"
+#include "lensmith/core/errors.h"
+#include "lensmith/core/text_file.h"
+
+namespace lensmith {
+
+namespace fs = std::filesystem;
+
+namespace codecs {
+
+Raster select_channels(const Decoded& decoded, std::span<const int> channels) {
+  const std::size_t stride = decoded.info.channels.size();
+  Raster raster;
+  raster.width = decoded.info.width;
+  raster.height = decoded.info.height;
+  raster.channels = static_cast<int>(channels.size());
+  const std::size_t pixels = static_cast<std::size_t>(raster.width) * static_cast<std::size_t>(raster.height);
+  raster.samples.resize(pixels * channels.size());
+  for (std::size_t p = 0; p < pixels; ++p) {
+    for (std::size_t c = 0; c < channels.size(); ++c) {
+      raster.samples[p * channels.size() + c] = decoded.samples[p * stride + static_cast<std::size_t>(channels[c])];
+    }
+  }
+  return raster;
+}
+
+std::string shortest_float_text(float value) {
+  std::array<char, 32> buffer{};
+  const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
+  return std::string(buffer.data(), result.ptr);
+}
+
+}  // namespace codecs
+
+namespace {
+
+// The first bytes of a file; fewer when the file is shorter.
+std::string leading_bytes(const fs::path& path, std::size_t count) {
+  const std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"), &std::fclose);
+  if (!file) throw IoError(path.string() + ": cannot read the image: " + std::strerror(errno));
+  std::string bytes(count, '\0');
+  bytes.resize(std::fread(bytes.data(), 1, count, file.get()));
+  return bytes;
+}
+
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
+
+template <typename Sample>
+void check_view(const fs::path& path, const PixelsView<Sample>& pixels, int min_channels, int max_channels) {
+  if (pixels.width < 1 || pixels.height < 1 || pixels.channels < min_channels || pixels.channels > max_channels ||
+      pixels.samples.size() != static_cast<std::size_t>(pixels.width) * static_cast<std::size_t>(pixels.height) *
+                                   static_cast<std::size_t>(pixels.channels)) {
+    throw OptionsError(path.string() + ": cannot write " + std::to_string(pixels.width) + " x " + std::to_string(pixels.height) +
+                       " pixels of " + std::to_string(pixels.channels) + " channels from " + std::to_string(pixels.samples.size()) +
+                       " samples: this format takes " + std::to_string(min_channels) + " to " + std::to_string(max_channels) +
+                       " channels and width x height x channels samples");
+  }
+}
+
+// Writes through a hidden temporary file beside `path` (same extension, for anyone looking at it).
+void write_through_temporary(const fs::path& path, const std::function<void(const std::string&)>& write) {
+  write_atomically(path.string(), path.extension().string(), write);
+}
+
+}  // namespace
+
+ImageFormat detect_image_format(const fs::path& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw IoError(path.string() + ": cannot read the image: it is a folder");
+  const std::string head = leading_bytes(path, 16);
+  const auto starts = [&](std::string_view magic) { return std::string_view(head).substr(0, magic.size()) == magic; };
+  using namespace std::string_view_literals;
+  // OpenEXR file layout, "Magic Number"; TIFF 6.0 section 2 (and BigTIFF's 43); PNG spec 5.2;
+  // JPEG's SOI marker and the first marker of the next segment; Radiance's "#?" program line.
+  if (starts("\x76\x2f\x31\x01"sv)) return ImageFormat::Exr;
+  if (starts("II*\0"sv) || starts("MM\0*"sv) || starts("II+\0"sv) || starts("MM\0+"sv)) return ImageFormat::Tiff;
+  if (starts("\x89PNG\r\n\x1a\n"sv)) return ImageFormat::Png;
+  if (starts("\xff\xd8\xff"sv)) return ImageFormat::Jpeg;
+  if (starts("#?"sv)) return ImageFormat::Hdr;
+  if (head.size() >= 3 && head[0] == 'P' && is_space(head[2])) {
+    if (head[1] == 'F' || head[1] == 'f') return ImageFormat::Pfm;
+    if (head[1] == '5' || head[1] == '6') return ImageFormat::Pnm;
+  }
+  if (starts("BM"sv)) return ImageFormat::Bmp;
+  // TGA has no signature: it is what stb_image's header test accepts once the others are excluded.
+  if (codecs::stb_can_decode(path)) return ImageFormat::Tga;
+  throw IoError(path.string() + ": not a picture lensmith can read: its first bytes match none of the formats it reads, " +
+                kReadableImageFormats);
+}
+
+RasterInfo read_raster_info(const fs::path& path) {
+  const ImageFormat format = detect_image_format(path);
+  switch (format) {
+    case ImageFormat::Exr: return codecs::read_exr_info(path);
+    case ImageFormat::Tiff: return codecs::read_tiff_info(path);
+    case ImageFormat::Pfm: return codecs::read_pfm_info(path);
+    case ImageFormat::Png: {
+      RasterInfo info = codecs::read_stb_info(path, format);
+      info.integers_are_linear = codecs::read_png_chunks(path).linear;
+      return info;
+    }
+    case ImageFormat::Jpeg:
+    case ImageFormat::Hdr:
+    case ImageFormat::Bmp:
+    case ImageFormat::Tga:
+    case ImageFormat::Pnm: return codecs::read_stb_info(path, format);
+  }
+  throw IoError(path.string() + ": unknown image format");
+}
+
+Raster read_raster(const fs::path& path, const RasterInfo& info, std::span<const int> channels) {
+  for (const int c : channels) {
+    if (c < 0 || static_cast<std::size_t>(c) >= info.channels.size()) {
+      throw OptionsError(path.string() + ": channel index " + std::to_string(c) + " outside the file's " +
+                         std::to_string(info.channels.size()) + " channels");
+    }
+  }
+  if (info.format == ImageFormat::Exr) return codecs::read_exr(path, info, channels);
+  codecs::Decoded decoded;
+  switch (info.format) {
+    case ImageFormat::Tiff: decoded = codecs::read_tiff(path); break;
+    case ImageFormat::Pfm: decoded = codecs::read_pfm(path); break;
+    default: decoded = codecs::read_stb(path, info.format); break;
+  }
+  if (decoded.info.width != info.width || decoded.info.height != info.height ||
+      decoded.info.channels.size() != info.channels.size()) {
+    throw IoError(path.string() + ": the file changed while it was read (" + info.to_string() + ", then " +
+                  decoded.info.to_string() + ")");
+  }
+  return codecs::select_channels(decoded, channels);
+}
+
+std::vector<std::pair<std::string, std::string>> read_image_metadata_pairs(const fs::path& path) {
+  switch (detect_image_format(path)) {
+    case ImageFormat::Exr: return codecs::read_exr_metadata(path);
+    case ImageFormat::Tiff: return codecs::read_tiff_metadata(path);
+    case ImageFormat::Png: return codecs::read_png_chunks(path).text;
+    case ImageFormat::Jpeg: return codecs::read_jpeg_metadata(path);
+    case ImageFormat::Hdr: return codecs::read_hdr_metadata(path);
+    case ImageFormat::Pfm:
+    case ImageFormat::Bmp:
+    case ImageFormat::Tga:
+    case ImageFormat::Pnm: return {};
+  }
+  return {};
+}
+
+void write_exr(const fs::path& path, const PixelsView<float>& pixels, const std::vector<std::string>& channel_names,
+               const std::vector<ImageAttribute>& attributes) {
+  check_view(path, pixels, 1, 1 << 16);
+  if (channel_names.size() != static_cast<std::size_t>(pixels.channels)) {
+    throw OptionsError(path.string() + ": " + std::to_string(channel_names.size()) + " channel names for " +
+                       std::to_string(pixels.channels) + " channels");
+  }
+  write_through_temporary(path, [&](const std::string& file) { codecs::write_exr_file(path, file, pixels, channel_names, attributes); });
+}
+
+void write_png(const fs::path& path, const PixelsView<std::uint8_t>& pixels, const std::vector<ImageAttribute>& attributes) {
+  check_view(path, pixels, 1, 4);
+  write_through_temporary(path, [&](const std::string& file) { codecs::write_png_file(path, file, pixels, attributes); });
+}
+
+void write_jpeg(const fs::path& path, const PixelsView<std::uint8_t>& pixels, int quality,
+                const std::vector<ImageAttribute>& attributes) {
+  check_view(path, pixels, 1, 3);
+  if (pixels.channels == 2) throw OptionsError(path.string() + ": JPEG takes 1 (gray) or 3 (RGB) channels, not 2");
+  if (quality < 1 || quality > 100) throw OptionsError(path.string() + ": JPEG quality " + std::to_string(quality) + ": must be 1 to 100");
+  write_through_temporary(path, [&](const std::string& file) { codecs::write_jpeg_file(path, file, pixels, quality, attributes); });
+}
+
+void write_tiff(const fs::path& path, const PixelsView<std::uint16_t>& pixels, const std::vector<ImageAttribute>& attributes) {
+  check_view(path, pixels, 1, 4);
+  write_through_temporary(path, [&](const std::string& file) { codecs::write_tiff_file(path, file, pixels, attributes); });
+}
+
+void write_hdr(const fs::path& path, const PixelsView<float>& rgb, const std::vector<ImageAttribute>& attributes) {
+  check_view(path, rgb, 3, 3);
+  write_through_temporary(path, [&](const std::string& file) { codecs::write_hdr_file(path, file, rgb, attributes); });
+}
+
+}  // namespace lensmith
