@@ -203,6 +203,14 @@ void clip_pupil_polygon(const std::vector<PupilPoint>& convex, std::span<const P
       const double t = std::clamp(entering ? (-qb - root) / (2.0 * qa) : (-qb + root) / (2.0 * qa), 0.0, 1.0);
       return PupilPoint{a.x + t * ex, a.y + t * ey};
     };
+    // Whether the segment a -> b comes within the circle (touching counts where `touch`): its point
+    // nearest the centre.
+    auto meets = [&d, r2](const PupilPoint& a, const PupilPoint& b, bool touch) {
+      const double ex = b.x - a.x, ey = b.y - a.y;
+      const double t = std::clamp(((d.x - a.x) * ex + (d.y - a.y) * ey) / (ex * ex + ey * ey), 0.0, 1.0);
+      const double gx = a.x + t * ex - d.x, gy = a.y + t * ey - d.y;
+      return touch ? gx * gx + gy * gy <= r2 : gx * gx + gy * gy < r2;
+    };
     // The exit point of the arc being drawn, while outside.
     std::optional<PupilPoint> exit;
     double orientation = 0.0;
@@ -238,12 +246,7 @@ void clip_pupil_polygon(const std::vector<PupilPoint>& convex, std::span<const P
     if (start == n) {
       bool any_crossing = false;
       for (std::size_t i = 0; i < n && !any_crossing; ++i) {
-        const PupilPoint& a = out[i];
-        const PupilPoint& b = out[(i + 1) % n];
-        const double ex = b.x - a.x, ey = b.y - a.y;
-        const double t = std::clamp(((d.x - a.x) * ex + (d.y - a.y) * ey) / (ex * ex + ey * ey), 0.0, 1.0);
-        const double gx = a.x + t * ex - d.x, gy = a.y + t * ey - d.y;
-        any_crossing = gx * gx + gy * gy <= r2;
+        any_crossing = meets(out[i], out[(i + 1) % n], true);
       }
       if (!any_crossing) {
         // Disjoint, or the disc lies inside the polygon: then the disc itself is what passes.
@@ -287,10 +290,7 @@ void clip_pupil_polygon(const std::vector<PupilPoint>& convex, std::span<const P
         exit.reset();
       } else {
         // Both outside: the edge may still pass through the disc.
-        const double ex = b.x - a.x, ey = b.y - a.y;
-        const double t = std::clamp(((d.x - a.x) * ex + (d.y - a.y) * ey) / (ex * ex + ey * ey), 0.0, 1.0);
-        const double gx = a.x + t * ex - d.x, gy = a.y + t * ey - d.y;
-        if (gx * gx + gy * gy < r2) {
+        if (meets(a, b, false)) {
           const PupilPoint entry = crossing(a, b, true);
           if (exit) {
             work.push_back(*exit);
@@ -312,6 +312,5 @@ void clip_pupil_polygon(const std::vector<PupilPoint>& convex, std::span<const P
     out.swap(work);
   }
 }
-
 
 }  // namespace lensmith

@@ -55,17 +55,13 @@ ExactModel::ExactModel(const Camera& camera) : RayModel(camera) {
     apertures_.emplace_back(k, static_cast<int>(k) + 1 == stop_surface_ ? *r * (1.0 + kStopEdgeTolerance) : *r);
   }
   z_stop_mm_ = free_->vertex_z_mm(stop_surface_);
-  normalisation_ = WeightNormalisation(camera.min_wavelength_nm(), camera.max_wavelength_nm(), kNormalisationWavelengths,
-                                       [this, &camera](double wavelength_nm) {
-                                         return axial_mean_weight(camera, wavelength_nm, [this](auto&&... a) { map_raw(a...); });
-                                       });
+  normalisation_ = weight_normalisation_for(camera, [this](auto&&... a) { map_raw(a...); });
 }
 
 void ExactModel::map(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
                      std::span<SensorHit> hits) const {
   map_raw(point, wavelength_nm, pupil, hits);
-  const double scale = normalisation_.scale(wavelength_nm);
-  for (SensorHit& h : hits) h.weight *= scale;
+  normalisation_.apply(wavelength_nm, hits);
 }
 
 void ExactModel::map_raw(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,

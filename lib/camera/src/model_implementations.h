@@ -5,10 +5,12 @@
 #include <cmath>
 #include <memory>
 #include <optional>
+#include <span>
 #include <utility>
 #include <vector>
 
 #include "lensmith/camera/ray_model.h"
+#include "lensmith/core/units.h"
 #include "lensmith/polyfit/lens_fit.h"
 #include "lensmith/seidel/aberration_table.h"
 #include "lensmith/trace/sequential_tracer.h"
@@ -67,6 +69,11 @@ class WeightNormalisation {
     hi_ = max_wavelength_nm;
     for (int i = 0; i < samples; ++i) means_.push_back(raw_mean(lo_ + (hi_ - lo_) * i / (samples - 1)));
   }
+  // The raw weights of `hits` (map_raw at wavelength_nm) normalised.
+  void apply(double wavelength_nm, std::span<SensorHit> hits) const {
+    const double s = scale(wavelength_nm);
+    for (SensorHit& h : hits) h.weight *= s;
+  }
   // 1 / the interpolated mean.
   double scale(double wavelength_nm) const {
     if (means_.empty()) return 1.0;
@@ -91,13 +98,13 @@ double axial_mean_weight(const Camera& camera, double wavelength_nm, const MapRa
   for (int i = 0; i < kRings; ++i) {
     const double r = (i + 0.5) / kRings;
     for (int j = 0; j < kSectors; ++j) {
-      const double phi = 2.0 * 3.14159265358979323846 * (j + 0.5) / kSectors;
+      const double phi = 2.0 * kPi * (j + 0.5) / kSectors;
       pupil.push_back({r * std::cos(phi), r * std::sin(phi)});
       area.push_back(r);  // polar cell area, up to a constant
     }
   }
   std::vector<SensorHit> hits(pupil.size());
-  const ScenePoint axis{0.0, 0.0, std::isinf(camera.focus_distance_mm()) ? 0.0 : 1.0 / camera.focus_distance_mm()};
+  const ScenePoint axis{0.0, 0.0, inverse_per_mm(camera.focus_distance_mm())};
   map_raw(axis, wavelength_nm, pupil, hits);
   double sum = 0.0, total = 0.0;
   for (std::size_t k = 0; k < hits.size(); ++k) {
@@ -105,6 +112,14 @@ double axial_mean_weight(const Camera& camera, double wavelength_nm, const MapRa
     if (hits[k].ok) sum += area[k] * hits[k].weight;
   }
   return sum / total;
+}
+
+// The normalisation of a model whose raw map (map_raw(point, wavelength_nm, pupil, hits)) sets
+// unnormalised weights: axial_mean_weight at kNormalisationWavelengths over the camera's range.
+template <typename MapRaw>
+WeightNormalisation weight_normalisation_for(const Camera& camera, const MapRaw& map_raw) {
+  return WeightNormalisation(camera.min_wavelength_nm(), camera.max_wavelength_nm(), kNormalisationWavelengths,
+                             [&](double wavelength_nm) { return axial_mean_weight(camera, wavelength_nm, map_raw); });
 }
 
 // thin, paraxial and seidel: the ray from the exit-pupil point towards the Gaussian image point,

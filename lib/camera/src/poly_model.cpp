@@ -39,10 +39,7 @@ PolyModel::PolyModel(const Camera& camera, std::shared_ptr<const LensFit> fit) :
                        format_number(fit_->options().max_wavelength_nm) + " nm, the renderer needs " +
                        format_number(camera.min_wavelength_nm()) + "-" + format_number(camera.max_wavelength_nm()) + " nm");
   }
-  normalisation_ = WeightNormalisation(camera.min_wavelength_nm(), camera.max_wavelength_nm(), kNormalisationWavelengths,
-                                       [this, &camera](double wavelength_nm) {
-                                         return axial_mean_weight(camera, wavelength_nm, [this](auto&&... a) { map_raw(a...); });
-                                       });
+  normalisation_ = weight_normalisation_for(camera, [this](auto&&... a) { map_raw(a...); });
 }
 
 double PolyModel::outer_solid_angle(const ScenePoint& point, double z_perspective_mm, double x_mm, double y_mm) const {
@@ -54,8 +51,7 @@ double PolyModel::outer_solid_angle(const ScenePoint& point, double z_perspectiv
 void PolyModel::map(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
                     std::span<SensorHit> hits) const {
   map_raw(point, wavelength_nm, pupil, hits);
-  const double scale = normalisation_.scale(wavelength_nm);
-  for (SensorHit& h : hits) h.weight *= scale;
+  normalisation_.apply(wavelength_nm, hits);
 }
 
 void PolyModel::map_raw(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,

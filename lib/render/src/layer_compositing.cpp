@@ -43,14 +43,19 @@ void composite_layer_over(const std::vector<float>& layer_rgba, const std::vecto
 }
 
 Image finish_composite(const std::vector<double>& result, int width, int height) {
-  std::vector<std::array<double, 5>> fill(static_cast<std::size_t>(width) * height, std::array<double, 5>{});
+  const std::size_t count = static_cast<std::size_t>(width) * height;
   bool any_gap = false;
-  for (std::size_t k = 0; k < fill.size(); ++k) {
-    const double coverage = result[4 * k + 3];
-    any_gap = any_gap || coverage < kRenormaliseCoverage;
-    if (coverage >= kKnownCoverage) fill[k] = {result[4 * k], result[4 * k + 1], result[4 * k + 2], 0.0, coverage};
+  for (std::size_t k = 0; k < count && !any_gap; ++k) any_gap = result[4 * k + 3] < kRenormaliseCoverage;
+  // The push-pull fill (5 doubles a pixel) only where some gap is too empty to renormalise.
+  std::vector<std::array<double, 5>> fill;
+  if (any_gap) {
+    fill.assign(count, std::array<double, 5>{});
+    for (std::size_t k = 0; k < count; ++k) {
+      const double coverage = result[4 * k + 3];
+      if (coverage >= kKnownCoverage) fill[k] = {result[4 * k], result[4 * k + 1], result[4 * k + 2], 0.0, coverage};
+    }
+    push_pull(width, height, fill);
   }
-  if (any_gap) push_pull(width, height, fill);
   Image out(width, height, 3);
   for (std::size_t k = 0; k < out.pixel_count(); ++k) {
     const double gap = std::max(0.0, 1.0 - result[4 * k + 3]);
@@ -59,7 +64,8 @@ Image finish_composite(const std::vector<double>& result, int width, int height)
       continue;
     }
     for (std::size_t c = 0; c < 3; ++c) {
-      out.data[3 * k + c] = static_cast<float>(std::max(0.0, result[4 * k + c] + (gap > 0.0 ? gap * fill[k][c] : 0.0)));
+      // A gap below kRenormaliseCoverage exists only where any_gap made the fill.
+      out.data[3 * k + c] = static_cast<float>(std::max(0.0, result[4 * k + c] + (gap > 0.0 && any_gap ? gap * fill[k][c] : 0.0)));
     }
   }
   return out;

@@ -54,7 +54,6 @@ struct ScenePoint {
   double inverse_depth_per_mm = 0.0;
 };
 
-
 // The paraxial (Gaussian) image of a scene point at one wavelength: a point in the lens frame.
 struct GaussianImage {
   double x_mm = 0.0;

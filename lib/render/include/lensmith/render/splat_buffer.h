@@ -130,6 +130,7 @@ class SplatBuffer {
   double scale_ = 1.0;
   double x_offset_ = 0.0;
   std::vector<Point2f> scaled_;  // scratch: a polygon's vertices in cells
+  mutable std::vector<double> cells_;  // scratch of resolve_into: the grid's integrated cells
   // First differences along x, double: width_ x (row_end_ - row_begin_) x 4 channels, row-major.
   // double keeps a bright highlight's rounding from streaking along its row through the prefix sum.
   std::vector<double> diff_;
