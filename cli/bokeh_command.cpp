@@ -90,6 +90,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   for (float z : depth.z_m) nearest_m = std::min(nearest_m, z);
   RayModelOptions model_options;
   model_options.nearest_depth_m = std::isfinite(nearest_m) ? std::max(0.01, static_cast<double>(nearest_m)) : 1.0;
+  model_options.seidel_coefficients = parse_seidel_coefficients(o.seidel_coefficients);
   if (!o.thin_lens) model_options.fit = fit_for_models({kind}, *cam, o.fit, global);
   else if (!o.fit.empty()) throw OptionsError("--fit is for --model poly with --lens");
   const auto model = make_ray_model(kind, *cam, model_options);
@@ -124,6 +125,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
                 {"edge_pixels", o.edge_pixels},
                 {"vignetting", options.vignetting ? "natural" : "off"},
                 {"spectral", options.spectral ? std::to_string(options.spectral_samples) + " nodes" : "off"}};
+  if (kind == RayModelKind::Seidel) meta.extra.emplace_back("seidel_coefficients", o.seidel_coefficients);
   write_output_image(output, out, meta);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   std::cout << "wrote " << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed

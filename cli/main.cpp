@@ -191,6 +191,9 @@ int main(int argc, char** argv) {
       ->excludes(bokeh_blades);
   bokeh_cmd->add_option("--model", bokeh.model, "thin | paraxial | seidel (default) | poly | exact")
       ->check(CLI::IsMember({"thin", "paraxial", "seidel", "poly", "exact"}));
+  bokeh_cmd->add_option("--seidel-coefficients", bokeh.seidel_coefficients,
+                        "seidel model: fitted (default: third order fitted to the real rays) | sums (Seidel sums, Asberg)")
+      ->check(CLI::IsMember({"fitted", "sums"}));
   bokeh_cmd->add_option("--fit", bokeh.fit, "Fit file for --model poly (lensmith fit -o); default: fit the lens in this run")
       ->check(CLI::ExistingFile);
   bokeh_cmd->add_option("--hidden", bokeh.hidden, "Background hidden behind foreground edges: extend (default) | stretch")
@@ -224,6 +227,9 @@ int main(int argc, char** argv) {
   validate_cmd->add_option("--out", validate.out, "Directory for report.md and psf.png (default ./validation)");
   validate_cmd->add_option("--models", validate.models, "Models to compare with exact (default paraxial seidel; also poly)")
       ->check(CLI::IsMember({"paraxial", "seidel", "poly"}));
+  validate_cmd->add_option("--seidel-coefficients", validate.seidel_coefficients,
+                           "seidel model: fitted (default: third order fitted to the real rays) | sums (Seidel sums)")
+      ->check(CLI::IsMember({"fitted", "sums"}));
   validate_cmd->add_option("--fit", validate.fit, "Fit file for the poly model (lensmith fit -o); default: fit the lens in this run")
       ->check(CLI::ExistingFile);
   validate_cmd->add_option("--width", validate.width_px, "Frame width the fields refer to, px (default 1920)")->check(CLI::Range(16, 65536));

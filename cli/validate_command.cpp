@@ -29,6 +29,7 @@ int run_validate(const ValidateCommandOptions& o, const GlobalOptions& global) {
   RayModelOptions model_options;
   model_options.fit = fit_for_models(models, camera, o.fit, global);
   model_options.nearest_depth_m = std::isinf(o.focus_m) ? 1.0 : std::max(0.05, 0.4 * o.focus_m);
+  model_options.seidel_coefficients = parse_seidel_coefficients(o.seidel_coefficients);
   const PsfValidation result = validate_point_spreads(camera, models, Aperture::circular(), psf, model_options);
   const std::string psf_tables = result.to_markdown();
 
@@ -61,6 +62,7 @@ int run_validate(const ValidateCommandOptions& o, const GlobalOptions& global) {
     for (const std::string& s : o.scenes) image_options.scenes.emplace_back(s);
     image_options.models = models;
     image_options.fit = model_options.fit;
+    image_options.seidel_coefficients = model_options.seidel_coefficients;
     image_options.width_px = o.image_width_px;
     image_options.height_px = o.image_height_px;
     image_options.spp = o.image_spp;

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -122,6 +123,113 @@ WeightNormalisation weight_normalisation_for(const Camera& camera, const MapRaw&
                              [&](double wavelength_nm) { return axial_mean_weight(camera, wavelength_nm, map_raw); });
 }
 
+// Born & Wolf's aberration vector at one field y0: its coefficients times the powers of y0 that
+// go with them, mm. In these terms the vector (Marsicano 2023, eq. 3.35) at pupil point
+// (a, b) = rho (sin t, cos t) is
+//   dx = a (spherical rho^2 - 2 coma b + curvature)
+//   dy = b spherical rho^2 - coma (rho^2 + 2 b^2) + (2 astigmatism + curvature) b - distortion.
+struct FieldTerms {
+  double spherical = 0.0;    // B
+  double astigmatism = 0.0;  // C y0^2
+  double curvature = 0.0;    // D y0^2
+  double distortion = 0.0;   // E y0^3
+  double coma = 0.0;         // F y0
+
+  static FieldTerms at(const AberrationCoefficients& c, double y0) {
+    return {c.B_mm, c.C_mm * y0 * y0, c.D_mm * y0 * y0, c.E_mm * y0 * y0 * y0, c.F_mm * y0};
+  }
+  double& operator[](int i) { return i == 0 ? spherical : i == 1 ? astigmatism : i == 2 ? curvature : i == 3 ? distortion : coma; }
+  double operator[](int i) const { return const_cast<FieldTerms&>(*this)[i]; }
+};
+
+// Asberg's construction for one scene point at one wavelength (Marsicano 2023, sec. 3.10): the
+// aberration vector moves the Gaussian image point G to P1 on the Gaussian image plane; the ray
+// leaves the Gaussian reference sphere (centred on G, through the exit pupil's centre) where the line
+// from the exit-pupil point to G meets it (eq. 3.45), and goes through P1 to the sensor (eq. 3.46).
+// The sensor point is affine in the FieldTerms (the vector is linear in them and the ray's parameter
+// at the sensor does not depend on it), which is what lets FittedAberrations fit them by linear
+// least squares.
+struct SeidelRayGeometry {
+  GaussianImage g;
+  double r_exit = 0.0;  // signed exit-pupil radius, mm (pupil orientation applied)
+  double z_exit = 0.0;
+  double z_sensor = 0.0;
+  double radius_sphere = 0.0;
+  // Born & Wolf's frame: y along the image point's direction from the axis, x completing a
+  // right-handed pair; y0 the field in units of the coefficients' maximum field.
+  double ex_x = 0.0, ex_y = 0.0, ey_x = 0.0, ey_y = 1.0;
+  double y0 = 0.0;
+
+  SeidelRayGeometry(const Camera& camera, const FirstOrderSample& fo, const ScenePoint& point, double max_field_tangent)
+      : g(camera.gaussian_image(point, fo)),
+        r_exit(fo.exit_pupil_radius_mm * camera.pupil_orientation()),
+        z_exit(fo.z_exit_pupil_mm),
+        z_sensor(camera.z_sensor_mm()) {
+    radius_sphere = std::sqrt(g.x_mm * g.x_mm + g.y_mm * g.y_mm + (g.z_mm - z_exit) * (g.z_mm - z_exit));
+    const double t_len = std::hypot(point.tan_x, point.tan_y);
+    if (t_len > 0.0) {
+      ey_x = -point.tan_x / t_len;  // the image lies opposite the object
+      ey_y = -point.tan_y / t_len;
+    }
+    ex_x = ey_y;
+    ex_y = -ey_x;
+    y0 = max_field_tangent > 0.0 ? t_len / max_field_tangent : 0.0;
+  }
+
+  // Where the ray through normalised pupil point q meets the sensor (mm) with aberration terms t.
+  void sensor_point(const PupilPoint& q, const FieldTerms& t, double& x_mm, double& y_mm) const {
+    // a = rho sin(theta), b = rho cos(theta) in Born & Wolf's frame (theta from +y); the pupil
+    // coordinate is the same in both pupils.
+    const double a = q.x * ex_x + q.y * ex_y;
+    const double b = q.x * ey_x + q.y * ey_y;
+    const double rho2 = a * a + b * b;
+    const double dx = a * (t.spherical * rho2 - 2.0 * t.coma * b + t.curvature);
+    const double dy = b * t.spherical * rho2 - t.coma * (rho2 + 2.0 * b * b) + (2.0 * t.astigmatism + t.curvature) * b - t.distortion;
+    const double p1x = g.x_mm + dx * ex_x + dy * ey_x;
+    const double p1y = g.y_mm + dx * ex_y + dy * ey_y;
+    const double ux = r_exit * q.x - g.x_mm, uy = r_exit * q.y - g.y_mm, uz = z_exit - g.z_mm;
+    const double scale = radius_sphere / std::sqrt(ux * ux + uy * uy + uz * uz);
+    const double qx = g.x_mm + ux * scale, qy = g.y_mm + uy * scale, qz = g.z_mm + uz * scale;
+    const double s = (z_sensor - g.z_mm) / (g.z_mm - qz);
+    x_mm = p1x + (p1x - qx) * s;
+    y_mm = p1y + (p1y - qy) * s;
+  }
+};
+
+class ExactModel;
+
+// The seidel model's aberration terms fitted to real rays (RayModelOptions::seidel_coefficients,
+// fitted_aberrations.cpp says why and how): per object distance of the model's table, field and a
+// few wavelengths, the difference between the least-squares FieldTerms of the exact model's rays
+// and the terms of the Seidel sums, to be added to the latter; and the ratio of the light the real
+// lens passes (the exact model's weights summed over the rays that pass) to the model's own.
+class FittedAberrations {
+ public:
+  // The model's own map (weights and first-order clipping), for the light ratio.
+  using ModelMap = std::function<void(const ScenePoint&, double, std::span<const PupilPoint>, std::span<SensorHit>)>;
+  // Fits `table` (made for `camera`'s lens at its f-number) against `exact` (the same camera).
+  FittedAberrations(const Camera& camera, const ExactModel& exact, const AberrationTable& table, const ModelMap& model);
+  // Adds the fitted correction at this wavelength, object distance (mm, from surface 1) and field
+  // y0 (in the table's units) to `terms` and returns the light ratio there: trilinear in
+  // wavelength, inverse distance and field.
+  double correct(double wavelength_nm, double object_distance_mm, double y0, FieldTerms& terms) const;
+  // (distance, wavelength, field) samples fitted, and those that kept the sums (too few rays passed).
+  int fitted() const { return fitted_; }
+  int kept() const { return kept_; }
+
+ private:
+  std::vector<double> inverse_distances_per_mm_;  // ascending, the table's
+  std::vector<double> wavelengths_nm_;            // ascending
+  std::vector<double> fields_;                    // y0, ascending from 0
+  std::vector<FieldTerms> delta_;                 // [distance][wavelength][field]
+  std::vector<double> light_;                     // [distance][wavelength][field]
+  int fitted_ = 0;
+  int kept_ = 0;
+  const FieldTerms& delta(std::size_t j, std::size_t n, std::size_t k) const {
+    return delta_[(j * wavelengths_nm_.size() + n) * fields_.size() + k];
+  }
+};
+
 // thin, paraxial and seidel: the ray from the exit-pupil point towards the Gaussian image point,
 // through the aberrated image point for seidel (Asberg's construction with the Gaussian reference
 // sphere centred on the Gaussian image point and passing through the exit-pupil centre).
@@ -151,6 +259,7 @@ class ReferenceSphereModel final : public RayModel {
 
   RayModelKind kind_;
   std::optional<AberrationTable> table_;  // seidel only
+  std::optional<FittedAberrations> fitted_;  // seidel with fitted coefficients
   std::vector<ParaxialAperture> apertures_;  // paraxial and seidel: every clear aperture but the stop
   double z_entrance_pupil_mm_ = 0.0;          // reference wavelength
   double entrance_pupil_radius_mm_ = 0.0;

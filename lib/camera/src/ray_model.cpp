@@ -27,6 +27,14 @@ RayModelKind parse_ray_model_kind(std::string_view text) {
   throw OptionsError("unknown ray model '" + std::string(text) + "': expected thin, paraxial, seidel, poly or exact");
 }
 
+std::string_view to_string(SeidelCoefficients source) { return source == SeidelCoefficients::Fitted ? "fitted" : "sums"; }
+
+SeidelCoefficients parse_seidel_coefficients(std::string_view text) {
+  if (text == "fitted") return SeidelCoefficients::Fitted;
+  if (text == "sums") return SeidelCoefficients::Sums;
+  throw OptionsError("unknown Seidel coefficient source '" + std::string(text) + "': expected fitted or sums");
+}
+
 std::string RayModel::to_string() const {
   return std::string(lensmith::to_string(kind())) + " model, " + camera_.to_string();
 }

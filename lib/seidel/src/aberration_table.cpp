@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "lensmith/core/errors.h"
+#include "lensmith/core/grid_interval.h"
 #include "lensmith/core/units.h"
 
 namespace lensmith {
@@ -39,14 +40,6 @@ AberrationSample lerp(const AberrationSample& a, const AberrationSample& b, doub
   return s;
 }
 
-// Index of the interval [i, i+1] of the sorted `grid` holding x, and the fraction within it.
-std::pair<std::size_t, double> locate(const std::vector<double>& grid, double x) {
-  if (grid.size() < 2 || x <= grid.front()) return {0, 0.0};
-  if (x >= grid.back()) return {grid.size() - 2, 1.0};
-  const auto it = std::upper_bound(grid.begin(), grid.end(), x);
-  const std::size_t i = static_cast<std::size_t>(it - grid.begin()) - 1;
-  return {i, (x - grid[i]) / (grid[i + 1] - grid[i])};
-}
 
 }  // namespace
 
@@ -96,8 +89,8 @@ AberrationTable::AberrationTable(const Prescription& lens, const AberrationTable
 }
 
 AberrationSample AberrationTable::at(double wavelength_nm, double object_distance_mm) const {
-  const auto [i, ti] = locate(wavelengths_nm_, wavelength_nm);
-  const auto [j, tj] = locate(inverse_distances_per_mm_, inverse_per_mm(object_distance_mm));
+  const auto [i, ti] = grid_interval(wavelengths_nm_, wavelength_nm);
+  const auto [j, tj] = grid_interval(inverse_distances_per_mm_, inverse_per_mm(object_distance_mm));
   const std::size_t i1 = std::min(i + 1, wavelengths_nm_.size() - 1);
   const std::size_t j1 = std::min(j + 1, distances_mm_.size() - 1);
   const AberrationSample near_lambda = lerp(sample(i, j), sample(i1, j), ti);

@@ -43,6 +43,7 @@ ImageValidation validate_images(const Prescription& lens, const CameraOptions& c
     for (float z : pinhole.depth.z_m) nearest_m = std::min(nearest_m, z);
     RayModelOptions model_options;
     model_options.fit = options.fit;
+    model_options.seidel_coefficients = options.seidel_coefficients;
     model_options.nearest_depth_m = std::isfinite(nearest_m) ? std::max(0.01, static_cast<double>(nearest_m)) : 1.0;
     OutputMetadata meta;
     meta.lens = lens.name;

@@ -36,6 +36,8 @@ class AberrationTable {
   const std::vector<double>& object_distances_mm() const { return distances_mm_; }
   // Sample at wavelength index i and distance index j.
   const AberrationSample& sample(std::size_t i, std::size_t j) const { return samples_[j * wavelengths_nm_.size() + i]; }
+  // The same, to replace its coefficients (the camera layer fits them to real rays).
+  AberrationSample& sample(std::size_t i, std::size_t j) { return samples_[j * wavelengths_nm_.size() + i]; }
   // Bilinear interpolation in wavelength and in 1 / object distance; clamps outside the table.
   AberrationSample at(double wavelength_nm, double object_distance_mm) const;
   std::string to_string() const;
