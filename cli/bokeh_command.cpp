@@ -79,6 +79,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
       cam = Camera::thin_lens(p.efl_mm(), camera, image.width, image.height);
     } else {
       cam = Camera::from_lens(lens, camera, image.width, image.height);
+      warn_about_aperture(*cam, global);
     }
   }
   DepthReadOptions depth_options;

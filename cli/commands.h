@@ -233,6 +233,11 @@ int run_scene_render(const SceneRenderOptions& options, const GlobalOptions& glo
 // Prints the reader's warnings to stderr unless quiet.
 void print_diagnostics(const Diagnostics& diagnostics, const GlobalOptions& global);
 
+// Warns on stderr (unless quiet) when the camera's f-number is faster than its lens's design
+// aperture: how much of the axial beam the clear apertures then pass, and the fastest f-number they
+// pass whole.
+void warn_about_aperture(const Camera& camera, const GlobalOptions& global);
+
 // Loads LENS (a file path or a shipped lens name) and prints its warnings.
 Prescription load_lens(const std::string& lens, const GlobalOptions& global);
 

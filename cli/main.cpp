@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "commands.h"
+#include "lensmith/core/number_parsing.h"
 #include "lensmith/core/errors.h"
 #include "lensmith/prescription/lens_library.h"
 
@@ -19,6 +20,24 @@ Prescription load_lens(const std::string& lens, const GlobalOptions& global) {
   LensReadResult result = LensLibrary::load_path_or_name(lens);
   print_diagnostics(result.diagnostics, global);
   return std::move(result.prescription);
+}
+
+void warn_about_aperture(const Camera& camera, const GlobalOptions& global) {
+  // 5 % below the design value (about 1/7 stop): the design f-number rounded and typed back is not
+  // a request to open the lens.
+  constexpr double kMargin = 0.95;
+  const double n = camera.f_number(), design = camera.design_f_number(), clear = camera.fastest_unclipped_f_number();
+  if (global.quiet || camera.is_thin_lens() || !(n < kMargin * design)) return;
+  std::cerr << "warning: f/" << format_rounded(n, 3) << " is faster than this lens's design aperture f/" << format_rounded(design, 3);
+  if (clear > n) {
+    // On the axis the clear apertures' first-order images are discs centred on the pupil: the share
+    // that passes is the square of the f-number ratio.
+    std::cerr << ": its clear apertures clip the axial beam, which passes about " << format_rounded(100.0 * (n / clear) * (n / clear), 2)
+              << " % of the iris's area (the lens works at about f/" << format_rounded(clear, 3)
+              << " on the axis, the rest is vignetting); f/" << format_rounded(clear, 3) << " is the fastest f-number they pass whole\n";
+  } else {
+    std::cerr << ": its aberrations at this aperture were not corrected by its designer (expect a softer, hazier picture)\n";
+  }
 }
 
 // A focus distance: metres > 0, or inf (CLI11's PositiveNumber refuses infinity).

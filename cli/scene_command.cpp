@@ -102,6 +102,7 @@ int run_scene_render(const SceneRenderOptions& o, const GlobalOptions& global) {
       meta.lens = lens.name.empty() ? o.lens : lens.name;
       meta.model = "exact trace ground truth";
       camera = Camera::from_lens(lens, camera_options, o.width_px, o.height_px);
+      warn_about_aperture(*camera, global);
       out = render_through_lens(scene, *camera, options);
     }
     bar.finish();

@@ -22,6 +22,7 @@ int run_validate(const ValidateCommandOptions& o, const GlobalOptions& global) {
   camera_options.focus_distance_m = o.focus_m;
   camera_options.f_number = o.f_number;
   const Camera camera = Camera::from_lens(lens, camera_options, o.width_px, o.height_px);
+  warn_about_aperture(camera, global);
   std::vector<RayModelKind> models;
   for (const std::string& m : o.models) models.push_back(parse_ray_model_kind(m));
   PsfValidationOptions psf;

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "lensmith/camera/ray_model.h"
+#include "lensmith/core/errors.h"
 #include "lensmith/core/units.h"
 #include "lensmith/paraxial/paraxial_system.h"
 #include "lensmith/prescription/lens_library.h"
@@ -331,3 +332,52 @@ TEST_CASE("Clipping the pupil by a clear aperture's disc leaves the area of two 
   CHECK(out.empty());
 }
 
+
+TEST_CASE("Opened beyond its clear apertures, a lens says at which f-number they start to clip, and the exact tracer agrees on the light lost",
+          "[camera][aperture]") {
+  // Outside truth: the exact model traces a polar grid of the iris on the axis of the focus plane
+  // and counts the rays the clear apertures pass. To first order the apertures' images in the pupil
+  // are discs centred on it, so the share that passes is (N / N_clear)^2.
+  const Prescription lens = LensLibrary::load("pbrt-dgauss-50mm").prescription;
+  const Camera cam = Camera::from_lens(lens, options(1.2, 1.4), 640, 360);
+  CHECK(cam.design_f_number() == Approx(ParaxialSystem(lens).f_number()).epsilon(1e-12));
+  const double clear = cam.fastest_unclipped_f_number();
+  REQUIRE(clear > 1.4);
+  const auto exact = make_ray_model(RayModelKind::Exact, cam);
+  std::vector<PupilPoint> pupil;
+  std::vector<double> area;
+  for (int i = 0; i < 64; ++i) {
+    for (int j = 0; j < 32; ++j) {
+      const double r = (i + 0.5) / 64.0, phi = 2.0 * kPi * (j + 0.5) / 32.0;
+      pupil.push_back({r * std::cos(phi), r * std::sin(phi)});
+      area.push_back(r);
+    }
+  }
+  const auto h = hits(*exact, {0.0, 0.0, 1.0 / cam.focus_distance_mm()}, cam.reference_wavelength_nm(), pupil);
+  double passing = 0.0, total = 0.0;
+  for (std::size_t k = 0; k < h.size(); ++k) {
+    total += area[k];
+    if (h[k].ok) passing += area[k];
+  }
+  const double first_order = (1.4 / clear) * (1.4 / clear);
+  INFO("fastest unclipped f/" << clear << ": first-order share " << first_order << ", exact " << passing / total);
+  // The real marginal heights differ from the paraxial ones by a few percent at f/1.4.
+  CHECK(passing / total == Approx(first_order).margin(0.03));
+  // Stopped down past it, nothing but the iris clips on the axis.
+  CHECK(Camera::from_lens(lens, options(1.2, 2.2), 640, 360).fastest_unclipped_f_number() < 2.2);
+}
+
+TEST_CASE("An f-number whose stop would be wider than its surface is refused, naming the fastest one the stop allows", "[camera][aperture]") {
+  // The Sasian triplet's stop lies on a curved surface (R = 24.456 mm, lensmith info): a stop
+  // semi-diameter beyond |R| has no sag. Marginal heights scale as 1 / N, so f/0.77 is the limit.
+  const Prescription lens = LensLibrary::load("sasian-triplet").prescription;
+  try {
+    (void)Camera::from_lens(lens, options(3.0, 0.7), 640, 360);
+    FAIL("f/0.7 was accepted");
+  } catch (const OptionsError& e) {
+    const std::string message = e.what();
+    INFO(message);
+    CHECK(message.find("fastest f-number this lens can be opened to is f/0.77") != std::string::npos);
+  }
+  CHECK_NOTHROW(Camera::from_lens(lens, options(3.0, 0.78), 640, 360));
+}

@@ -82,6 +82,7 @@ Camera Camera::thin_lens(double focal_length_mm, const CameraOptions& options, i
   Camera c(PinholeFrame::from_options(width_px, height_px, options.framing, focal_length_mm));
   c.options_ = options;
   c.f_number_ = *options.f_number;
+  c.design_f_number_ = c.f_number_;
   c.reference_nm_ = options.reference_wavelength_nm;
   ParaxialSample s;
   s.wavelength_nm = options.reference_wavelength_nm;
@@ -106,11 +107,22 @@ Camera Camera::from_lens(const Prescription& lens, const CameraOptions& options,
   // that the paraxial pupils describe; the other clear apertures stay as prescribed (vignetting).
   const ParaxialSystem at_n(*at_f_number);
   const std::size_t stop = static_cast<std::size_t>(at_n.stop_surface() - 1);
-  at_f_number->surfaces[stop].semi_diameter_mm = std::abs(at_n.marginal_ray().rows[stop].y_mm);
+  const double stop_mm = std::abs(at_n.marginal_ray().rows[stop].y_mm);
+  const double widest_stop_mm = at_f_number->surfaces[stop].max_semi_diameter_mm();
+  if (stop_mm > widest_stop_mm) {
+    // Marginal heights scale as 1 / N: the stop is as wide as its surface at N stop_mm / widest.
+    throw OptionsError("f/" + format_rounded(n, 3) + " needs a stop " + format_rounded(stop_mm, 4) + " mm in radius, but surface " +
+                       std::to_string(stop + 1) + " (the stop) can be at most " + format_rounded(widest_stop_mm, 4) +
+                       " mm wide for its curvature: the fastest f-number this lens can be opened to is f/" +
+                       format_rounded(std::ceil(n * stop_mm / widest_stop_mm * 100.0) / 100.0, 4) + " (its design aperture is f/" +
+                       format_rounded(own.f_number(), 3) + ")");
+  }
+  at_f_number->surfaces[stop].semi_diameter_mm = stop_mm;
 
   Camera c(PinholeFrame::from_options(width_px, height_px, options.framing, own.efl_mm()));
   c.options_ = options;
   c.f_number_ = n;
+  c.design_f_number_ = own.f_number();
   c.reference_nm_ = options.reference_wavelength_nm;
   c.pupil_orientation_ = at_n.exit_pupil().magnification * at_n.entrance_pupil().magnification < 0.0 ? -1.0 : 1.0;
   SpectralTableOptions table_options;
@@ -121,6 +133,17 @@ Camera Camera::from_lens(const Prescription& lens, const CameraOptions& options,
   c.samples_ = ParaxialSpectralTable(*at_f_number, table_options).samples();
   c.lens_ = std::move(at_f_number);
   c.finish();
+  // The marginal ray from the axial point of the focus plane at N = n: its heights scale as n / N,
+  // so the first clear aperture (the stop aside) it fills sets the fastest unclipped N.
+  ParaxialOptions at_focus;
+  at_focus.wavelength_nm = c.reference_nm_;
+  at_focus.object_distance_mm = std::isinf(c.focus_mm_) ? kInfinity : std::max(1.0, c.focus_mm_ - c.z_perspective_mm_);
+  const ParaxialSystem focused(*c.lens_, at_focus);
+  for (std::size_t k = 0; k < c.lens_->surfaces.size(); ++k) {
+    const std::optional<double>& r = lens.surfaces[k].semi_diameter_mm;
+    if (k == stop || !r || !(*r > 0.0)) continue;
+    c.fastest_unclipped_f_number_ = std::max(c.fastest_unclipped_f_number_, n * std::abs(focused.marginal_ray().rows[k].y_mm) / *r);
+  }
   return c;
 }
 

@@ -49,21 +49,39 @@ constexpr int kFitPupilGrid = 12;
 // A field needs at least this many passing rays (each gives two equations for five unknowns); with
 // fewer it keeps the sums.
 constexpr int kMinFitRays = 16;
+// Where fewer rays than this pass the full grid in either model, the grid is laid again over the box
+// around what passes.
+constexpr std::size_t kDenseBelow = 48;
+// Where the real rays reach less than this pupil radius, the spherical term (rho^3) is not fitted.
+constexpr double kSphericalReach = 0.5;
 // Ridge added to the normal equations, relative to their mean diagonal: keeps a term the rays do not
 // see (coma and distortion on the axis) at zero instead of at noise.
 constexpr double kRidge = 1e-9;
 
 
-// The least-squares terms of the real rays of one scene point (see the file comment); false when
-// too few rays pass or the system is singular.
-bool fit_field(const ExactModel& exact, const SeidelRayGeometry& geometry, const ScenePoint& point, double wavelength_nm,
-               const std::vector<PupilPoint>& pupil, std::vector<SensorHit>& hits, FieldTerms& out) {
+// The points of a kFitPupilGrid x kFitPupilGrid grid of equal cells over [x0, x1] x [y0, y1] that lie
+// in the unit pupil.
+void pupil_grid(double x0, double x1, double y0, double y1, std::vector<PupilPoint>& out) {
+  out.clear();
+  for (int i = 0; i < kFitPupilGrid; ++i) {
+    for (int j = 0; j < kFitPupilGrid; ++j) {
+      const PupilPoint q{x0 + (x1 - x0) * (i + 0.5) / kFitPupilGrid, y0 + (y1 - y0) * (j + 0.5) / kFitPupilGrid};
+      if (q.x * q.x + q.y * q.y <= 1.0) out.push_back(q);
+    }
+  }
+}
+
+// The least-squares terms of the real rays `hits` of one scene point through `pupil` (see the file
+// comment); false when too few rays pass or the system is singular.
+bool fit_field(const SeidelRayGeometry& geometry, const std::vector<PupilPoint>& pupil, const std::vector<SensorHit>& hits,
+               FieldTerms& out) {
   using Row = Eigen::Matrix<double, 6, 1>;  // five basis columns and the residual
-  exact.map(point, wavelength_nm, pupil, hits);
   std::vector<Row> rows;
   Row mean_x = Row::Zero(), mean_y = Row::Zero();
+  double reach = 0.0;  // the largest pupil radius that passes
   for (std::size_t p = 0; p < pupil.size(); ++p) {
     if (!hits[p].ok) continue;
+    reach = std::max(reach, std::hypot(pupil[p].x, pupil[p].y));
     double x0, y0;
     geometry.sensor_point(pupil[p], FieldTerms{}, x0, y0);
     Row ax, ay;
@@ -98,6 +116,14 @@ bool fit_field(const ExactModel& exact, const SeidelRayGeometry& geometry, const
     rhs += a * d[5];
   }
   normal.diagonal().array() += kRidge * normal.trace() / 4.0;
+  if (reach < kSphericalReach) {
+    // Over a small patch of the pupil rho^3 is told from rho only by noise, and the model's rays
+    // beyond the patch would carry the difference far: no spherical term.
+    normal.row(0).setZero();
+    normal.col(0).setZero();
+    normal(0, 0) = 1.0;
+    rhs[0] = 0.0;
+  }
   const Eigen::LDLT<Eigen::Matrix4d> solver(normal);
   if (solver.info() != Eigen::Success || !solver.isPositive()) return false;
   const Eigen::Vector4d shape = solver.solve(rhs);
@@ -128,13 +154,8 @@ FittedAberrations::FittedAberrations(const Camera& camera, const ExactModel& exa
   for (int k = 0; k < kFitFields; ++k) fields_.push_back(static_cast<double>(k) / (kFitFields - 1));
   delta_.assign(distances.size() * nodes * fields_.size(), FieldTerms{});
   light_.assign(delta_.size(), 1.0);
-  std::vector<PupilPoint> pupil;
-  for (int i = 0; i < kFitPupilGrid; ++i) {
-    for (int j = 0; j < kFitPupilGrid; ++j) {
-      const PupilPoint q{2.0 * (i + 0.5) / kFitPupilGrid - 1.0, 2.0 * (j + 0.5) / kFitPupilGrid - 1.0};
-      if (q.x * q.x + q.y * q.y <= 1.0) pupil.push_back(q);
-    }
-  }
+  std::vector<PupilPoint> full;
+  pupil_grid(-1.0, 1.0, -1.0, 1.0, full);
   const int tasks = static_cast<int>(distances.size() * nodes);
   int fitted = 0, kept = 0;
 #pragma omp parallel for schedule(dynamic, 1) reduction(+ : fitted, kept)
@@ -145,14 +166,39 @@ FittedAberrations::FittedAberrations(const Camera& camera, const ExactModel& exa
     const FirstOrderSample fo = camera.first_order(s.wavelength_nm);
     // The depth, from the perspective centre, of the table's object distance (from surface 1).
     const double w = inverse_per_mm(s.object_distance_mm + camera.z_perspective_mm());
-    std::vector<SensorHit> hits(pupil.size()), own(pupil.size());
+    std::vector<PupilPoint> pupil;
+    std::vector<SensorHit> hits, own;
     for (std::size_t k = 0; k < fields_.size(); ++k) {
       const ScenePoint point{0.0, fields_[k] * c.max_field_tangent, w};
       const SeidelRayGeometry geometry(camera, fo, point, c.max_field_tangent);
-      FieldTerms fit;
-      const bool ok = fit_field(exact, geometry, point, s.wavelength_nm, pupil, hits, fit);
-      // The light: the same pupil grid through both, so its discretisation cancels in the ratio.
+      // Both models on the full grid; where little passes (a lens opened beyond its clear
+      // apertures), again on a grid over the box around what passes in either.
+      pupil = full;
+      hits.resize(pupil.size());
+      own.resize(pupil.size());
+      exact.map(point, s.wavelength_nm, pupil, hits);
       model(point, s.wavelength_nm, pupil, own);
+      std::size_t passing = 0, own_passing = 0;
+      double x0 = kInfinity, x1 = -kInfinity, y0 = kInfinity, y1 = -kInfinity;
+      for (std::size_t p = 0; p < pupil.size(); ++p) {
+        passing += hits[p].ok;
+        own_passing += own[p].ok;
+        if (!(hits[p].ok || own[p].ok)) continue;
+        x0 = std::min(x0, pupil[p].x), x1 = std::max(x1, pupil[p].x);
+        y0 = std::min(y0, pupil[p].y), y1 = std::max(y1, pupil[p].y);
+      }
+      if ((passing < kDenseBelow || own_passing < kDenseBelow) && x0 <= x1) {
+        const double cell = 2.0 / kFitPupilGrid;
+        pupil_grid(std::max(-1.0, x0 - cell), std::min(1.0, x1 + cell), std::max(-1.0, y0 - cell), std::min(1.0, y1 + cell), pupil);
+        hits.resize(pupil.size());
+        own.resize(pupil.size());
+        exact.map(point, s.wavelength_nm, pupil, hits);
+        model(point, s.wavelength_nm, pupil, own);
+      }
+      FieldTerms fit;
+      const bool ok = fit_field(geometry, pupil, hits, fit);
+      // The light: the same pupil grid (of equal cells) through both, so its discretisation cancels
+      // in the ratio.
       double real_light = 0.0, own_light = 0.0;
       for (std::size_t p = 0; p < pupil.size(); ++p) {
         if (hits[p].ok) real_light += hits[p].weight;
@@ -173,12 +219,12 @@ FittedAberrations::FittedAberrations(const Camera& camera, const ExactModel& exa
   // of 1 over the pupil (ray_model.h); on this grid their ratio there departs from 1 only by how
   // the grid meets the two clipping edges: divide that out per wavelength.
   for (std::size_t n = 0; n < nodes; ++n) {
-    std::vector<SensorHit> hits(pupil.size()), own(pupil.size());
+    std::vector<SensorHit> hits(full.size()), own(full.size());
     const ScenePoint axis{0.0, 0.0, inverse_per_mm(camera.focus_distance_mm())};
-    exact.map(axis, wavelengths_nm_[n], pupil, hits);
-    model(axis, wavelengths_nm_[n], pupil, own);
+    exact.map(axis, wavelengths_nm_[n], full, hits);
+    model(axis, wavelengths_nm_[n], full, own);
     double real_light = 0.0, own_light = 0.0;
-    for (std::size_t p = 0; p < pupil.size(); ++p) {
+    for (std::size_t p = 0; p < full.size(); ++p) {
       if (hits[p].ok) real_light += hits[p].weight;
       if (own[p].ok) own_light += own[p].weight;
     }

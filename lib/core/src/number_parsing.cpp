@@ -22,4 +22,11 @@ std::string format_number(double value) {
   return ec == std::errc() ? std::string(buffer, end) : std::string("?");
 }
 
+std::string format_rounded(double value, int significant_digits) {
+  char buffer[48];
+  const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::general,
+                                       significant_digits < 1 ? 1 : significant_digits > 17 ? 17 : significant_digits);
+  return ec == std::errc() ? std::string(buffer, end) : std::string("?");
+}
+
 }  // namespace lensmith

@@ -82,11 +82,10 @@ void Prescription::validate() const {
         reject_surface(i, "semi_diameter_mm", *s.semi_diameter_mm, "must be finite and > 0");
       }
       // A sphere cannot be wider than its radius: z(r) is undefined for r > |R|.
-      const double c = s.curvature_per_mm;
-      const double kc2 = (1.0 + s.conic) * c * c;
-      if (kc2 > 0.0 && *s.semi_diameter_mm * *s.semi_diameter_mm * kc2 > 1.0 + 1e-12) {
+      const double widest = s.max_semi_diameter_mm();
+      if (*s.semi_diameter_mm > widest * (1.0 + 1e-12)) {
         reject_surface(i, "semi_diameter_mm", *s.semi_diameter_mm,
-                       "larger than the surface allows (" + number(1.0 / std::sqrt(kc2)) + " mm for this radius and conic)");
+                       "larger than the surface allows (" + number(widest) + " mm for this radius and conic)");
       }
     }
     if (!std::isfinite(s.conic)) reject_surface(i, "conic", s.conic, "must be finite");

@@ -1,6 +1,7 @@
 #include "lensmith/prescription/surface.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "lensmith/core/units.h"
@@ -8,6 +9,11 @@
 namespace lensmith {
 
 double Surface::radius_mm() const { return curvature_per_mm == 0.0 ? kInfinity : 1.0 / curvature_per_mm; }
+
+double Surface::max_semi_diameter_mm() const {
+  const double kc2 = (1.0 + conic) * curvature_per_mm * curvature_per_mm;
+  return kc2 > 0.0 ? 1.0 / std::sqrt(kc2) : kInfinity;
+}
 
 bool Surface::has_asphere() const {
   return std::any_of(even_asphere.begin(), even_asphere.end(), [](double a) { return a != 0.0; });

@@ -208,8 +208,14 @@ bool FootprintScatter::clip_rings(const FootprintPlan& p, FootprintScratch& scra
   if (!centre_passes(scratch.discs)) return false;
   if (scratch.reach_of != &outline) disc_reach(meshes_.dense_directions(PupilMeshTable::sector_step_of_mesh(p.mesh)), scratch.discs, scratch.reach);
   scratch.reach_of = &outline;
+  // The rings span what passes: where the discs cut every direction short of the rim (a lens opened
+  // beyond its clear apertures), ring R is the passing region's outline and the others scale to
+  // its largest reach, so that no two rings clip to the same polygon (which would read as a fold).
+  double widest = 0.0;
+  for (double r : scratch.reach) widest = std::max(widest, r);
+  const double span = std::min(1.0, widest);
   for (int k = 1; k <= rings; ++k) {
-    reach_clip(outline, static_cast<double>(k) / rings, scratch.reach, scratch.clipped);
+    reach_clip(outline, span * k / rings, scratch.reach, scratch.clipped);
     pupil.insert(pupil.end(), scratch.clipped.begin(), scratch.clipped.end());
     scratch.ring_offsets.push_back(pupil.size());
     scratch.pupil_areas.push_back(pupil_polygon_area(scratch.clipped));
@@ -282,6 +288,24 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
   // beam is clipped, and the probe maps without clipping (cheaper).
   model_.clip_discs(point, scratch.discs);
   bool any_clipped = !scratch.discs.empty();
+  // The probe's edge points pulled in to the discs' edge where they cut it (star-shaped about the
+  // centre when the centre passes): the footprint's extent and its colour spread are the passing
+  // beam's, not the iris's (a lens opened beyond its clear apertures would otherwise plan meshes and
+  // spectral groups for light that never gets through).
+  if (any_clipped && centre_passes(scratch.discs)) {
+    for (std::size_t i = 1; i < pupil.size(); ++i) {
+      const double length = std::hypot(pupil[i].x, pupil[i].y);
+      if (!(length > 0.0)) continue;
+      const double ux = pupil[i].x / length, uy = pupil[i].y / length;
+      double reach = kInfinity;
+      for (const PupilDisc& d : scratch.discs) {
+        const double b = ux * d.x + uy * d.y;
+        reach = std::min(reach, b + std::sqrt(b * b - (d.x * d.x + d.y * d.y - d.radius * d.radius)));
+      }
+      const double f = std::min(1.0, reach / length);
+      pupil[i] = {pupil[i].x * f, pupil[i].y * f};
+    }
+  }
   for (std::size_t l = 0; l < wavelengths; ++l) {
     if (scratch.discs.empty()) {
       model_.map(point, lambdas[l], pupil, hits);

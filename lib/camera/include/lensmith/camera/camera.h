@@ -66,7 +66,9 @@ class Camera {
   // An ideal thin lens of focal length f (mm) at f-number N; pupils and principal planes at z = 0.
   static Camera thin_lens(double focal_length_mm, const CameraOptions& options, int width_px, int height_px);
   // A real lens (materials resolved). Its first-order data is tabulated at 64 wavelengths from
-  // 380 to 780 nm. Throws ComputationError for afocal lenses or a focus plane the lens cannot image.
+  // 380 to 780 nm. Throws ComputationError for afocal lenses or a focus plane the lens cannot image,
+  // OptionsError for an f-number whose stop would be wider than its surface can be (naming the
+  // fastest f-number the stop allows).
   static Camera from_lens(const Prescription& lens, const CameraOptions& options, int width_px, int height_px);
 
   bool is_thin_lens() const { return !lens_; }
@@ -76,6 +78,12 @@ class Camera {
   const PinholeFrame& frame() const { return frame_; }
   const CameraOptions& options() const { return options_; }
   double f_number() const { return f_number_; }
+  // The lens's own f-number (its prescription's aperture); the thin lens: f_number().
+  double design_f_number() const { return design_f_number_; }
+  // The f-number below which a clear aperture other than the stop starts to clip the axial beam
+  // (first order, the focus plane's marginal ray): opened further, the lens's rims and not the iris
+  // limit the light on the axis. 0 when no other clear aperture is given (and for the thin lens).
+  double fastest_unclipped_f_number() const { return fastest_unclipped_f_number_; }
   double focus_distance_mm() const { return focus_mm_; }
   double reference_wavelength_nm() const { return reference_nm_; }
   double z_sensor_mm() const { return z_sensor_mm_; }
@@ -111,6 +119,8 @@ class Camera {
   PinholeFrame frame_;
   CameraOptions options_;
   double f_number_ = 0.0;
+  double design_f_number_ = 0.0;
+  double fastest_unclipped_f_number_ = 0.0;
   double focus_mm_ = 0.0;
   double reference_nm_ = kWavelengthD_nm;
   std::vector<ParaxialSample> samples_;  // evenly spaced in wavelength (one for a thin lens)

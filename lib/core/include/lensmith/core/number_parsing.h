@@ -15,5 +15,8 @@ std::optional<double> parse_finite_number(std::string_view token);
 // The shortest decimal text that parses back to exactly `value` ("0.1", "-2", "1e-05", "nan", "inf"),
 // for messages that quote a value from the user's file.
 std::string format_number(double value);
+// `value` to at most `significant_digits` (1..17) significant digits, trailing zeros dropped ("2.03",
+// "0.5", "1.2e+06"), for prose that states a computed value.
+std::string format_rounded(double value, int significant_digits);
 
 }  // namespace lensmith
