@@ -5,6 +5,7 @@
 
 #include "lensmith/core/errors.h"
 #include "lensmith/prescription/lens_library.h"
+#include "reference_lenses.h"
 
 using namespace lensmith;
 using Catch::Contains;
@@ -55,4 +56,26 @@ TEST_CASE("prescription: the flagged stop and vertex positions", "[prescription]
   CHECK(*p.flagged_stop_index() == 2);
   // Sum of the first five thicknesses of the Sasian triplet (REFERENCE-VALUES.md section 2).
   CHECK_THAT(p.last_vertex_z_mm(), Catch::Matchers::WithinAbs(4.831 + 5.86 + 0.975 + 4.822 + 3.127, 1e-12));
+}
+
+TEST_CASE("Geometry a glassmaker cannot build is warned about, naming the surfaces; a real lens is not", "[prescription][geometry]") {
+  // A biconvex N-BK7 singlet, R = +/-50 mm, 5 mm thick, 10 mm semi-diameter: the sags at the rim
+  // are +/-1.0102 mm, so the edge is 5 - 2 x 1.0102 = 2.98 mm thick.
+  auto singlet = [](double centre_mm) {
+    Prescription p;
+    p.surfaces = {testing::make_surface(50.0, centre_mm, MaterialSpec::model(1.5168, 64.17), 10.0),
+                  testing::make_surface(-50.0, 40.0, MaterialSpec::air(), 10.0)};
+    return p;
+  };
+  CHECK(singlet(5.0).geometry_warnings().empty());
+  // 1.5 mm at the centre leaves -0.52 mm at the rim: the element's faces cross.
+  const Diagnostics thin = singlet(1.5).geometry_warnings();
+  REQUIRE(thin.size() == 1);
+  CHECK(thin.front().message.find("surfaces 1 and 2 cross") != std::string::npos);
+  CHECK(thin.front().message.find("edge thickness is -0.52") != std::string::npos);
+  const Diagnostics negative = singlet(-2.0).geometry_warnings();
+  REQUIRE(negative.size() == 1);
+  CHECK(negative.front().message.find("surface 1: the glass after it") != std::string::npos);
+  CHECK(negative.front().message.find("negative centre thickness") != std::string::npos);
+  CHECK(sasian().geometry_warnings().empty());
 }

@@ -556,3 +556,19 @@ TEST_CASE("Zemax: extra surface data (XDAT) is refused unless its value is zero"
   const std::string text = mini_zmx("", "  XDAT 3 2.5E-3 0 0\n");
   CHECK(zemax_error(text).where().column == 10);
 }
+
+TEST_CASE("Zemax: a glass missing from the file's GCAT catalogues is taken from another, with a warning naming both", "[prescription][zemax]") {
+  // OpticStudio looks only in the GCAT catalogues. SK4 is no longer in Schott's (N-SK4 is); lensmith
+  // finds an SK4 elsewhere and must say whose, not take it silently.
+  std::string text = mini_zmx();
+  const std::string bk7 = "GLAS N-BK7";
+  text.replace(text.find(bk7), bk7.size(), "GLAS SK4");
+  const LensReadResult r = read_zemax(text, "t.zmx");
+  REQUIRE(r.diagnostics.size() == 1);
+  const std::string message = r.diagnostics.front().message;
+  INFO(message);
+  CHECK(message.find("\"SK4\" is in none of the file's GCAT catalogues (SCHOTT)") != std::string::npos);
+  CHECK(message.find("using " + r.prescription.surfaces[1].material.vendor) != std::string::npos);
+  // In its GCAT catalogue: no warning.
+  CHECK(read_zemax(mini_zmx(), "t.zmx").diagnostics.empty());
+}

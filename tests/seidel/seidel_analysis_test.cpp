@@ -97,6 +97,21 @@ TEST_CASE("Seidel: the Sasian triplet's wavefront, transverse and curvature form
   CHECK_THAT(f.petzval_per_mm, WithinAbs(0.007014, kCurvature));
 }
 
+TEST_CASE("Seidel: on the axis (field 0) the field curvatures are still the lens's, ray-optics' values", "[seidel]") {
+  // Petzval, sagittal and tangential curvature do not depend on the field (S_III and S_IV grow as
+  // H^2); at field 0 both are 0 and the ratio must come from the lens, not be 0 / 0.
+  SeidelOptions axis;
+  axis.field_angle_deg = 0.0;
+  const SeidelAnalysis s(testing::sasian_triplet(), axis);
+  CHECK(s.lagrange_invariant() == 0.0);
+  const FieldCurvatures f = s.field_curvatures();
+  constexpr double kCurvature = 5e-7;  // ray-optics prints 6 decimals
+  CHECK_THAT(f.tangential_per_mm, WithinAbs(0.000734, kCurvature));
+  CHECK_THAT(f.sagittal_per_mm, WithinAbs(0.004921, kCurvature));
+  CHECK_THAT(f.petzval_per_mm, WithinAbs(0.007014, kCurvature));
+  CHECK(std::isfinite(f.petzval_radius_mm()));
+}
+
 TEST_CASE("Seidel: Smith's Cooke triplet, surface by surface, in Smith's transverse forms", "[seidel]") {
   const SeidelAnalysis s(testing::smith_cooke_triplet());
   // Smith's transverse forms divide by 2 n'u' (n'u' for colour) of the final image space.

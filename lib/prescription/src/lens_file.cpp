@@ -52,7 +52,25 @@ LensFormat lens_format_from_path(const std::string& path) {
                                         "\"; expected .json (lensmith or lentil), .zmx (Zemax) or .dat (pbrt)");
 }
 
+namespace {
+
+LensReadResult read_any(const std::string& path_with_id, const GlassCatalog& catalogue);
+
+}  // namespace
+
 LensReadResult read_lens_file(const std::string& path_with_id, const GlassCatalog& catalogue) {
+  LensReadResult result = read_any(path_with_id, catalogue);
+  const std::string path = path_with_id.substr(0, path_with_id.rfind('#'));
+  for (Diagnostic d : result.prescription.geometry_warnings()) {
+    d.where.file = path;
+    result.diagnostics.push_back(std::move(d));
+  }
+  return result;
+}
+
+namespace {
+
+LensReadResult read_any(const std::string& path_with_id, const GlassCatalog& catalogue) {
   std::string path = path_with_id;
   std::string entry_id;
   if (auto hash = path_with_id.rfind('#'); hash != std::string::npos && lower_extension(path_with_id.substr(0, hash)) == ".json") {
@@ -80,5 +98,7 @@ LensReadResult read_lens_file(const std::string& path_with_id, const GlassCatalo
   }
   throw LensFileError({path, 0, 0}, "unsupported lens format");
 }
+
+}  // namespace
 
 }  // namespace lensmith

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "lensmith/core/errors.h"
+#include "lensmith/core/number_parsing.h"
 
 namespace lensmith {
 
@@ -66,6 +67,32 @@ double Prescription::vertex_z_mm(std::size_t surface_index) const {
 }
 
 double Prescription::last_vertex_z_mm() const { return surfaces.empty() ? 0.0 : vertex_z_mm(surfaces.size() - 1); }
+
+Diagnostics Prescription::geometry_warnings() const {
+  Diagnostics out;
+  auto warn = [&out](const std::string& message) { out.push_back({Diagnostic::Severity::Warning, {}, message}); };
+  // Tolerance for a crossing at the edge (mm): the rounding of thicknesses and radii in lens files.
+  constexpr double kEdgeToleranceMm = 1e-4;
+  for (std::size_t i = 0; i + 1 < surfaces.size(); ++i) {
+    const Surface& s = surfaces[i];
+    const Surface& next = surfaces[i + 1];
+    const bool glass = s.material.kind != MaterialSpec::Kind::Air;
+    if (glass && s.thickness_mm < 0.0) {
+      warn("surface " + std::to_string(i + 1) + ": the glass after it (" + s.material.to_string() + ") has a negative centre thickness, " +
+           format_rounded(s.thickness_mm, 4) + " mm: no element can be made so");
+      continue;
+    }
+    if (!s.semi_diameter_mm || !next.semi_diameter_mm) continue;
+    const double r = std::min(*s.semi_diameter_mm, *next.semi_diameter_mm);
+    const double edge = s.thickness_mm + next.sag_mm(r) - s.sag_mm(r);
+    if (std::isfinite(edge) && edge < -kEdgeToleranceMm && s.thickness_mm >= 0.0) {
+      warn("surfaces " + std::to_string(i + 1) + " and " + std::to_string(i + 2) + " cross within their clear apertures: at r = " +
+           format_rounded(r, 4) + " mm " + (glass ? "the element's edge thickness is " : "the air space between them is ") + format_rounded(edge, 3) +
+           " mm (" + (glass ? "an element thinner than nothing at its rim" : "the elements overlap") + ")");
+    }
+  }
+  return out;
+}
 
 void Prescription::validate() const {
   if (surfaces.empty()) throw PrescriptionError("surfaces: a lens needs at least one surface");

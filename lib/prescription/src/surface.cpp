@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 
 #include "lensmith/core/units.h"
@@ -13,6 +14,17 @@ double Surface::radius_mm() const { return curvature_per_mm == 0.0 ? kInfinity :
 double Surface::max_semi_diameter_mm() const {
   const double kc2 = (1.0 + conic) * curvature_per_mm * curvature_per_mm;
   return kc2 > 0.0 ? 1.0 / std::sqrt(kc2) : kInfinity;
+}
+
+double Surface::sag_mm(double r_mm) const {
+  const double c = curvature_per_mm;
+  const double u = r_mm * r_mm;
+  const double d = 1.0 - (1.0 + conic) * c * c * u;
+  if (d < 0.0) return std::numeric_limits<double>::quiet_NaN();
+  double poly = 0.0;
+  for (std::size_t j = even_asphere.size(); j-- > 0;) poly = poly * u + even_asphere[j];
+  // c u / (1 + sqrt(d)): the conic's sag without cancellation near the vertex.
+  return c * u / (1.0 + std::sqrt(d)) + u * poly;
 }
 
 bool Surface::has_asphere() const {

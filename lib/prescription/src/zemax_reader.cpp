@@ -631,6 +631,13 @@ class ZemaxParser {
     }
     if (upper == "AIR") return MaterialSpec::air();
     if (const Glass* found = catalogue_.find(g.name, {}, vendor_order_)) {
+      if (!vendor_order_.empty() && std::find(vendor_order_.begin(), vendor_order_.end(), found->vendor()) == vendor_order_.end()) {
+        // OpticStudio would look in the GCAT catalogues only; say what was taken instead.
+        std::string listed;
+        for (const std::string& v : vendor_order_) listed += (listed.empty() ? "" : ", ") + v;
+        warn(g.line, "glass \"" + g.name + "\" is in none of the file's GCAT catalogues (" + listed + "); using " + found->vendor() +
+                         "'s " + found->name() + " (nd " + format_rounded(found->nd(), 6) + ", Vd " + format_rounded(found->vd(), 4) + ")");
+      }
       return MaterialSpec::catalog(found->name(), found->vendor());
     }
     const bool placeholder = g.nd && g.vd && *g.nd == kPlaceholderNd && *g.vd == kPlaceholderVd;

@@ -184,6 +184,23 @@ SeidelAnalysis::SeidelAnalysis(const Prescription& lens, const SeidelOptions& op
   }
   image_slope_ = u;
   image_index_ = n;
+  if (H != 0.0) {
+    const double h2 = H * H;
+    curvatures_ = {(3.0 * sums_.S3 + sums_.S4) / h2, (sums_.S3 + sums_.S4) / h2, sums_.S4 / h2};
+  } else {
+    // S_III and S_IV grow as H^2 (S_IV = -H^2 c (1/n' - 1/n) per surface): the curvatures do not
+    // depend on the field, but on the axis both are 0. Take them from a nominal field (1 degree, or
+    // 1 mm of object height for a near object); the paraxial rays are linear in it.
+    SeidelOptions nominal = options;
+    if (std::isinf(paraxial_.object_distance_mm())) {
+      nominal.field_angle_deg = 1.0;
+      nominal.object_height_mm.reset();
+    } else {
+      nominal.object_height_mm = 1.0;
+      nominal.field_angle_deg.reset();
+    }
+    curvatures_ = SeidelAnalysis(lens, nominal).field_curvatures();
+  }
 }
 
 WavefrontCoefficients SeidelAnalysis::wavefront() const {
@@ -218,10 +235,7 @@ LongitudinalAberrations SeidelAnalysis::longitudinal() const {
   return {t.TSA * k, t.TAS * k, t.SAS * k, t.PTB * k, t.TAX * k};
 }
 
-FieldCurvatures SeidelAnalysis::field_curvatures() const {
-  const double h2 = lagrange_ * lagrange_;
-  return {(3.0 * sums_.S3 + sums_.S4) / h2, (sums_.S3 + sums_.S4) / h2, sums_.S4 / h2};
-}
+FieldCurvatures SeidelAnalysis::field_curvatures() const { return curvatures_; }
 
 std::string SeidelAnalysis::to_string() const {
   std::ostringstream os;

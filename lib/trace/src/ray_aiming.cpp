@@ -62,15 +62,9 @@ constexpr double kMaxContinuationStep = 0.5;
 constexpr double kMinContinuationStep = 1.0 / 1024.0;
 constexpr int kCorrectorIterations = 12;
 
-// The sag of a surface at radius r (conic + even asphere); false outside its domain.
+// The sag of a surface at radius r (Surface::sag_mm); false outside its domain.
 bool surface_sag(const Surface& s, double r_mm, double& sag_mm) {
-  const double c = s.curvature_per_mm;
-  const double u = r_mm * r_mm;
-  const double d = 1.0 - (1.0 + s.conic) * c * c * u;
-  if (d < 0.0) return false;
-  double poly = 0.0;
-  for (std::size_t j = s.even_asphere.size(); j-- > 0;) poly = poly * u + s.even_asphere[j];
-  sag_mm = c * u / (1.0 + std::sqrt(d)) + u * poly;
+  sag_mm = s.sag_mm(r_mm);
   return std::isfinite(sag_mm);
 }
 

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "lensmith/core/diagnostic.h"
 #include "lensmith/core/units.h"
 #include "lensmith/prescription/material.h"
 #include "lensmith/prescription/surface.h"
@@ -79,6 +80,12 @@ struct Prescription {
   // field only for a finite object, wavelengths in (100, 20000) nm, primary index in range,
   // object distance > 0.
   void validate() const;
+  // What a glassmaker could not build, as warnings naming the surfaces (validate() accepts it: a
+  // negative air space is a legitimate way to write some designs): a glass element of negative
+  // centre thickness, and consecutive surfaces that cross within their common clear aperture (a
+  // negative edge thickness: an element or two elements overlapping). Needs semi-diameters for the
+  // edge check; surfaces without one are checked at the vertex only.
+  Diagnostics geometry_warnings() const;
 
   // Resolves every MaterialSpec against `catalogue` (throws GlassError with the surface number).
   void resolve_materials(const GlassCatalog& catalogue);

@@ -31,6 +31,9 @@ struct Surface {
   // The largest semi-diameter the conic's sag is defined for (mm): 1 / sqrt((1 + k) c^2) where
   // (1 + k) c^2 > 0 (a sphere: |R|), else +infinity.
   double max_semi_diameter_mm() const;
+  // The sag z(r) of the conic plus even asphere at radius r (mm), measured from the vertex along
+  // +z; NaN where the conic is undefined (r beyond max_semi_diameter_mm()).
+  double sag_mm(double r_mm) const;
   bool is_plane() const { return curvature_per_mm == 0.0 && !has_asphere(); }
   bool has_asphere() const;          // any non-zero even-asphere coefficient
   // Curvature that paraxial optics sees: c + 2 a2 (1/mm).

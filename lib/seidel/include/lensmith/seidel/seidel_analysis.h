@@ -116,6 +116,7 @@ class SeidelAnalysis {
   std::vector<SeidelSums> aspheric_;
   SeidelSums sums_;
   double lagrange_ = 0.0;
+  FieldCurvatures curvatures_;  // from the sums, or (on the axis, H = 0) from a nominal field
   double image_slope_ = 0.0;
   double image_index_ = 1.0;
 };
