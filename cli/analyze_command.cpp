@@ -144,7 +144,7 @@ int run_analyze(const AnalyzeCommandOptions& options, const GlobalOptions& globa
     if (options.grid) o.pupil_grid = *options.grid;
     return report(compute_relative_illumination(context, o), options, global, illumination_json, plot::plot_relative_illumination);
   }
-  throw OptionsError("--what " + what + ": must be distortion, field-curves, focal-shift, illumination or pupil");
+  throw UsageError("--what " + what + ": must be distortion, field-curves, focal-shift, illumination or pupil");
 }
 
 }  // namespace lensmith::cli

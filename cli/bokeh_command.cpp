@@ -7,10 +7,12 @@
 #include <iomanip>
 #include <iostream>
 #include <limits>
+#include <sstream>
 
 #include "commands.h"
 #include "progress_bar.h"
 #include "lensmith/core/errors.h"
+#include "lensmith/core/number_parsing.h"
 #include "lensmith/core/units.h"
 #include "lensmith/paraxial/paraxial_system.h"
 #include "lensmith/render/bokeh_renderer.h"
@@ -45,6 +47,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   std::vector<std::filesystem::path> inputs{o.image, depth_source.file};
   if (!o.aperture_image.empty()) inputs.emplace_back(o.aperture_image);
   ensure_not_an_input(output, inputs);
+  ensure_writable_location(output);
   RadianceReadOptions read;
   read.highlight_gain = o.highlight_gain;
   read.highlight_threshold = o.highlight_threshold;
@@ -63,13 +66,13 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   std::optional<Camera> cam;
   if (o.thin_lens) {
     if (kind != RayModelKind::Thin) {
-      throw OptionsError("--thin-lens has no prescription: only --model thin applies (got --model " + o.model + ")");
+      throw UsageError("--thin-lens has no prescription: only --model thin applies (got --model " + o.model + ")");
     }
-    if (!o.focal_length_mm) throw OptionsError("--thin-lens needs --focal-length MM");
+    if (!o.focal_length_mm) throw UsageError("--thin-lens needs --focal-length MM");
     cam = Camera::thin_lens(*o.focal_length_mm, camera, image.width, image.height);
     lens_name = "thin lens f = " + std::to_string(*o.focal_length_mm) + " mm";
   } else {
-    if (o.lens.empty()) throw OptionsError("give --lens LENS (a file or shipped lens name) or --thin-lens --focal-length MM");
+    if (o.lens.empty()) throw UsageError("give --lens LENS (a file or shipped lens name) or --thin-lens --focal-length MM");
     const Prescription lens = load_lens(o.lens, global);
     lens_name = lens.name.empty() ? o.lens : lens.name;
     if (kind == RayModelKind::Thin) {
@@ -93,7 +96,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   model_options.nearest_depth_m = std::isfinite(nearest_m) ? std::max(0.01, static_cast<double>(nearest_m)) : 1.0;
   model_options.seidel_coefficients = parse_seidel_coefficients(o.seidel_coefficients);
   if (!o.thin_lens) model_options.fit = fit_for_models({kind}, *cam, o.fit, global);
-  else if (!o.fit.empty()) throw OptionsError("--fit is for --model poly with --lens");
+  else if (!o.fit.empty()) throw UsageError("--fit is for --model poly with --lens");
   const auto model = make_ray_model(kind, *cam, model_options);
   const Aperture aperture = make_aperture(o);
 
@@ -129,11 +132,17 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   if (kind == RayModelKind::Seidel) meta.extra.emplace_back("seidel_coefficients", o.seidel_coefficients);
   write_output_image(output, out, meta);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  std::cout << "wrote " << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed
-            << std::setprecision(2) << seconds << " s (rendering " << render_seconds << " s)\n"
-            << "  lens " << lens_name << ", model " << to_string(kind) << ", f/" << std::setprecision(2) << cam->f_number()
-            << ", focus " << std::setprecision(3) << o.focus_m << " m, aperture " << aperture.to_string() << "\n"
-            << "  " << stats.to_string() << "\n";
+  std::ostringstream what;
+  what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds
+       << " s (rendering " << render_seconds << " s)\n  " << lens_name << ", model " << to_string(kind) << ", f/"
+       << format_rounded(cam->f_number(), 3) << ", focus " << format_rounded(o.focus_m, 4) << " m, " << aperture.to_string()
+       << " aperture\n  " << stats.layers << " depth layers " << format_rounded(stats.layer_spacing_px, 3) << " px apart, largest blur "
+       << format_rounded(stats.max_abs_coc_px, 3) << " px; " << stats.footprints << " footprints";
+  if (stats.triangles > 0) what << " (" << stats.triangles << " triangles)";
+  what << "; " << stats.hidden_sources << " hidden background pixels filled in, " << stats.split_edge_pixels
+       << " edge pixels split between two surfaces";
+  if (stats.clamped_depths > 0) what << "; " << stats.clamped_depths << " pixels nearer than the lens serves (or beyond --max-blur) clamped";
+  report_written(what.str(), global);
   return kExitOk;
 }
 

@@ -238,6 +238,10 @@ void print_diagnostics(const Diagnostics& diagnostics, const GlobalOptions& glob
 // pass whole.
 void warn_about_aperture(const Camera& camera, const GlobalOptions& global);
 
+// "wrote WHAT" on stderr unless quiet: every command reports the files it wrote there, the same
+// way (stdout carries the command's results, and its JSON).
+void report_written(const std::string& what, const GlobalOptions& global);
+
 // Loads LENS (a file path or a shipped lens name) and prints its warnings.
 Prescription load_lens(const std::string& lens, const GlobalOptions& global);
 

@@ -17,7 +17,7 @@ std::shared_ptr<const LensFit> fit_for_models(const std::vector<RayModelKind>& m
                                               const std::string& fit_file, const GlobalOptions& global) {
   const Prescription& lens = *camera.lens();
   if (std::find(models.begin(), models.end(), RayModelKind::Poly) == models.end()) {
-    if (!fit_file.empty()) throw OptionsError("--fit is for --model poly");
+    if (!fit_file.empty()) throw UsageError("--fit is for --model poly");
     return nullptr;
   }
   if (!fit_file.empty()) {
@@ -100,7 +100,7 @@ int run_fit(const FitCommandOptions& o, const GlobalOptions& global) {
             << std::setprecision(2) << "Time: fit " << t.fit_seconds << " s; per ray (one thread, sensor -> outer) exact "
             << std::setprecision(1) << t.exact_ns_per_ray << " ns, polynomial " << t.poly_ns_per_ray << " ns ("
             << speedup << "x faster)\n";
-  if (!o.output.empty()) std::cout << "Wrote " << o.output << "\n";
+  if (!o.output.empty()) report_written(o.output, global);
   return kExitOk;
 }
 

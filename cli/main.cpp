@@ -2,9 +2,12 @@
 // exceptions to the exit codes documented in docs/cli.md (pbrt-v4 cmd/pbrt.cpp does the same).
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <iostream>
+#include <string_view>
 
 #include "commands.h"
+#include "json_output.h"
 #include "lensmith/core/number_parsing.h"
 #include "lensmith/core/errors.h"
 #include "lensmith/prescription/lens_library.h"
@@ -20,6 +23,10 @@ Prescription load_lens(const std::string& lens, const GlobalOptions& global) {
   LensReadResult result = LensLibrary::load_path_or_name(lens);
   print_diagnostics(result.diagnostics, global);
   return std::move(result.prescription);
+}
+
+void report_written(const std::string& what, const GlobalOptions& global) {
+  if (!global.quiet) std::cerr << "wrote " << what << "\n";
 }
 
 void warn_about_aperture(const Camera& camera, const GlobalOptions& global) {
@@ -38,6 +45,36 @@ void warn_about_aperture(const Camera& camera, const GlobalOptions& global) {
   } else {
     std::cerr << ": its aberrations at this aperture were not corrected by its designer (expect a softer, hazier picture)\n";
   }
+}
+
+// Numeric checks whose messages read as prose: "must be > 0, got -1", "must be between 0.5 and 512,
+// got 600" (CLI11's own print the limits with six decimals, or 309 digits for "no limit").
+CLI::Validator positive() {
+  return CLI::Validator(
+      [](std::string& text) {
+        double v = 0.0;
+        return CLI::detail::lexical_cast(text, v) && v > 0.0 && std::isfinite(v) ? std::string() : "must be > 0, got " + text;
+      },
+      "> 0", "positive");
+}
+// lo < value < hi.
+CLI::Validator open_range(double lo, double hi) {
+  const std::string limits = "between " + format_rounded(lo, 8) + " and " + format_rounded(hi, 8) + " (exclusive)";
+  return CLI::Validator(
+      [lo, hi, limits](std::string& text) {
+        double v = 0.0;
+        return CLI::detail::lexical_cast(text, v) && v > lo && v < hi ? std::string() : "must be " + limits + ", got " + text;
+      },
+      format_rounded(lo, 8) + " < x < " + format_rounded(hi, 8), "open range");
+}
+CLI::Validator range(double lo, double hi) {
+  const std::string limits = format_rounded(lo, 8) + " to " + format_rounded(hi, 8);
+  return CLI::Validator(
+      [lo, hi, limits](std::string& text) {
+        double v = 0.0;
+        return CLI::detail::lexical_cast(text, v) && v >= lo && v <= hi ? std::string() : "must be " + limits + ", got " + text;
+      },
+      limits, "range");
 }
 
 // A focus distance: metres > 0, or inf (CLI11's PositiveNumber refuses infinity).
@@ -65,10 +102,10 @@ int main(int argc, char** argv) {
   CLI::App* info_cmd = app.add_subcommand("info", "First-order (paraxial) optics of a lens: focal lengths, cardinal points, pupils, f-number, ray tables");
   info_cmd->add_option("lens", info.lens, "Lens file (.json, .zmx, .dat, lentil.json#ID) or shipped lens name (see `lensmith lenses`)")->required();
   info_cmd->add_option("-w,--wavelength", info.wavelength_nm, "Wavelength, nm (default: the lens's primary wavelength; range 100-20000)")
-      ->check(CLI::Range(100.0, 20000.0));
+      ->check(range(100.0, 20000.0));
   info_cmd->add_option("-d,--object-distance", info.object_distance_m,
                        "Distance from the object to the first lens vertex, metres (default: the lens's, usually infinity; > 0)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   info_cmd->add_flag("--json", info.json, "Print one JSON object (schema: docs/cli.md)");
   info_cmd->add_flag("--spectral", info.spectral, "Also print first-order values at 64 wavelengths from 380 to 780 nm");
 
@@ -82,7 +119,7 @@ int main(int argc, char** argv) {
   convert_cmd->add_option("lens", convert.lens, "Lens file or shipped lens name")->required();
   convert_cmd->add_option("-o,--output", convert.output, "Output .json file (written atomically; never the input)")->required();
   convert_cmd->add_option("--scale-to-efl", convert.scale_to_efl_mm, "Scale every length so the EFL becomes this, mm (> 0)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
 
   // Real-ray analyses (docs/cli.md, docs/analysis.md).
   const std::string lens_help = "Lens file (.json, .zmx, .dat, lentil.json#ID) or shipped lens name (see `lensmith lenses`)";
@@ -98,18 +135,18 @@ int main(int argc, char** argv) {
   trace_cmd->add_option("lens", trace.lens, lens_help)->required();
   CLI::Option* trace_angle = trace_cmd->add_option("--field-angle", trace.field_angle_deg,
                                                    "Object-space field angle along y, degrees (default 0; -90 < DEG < 90)")
-                                 ->check(CLI::Range(-89.999999, 89.999999));
+                                 ->check(open_range(-90.0, 90.0));
   CLI::Option* trace_height = trace_cmd->add_option("--object-height", trace.object_height_mm,
                                                     "Object height along y for a finite object, mm (instead of --field-angle)");
   CLI::Option* trace_relative = trace_cmd->add_option("--field", trace.relative_field,
                                                       "Field as a fraction of the lens's maximum field, 0 to 1 (instead of --field-angle)")
-                                    ->check(CLI::Range(0.0, 1.0));
+                                    ->check(range(0.0, 1.0));
   trace_angle->excludes(trace_height)->excludes(trace_relative);
   trace_height->excludes(trace_relative);
   trace_cmd->add_option("--pupil", trace.pupil, "Normalised pupil coordinate PX,PY in the unit disc (default 0,0: the chief ray)")
       ->check(pupil_check);
   trace_cmd->add_option("-w,--wavelength", trace.wavelength_nm, "Wavelength, nm (default: the lens's primary; 100-20000)")
-      ->check(CLI::Range(100.0, 20000.0));
+      ->check(range(100.0, 20000.0));
   trace_cmd->add_option("--image", trace.image, "Image plane: prescribed (the lens's last thickness) or paraxial (paraxial focus)")
       ->check(image_words);
   trace_cmd->add_option("--aim", trace.aim, aim_help)->check(aim_words);
@@ -120,13 +157,13 @@ int main(int argc, char** argv) {
     cmd->add_option("lens", o.lens, lens_help)->required();
     cmd->add_option("--fields", o.relative_fields, "Fields as fractions of the maximum field, comma separated, each 0 to 1 (default 0,0.7,1)")
         ->delimiter(',')
-        ->check(CLI::Range(0.0, 1.0));
+        ->check(range(0.0, 1.0));
     cmd->add_option("--field-angle", o.field_angle_deg,
                     "The object-space half field angle that field 1 means, degrees (0 < DEG < 90; default: the lens's field)")
-        ->check(CLI::Range(1e-9, 89.999999));
+        ->check(open_range(0.0, 90.0));
     cmd->add_option("-w,--wavelength", o.wavelengths_nm, "Wavelengths, nm, repeated or comma separated (default: the lens's; 100-20000)")
         ->delimiter(',')
-        ->check(CLI::Range(100.0, 20000.0));
+        ->check(range(100.0, 20000.0));
     cmd->add_option("--image", o.image, "Image plane: prescribed (the lens's last thickness) or paraxial (paraxial focus)")
         ->check(image_words);
     cmd->add_option("--aim", o.aim, aim_help)->check(aim_words);
@@ -138,9 +175,9 @@ int main(int argc, char** argv) {
   CLI::App* spot_cmd = app.add_subcommand("spot", "Spot diagrams per field and wavelength with RMS and GEO radii");
   add_real_ray_options(spot_cmd, spot.common);
   CLI::Option* spot_rings = spot_cmd->add_option("--rings", spot.rings, "Hexapolar rings (1 + 3 N (N + 1) rays; default 6 = 127 rays; 1-200)")
-                                ->check(CLI::Range(1, 200));
+                                ->check(range(1, 200));
   CLI::Option* spot_random = spot_cmd->add_option("--random", spot.random_rays, "Uniform random pupil points instead, this many (1-1000000)")
-                                 ->check(CLI::Range(1, 1000000));
+                                 ->check(range(1, 1000000));
   spot_cmd->add_option("--seed", spot.seed, "Seed of --random (default 1; the same seed gives the same rays everywhere)")->needs(spot_random);
   spot_rings->excludes(spot_random);
 
@@ -148,14 +185,14 @@ int main(int argc, char** argv) {
   CLI::App* seidel_cmd = app.add_subcommand("seidel", "Third-order (Seidel) aberrations per surface and summed, and Born & Wolf's B..F");
   seidel_cmd->add_option("lens", seidel.lens, "Lens file or shipped lens name")->required();
   seidel_cmd->add_option("-w,--wavelength", seidel.wavelength_nm, "Wavelength, nm (default: the lens's primary; 100-20000)")
-      ->check(CLI::Range(100.0, 20000.0));
+      ->check(range(100.0, 20000.0));
   seidel_cmd->add_option("-d,--object-distance", seidel.object_distance_m, "Object to first vertex, metres (default: the lens's; > 0)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   seidel_cmd->add_option("--field-angle", seidel.field_angle_deg, "Maximum field angle, degrees (default: the lens's; 0-89.9)")
-      ->check(CLI::Range(0.0, 89.9));
+      ->check(range(0.0, 89.9));
   CLI::Option* seidel_epd = seidel_cmd->add_option("--epd", seidel.epd_mm, "Entrance-pupil diameter, mm (default: the lens's aperture; > 0)")
-                                ->check(CLI::PositiveNumber);
-  seidel_cmd->add_option("--fstop", seidel.f_number, "Image-space F/# = EFL/EPD instead of --epd (> 0)")->check(CLI::PositiveNumber)->excludes(seidel_epd);
+                                ->check(positive());
+  seidel_cmd->add_option("--fstop", seidel.f_number, "Image-space F/# = EFL/EPD instead of --epd (> 0)")->check(positive())->excludes(seidel_epd);
   seidel_cmd->add_option("--png", seidel.png, "Also write the Seidel diagram (per-surface bar chart) to this PNG");
   seidel_cmd->add_flag("--json", seidel.json, "Print one JSON object (schema: docs/cli.md)");
 
@@ -163,7 +200,14 @@ int main(int argc, char** argv) {
   CLI::App* fan_cmd = app.add_subcommand("fan", "Transverse ray fans (ey against py, ex against px) per field and wavelength");
   add_real_ray_options(fan_cmd, fan.common);
   fan_cmd->add_option("--samples", fan.samples, "Pupil points per fan from -1 to 1, odd (default 41; 3-1001)")
-      ->check(CLI::Range(3, 1001));
+      ->check(range(3, 1001))
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            int n = 0;
+            return CLI::detail::lexical_cast(text, n) && n % 2 == 1 ? std::string()
+                                                                     : "must be odd, so that the chief ray (py = 0) is traced; got " + text;
+          },
+          "ODD", "odd count"));
 
   AnalyzeCommandOptions analyze;
   CLI::App* analyze_cmd = app.add_subcommand(
@@ -174,9 +218,9 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"distortion", "field-curves", "focal-shift", "illumination", "pupil"}));
   analyze_cmd->add_option("--samples", analyze.samples,
                           "Field samples from 0 to 1 (default 21), or wavelength samples for focal-shift (default 41); 2-1001")
-      ->check(CLI::Range(2, 1001));
+      ->check(range(2, 1001));
   analyze_cmd->add_option("--grid", analyze.grid, "Pupil grid cells across the diameter for illumination and pupil (default 64; 8-1024)")
-      ->check(CLI::Range(8, 1024));
+      ->check(range(8, 1024));
 
   BokehCommandOptions bokeh;
   CLI::App* bokeh_cmd = app.add_subcommand(
@@ -186,25 +230,25 @@ int main(int argc, char** argv) {
   bokeh_cmd->add_option("--depth-kind", bokeh.depth_kind, "z (planar, default) | distance (from the camera) | inverse (1/z)")
       ->check(CLI::IsMember({"z", "distance", "inverse"}));
   bokeh_cmd->add_option("--depth-unit", bokeh.depth_unit, "m (default) | cm | mm")->check(CLI::IsMember({"m", "cm", "mm"}));
-  bokeh_cmd->add_option("--invalid-depth", bokeh.invalid_depth, "NaN or negative depth: error (default) | far | near")
+  bokeh_cmd->add_option("--invalid-depth", bokeh.invalid_depth, "Depth pixels that are NaN, infinite-negative, zero or negative (inverse depth: NaN or negative): error naming the pixel (default) | far (infinitely far) | near (the nearest valid depth)")
       ->check(CLI::IsMember({"error", "far", "near"}));
   bokeh_cmd->add_option("-o,--output", bokeh.output, "Output: .exr (float, with metadata) or .png/.jpg/.tif (sRGB)")->required();
   CLI::Option* bokeh_lens = bokeh_cmd->add_option("--lens", bokeh.lens, "Lens file or shipped lens name (lensmith lenses)");
   CLI::Option* bokeh_thin = bokeh_cmd->add_flag("--thin-lens", bokeh.thin_lens, "An ideal thin lens instead of a prescription");
   bokeh_thin->excludes(bokeh_lens);
-  bokeh_cmd->add_option("--focal-length", bokeh.focal_length_mm, "Thin-lens focal length, mm (> 0)")->check(CLI::PositiveNumber)->needs(bokeh_thin);
-  bokeh_cmd->add_option("--fstop", bokeh.f_number, "f-number (default: the lens's own; 0.5-512)")->check(CLI::Range(0.5, 512.0));
-  bokeh_cmd->add_option("--focus", bokeh.focus_m, "Focus distance, metres from the camera (> 0; inf for infinity)")->required()
+  bokeh_cmd->add_option("--focal-length", bokeh.focal_length_mm, "Thin-lens focal length, mm (> 0)")->check(positive())->needs(bokeh_thin);
+  bokeh_cmd->add_option("--fstop", bokeh.f_number, "f-number (default: the lens's own; 0.5-512)")->check(range(0.5, 512.0));
+  bokeh_cmd->add_option("--focus", bokeh.focus_m, "Focus distance, metres from the lens's entrance pupil (the perspective centre; > 0, inf for infinity)")->required()
       ->check(focus_distance_check());
   bokeh_cmd->add_option("--sensor-width", bokeh.sensor_width_mm, "Sensor width of the input image's pinhole camera, mm (default 36)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   CLI::Option* bokeh_pf = bokeh_cmd->add_option("--pinhole-focal-length", bokeh.pinhole_focal_length_mm,
                                                 "Focal length of the input's pinhole camera, mm (default: the lens EFL)")
-                              ->check(CLI::PositiveNumber);
+                              ->check(positive());
   bokeh_cmd->add_option("--hfov", bokeh.hfov_deg, "Horizontal field of view of the input image, degrees (instead of the focal length)")
-      ->check(CLI::Range(0.01, 179.99))->excludes(bokeh_pf);
+      ->check(range(0.01, 179.99))->excludes(bokeh_pf);
   CLI::Option* bokeh_blades = bokeh_cmd->add_option("--blades", bokeh.blades, "Straight iris blades (3-64; default: a circular iris)")
-                                  ->check(CLI::Range(3, 64));
+                                  ->check(range(3, 64));
   bokeh_cmd->add_option("--blade-rotation", bokeh.blade_rotation_deg, "Rotation of the blade polygon, degrees")->needs(bokeh_blades);
   bokeh_cmd->add_option("--aperture-image", bokeh.aperture_image, "Aperture transmission from a picture over the pupil square")
       ->excludes(bokeh_blades);
@@ -225,24 +269,24 @@ int main(int argc, char** argv) {
                       "(the bokeh keeps its cat's-eye shape)");
   bokeh_cmd->add_flag("--no-spectral", bokeh.no_spectral, "Trace every ray at 587.6 nm and keep RGB as it is (no colour fringes)");
   bokeh_cmd->add_option("--spectral-samples", bokeh.spectral_samples, "Wavelengths of the spectral quadrature (3-64, default 16)")
-      ->check(CLI::Range(3, 64));
+      ->check(range(3, 64));
   bokeh_cmd->add_option("--highlight-gain", bokeh.highlight_gain, "8/16-bit inputs: boost clipped highlights up to this factor (>= 1; default 1 = off)")
-      ->check(CLI::Range(1.0, 1.0e6));
+      ->check(range(1.0, 1.0e6));
   bokeh_cmd->add_option("--highlight-threshold", bokeh.highlight_threshold, "Encoded value from which a channel counts as clipped (default 0.98)")
-      ->check(CLI::Range(0.5, 1.0));
+      ->check(range(0.5, 1.0));
   bokeh_cmd->add_option("--layer-spacing", bokeh.layer_spacing_px, "Depth-layer step in signed blur diameter, px (default 2)")
-      ->check(CLI::Range(0.1, 1000.0));
-  bokeh_cmd->add_option("--subrows", bokeh.subrows, "Sub-rows per pixel of the scatter (1-16, default 4)")->check(CLI::Range(1, 16));
+      ->check(range(0.1, 1000.0));
+  bokeh_cmd->add_option("--subrows", bokeh.subrows, "Sub-rows per pixel of the scatter (1-16, default 4)")->check(range(1, 16));
   bokeh_cmd->add_option("--max-blur", bokeh.max_blur_px, "Largest blur diameter, px; nearer points are clamped (default 1000)")
-      ->check(CLI::Range(1.0, 1.0e6));
-  bokeh_cmd->add_option("--threads", bokeh.threads, "Threads (default 0 = all cores)")->check(CLI::Range(0, 4096));
+      ->check(range(1.0, 1.0e6));
+  bokeh_cmd->add_option("--threads", bokeh.threads, "Threads (default 0 = all cores)")->check(range(0, 4096));
 
   ValidateCommandOptions validate;
   CLI::App* validate_cmd = app.add_subcommand(
-      "validate", "How close the paraxial and Seidel models come to the exact tracer: PSF metrics, pictures, a report");
+      "validate", "How close the paraxial, Seidel and poly models come to the exact tracer: PSF metrics, pictures, a report");
   validate_cmd->add_option("lens", validate.lens, "Lens file or shipped lens name")->required();
-  validate_cmd->add_option("--fstop", validate.f_number, "f-number (default: the lens's own; 0.5-512)")->check(CLI::Range(0.5, 512.0));
-  validate_cmd->add_option("--focus", validate.focus_m, "Focus distance, metres (default 3; inf allowed)")->check(focus_distance_check());
+  validate_cmd->add_option("--fstop", validate.f_number, "f-number (default: the lens's own; 0.5-512)")->check(range(0.5, 512.0));
+  validate_cmd->add_option("--focus", validate.focus_m, "Focus distance, metres from the entrance pupil (default 3; inf allowed)")->check(focus_distance_check());
   validate_cmd->add_option("--out", validate.out, "Directory for report.md and psf.png (default ./validation)");
   validate_cmd->add_option("--models", validate.models, "Models to compare with exact (default paraxial seidel; also poly)")
       ->check(CLI::IsMember({"paraxial", "seidel", "poly"}));
@@ -251,43 +295,43 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"fitted", "sums"}));
   validate_cmd->add_option("--fit", validate.fit, "Fit file for the poly model (lensmith fit -o); default: fit the lens in this run")
       ->check(CLI::ExistingFile);
-  validate_cmd->add_option("--width", validate.width_px, "Frame width the fields refer to, px (default 1920)")->check(CLI::Range(16, 65536));
-  validate_cmd->add_option("--height", validate.height_px, "Frame height, px (default 1080)")->check(CLI::Range(16, 65536));
+  validate_cmd->add_option("--width", validate.width_px, "Frame width the fields refer to, px (default 1920)")->check(range(16, 65536));
+  validate_cmd->add_option("--height", validate.height_px, "Frame height, px (default 1080)")->check(range(16, 65536));
   validate_cmd->add_option("--pupil-samples", validate.pupil_samples, "Pupil grid per axis for each PSF (default 96; 2-512)")
-      ->check(CLI::Range(2, 512));
+      ->check(range(2, 512));
   validate_cmd->add_option("--min-overlap", validate.min_overlap, "Fail (exit 6) when a model's worst PSF overlap is below this (0-1)")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(range(0.0, 1.0));
   validate_cmd->add_option("--scene", validate.scenes, "Analytic scene (JSON) for the image-level comparison; repeatable")
       ->check(CLI::ExistingFile);
   validate_cmd->add_option("--image-width", validate.image_width_px, "Width of the image-level renders, px (default 320)")
-      ->check(CLI::Range(16, 8192));
+      ->check(range(16, 8192));
   validate_cmd->add_option("--image-height", validate.image_height_px, "Height of the image-level renders, px (default 180)")
-      ->check(CLI::Range(16, 8192));
+      ->check(range(16, 8192));
   validate_cmd->add_option("--image-spp", validate.image_spp, "Samples per pixel of the ground truth (default 64)")
-      ->check(CLI::Range(1, 1 << 20));
+      ->check(range(1, 1 << 20));
   validate_cmd->add_option("--min-edge-psnr", validate.min_edge_psnr_db, "Fail (exit 6) when a model's depth-edge PSNR is below this, dB");
   validate_cmd->add_option("--max-centroid-offset", validate.max_centroid_offset_um,
                            "Fail (exit 6) when a model's largest centroid offset exceeds this, um")
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
 
   FitCommandOptions fit;
   CLI::App* fit_cmd = app.add_subcommand(
       "fit", "Fit the lens's ray mapping with polynomials (polynomial optics): held-out errors, speed, a fit file");
   fit_cmd->add_option("lens", fit.lens, "Lens file or shipped lens name")->required();
-  fit_cmd->add_option("--degree", fit.degree, "Highest total degree of a term (1-11, default 7)")->check(CLI::Range(1, 11));
+  fit_cmd->add_option("--degree", fit.degree, "Highest total degree of a term (1-11, default 7)")->check(range(1, 11));
   fit_cmd->add_option("--terms", fit.terms, "Term budget per output (1-1000; default: 5 per surface less 12, within 12-40)")
-      ->check(CLI::Range(1, 1000));
+      ->check(range(1, 1000));
   fit_cmd->add_option("--training-rays", fit.training_rays, "Rays the fit is made from (200-10000000, default 30000)")
-      ->check(CLI::Range(200, 10000000));
+      ->check(range(200, 10000000));
   fit_cmd->add_option("--test-rays", fit.test_rays, "Held-out rays the errors are measured on (100-10000000, default 10000)")
-      ->check(CLI::Range(100, 10000000));
+      ->check(range(100, 10000000));
   fit_cmd->add_option("--seed", fit.seed, "Seed of the training rays (default 2016; test rays use another stream)");
   fit_cmd->add_option("--image-radius", fit.image_radius_mm,
                       "Radius on the sensor plane the fit covers, mm (default 24.9: a 36 x 24 frame plus 15 %)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   fit_cmd->add_option("--fstop", fit.f_number, "Widest f-number the fit serves (default: the lens's own; 0.5-512)")
-      ->check(CLI::Range(0.5, 512.0));
-  fit_cmd->add_option("-o,--output", fit.output, "Write the fit here (lensmith-fit JSON; docs/fit-format.md)");
+      ->check(range(0.5, 512.0));
+  fit_cmd->add_option("-o,--output", fit.output, "Write the fit here (lensmith-fit JSON; docs/polyfit.md)");
   fit_cmd->add_flag("--json", fit.json, "Print one JSON object (schema: docs/cli.md)");
 
   SceneRenderOptions scene_render;
@@ -306,32 +350,66 @@ int main(int argc, char** argv) {
   scene_render_cmd->add_option("--depth", scene_render.depth, "With --pinhole: also write the planar depth, float EXR channel Z, metres")
       ->needs(scene_pinhole);
   scene_render_cmd->add_option("--focal-length", scene_render.focal_length_mm, "Thin-lens focal length, mm (> 0)")
-      ->check(CLI::PositiveNumber)->needs(scene_thin);
+      ->check(positive())->needs(scene_thin);
   // Options of renders through a lens: meaningless for a pinhole.
   const std::vector<CLI::Option*> lens_only{
       scene_render_cmd->add_option("--fstop", scene_render.f_number, "f-number (default: the lens's own; 0.5-512)")
-          ->check(CLI::Range(0.5, 512.0)),
+          ->check(range(0.5, 512.0)),
       scene_render_cmd->add_option("--focus", scene_render.focus_m, "Focus distance, metres from the entrance pupil (> 0; inf)")
           ->check(focus_distance_check()),
-      scene_render_cmd->add_option("--spp", scene_render.spp, "Samples per pixel (default 64; 1-1048576)")->check(CLI::Range(1, 1 << 20)),
+      scene_render_cmd->add_option("--spp", scene_render.spp, "Samples per pixel (default 64; 1-1048576)")->check(range(1, 1 << 20)),
       scene_render_cmd->add_option("--noise-target", scene_render.noise_target,
                                    "Double the samples until the estimated mean relative error is below this (> 0)")
-          ->check(CLI::PositiveNumber),
+          ->check(positive()),
       scene_render_cmd->add_option("--max-spp", scene_render.max_spp, "Most samples per pixel with --noise-target (>= --spp; default 4096 or --spp if larger)")
-          ->check(CLI::Range(1, 1 << 20)),
+          ->check(range(1, 1 << 20)),
       scene_render_cmd->add_option("--seed", scene_render.seed, "Random seed (default 1; the same seed gives the same image)"),
       scene_render_cmd->add_flag("--no-spectral", scene_render.no_spectral, "Trace every ray at 587.6 nm and keep RGB as it is"),
       scene_render_cmd->add_option("--spectral-samples", scene_render.spectral_samples, "Wavelengths of the spectral quadrature (3-64, default 16)")
-          ->check(CLI::Range(3, 64))};
+          ->check(range(3, 64))};
   for (CLI::Option* option : lens_only) option->excludes(scene_pinhole);
-  scene_render_cmd->add_option("--width", scene_render.width_px, "Image width, px (default 640)")->check(CLI::Range(1, 65536));
-  scene_render_cmd->add_option("--height", scene_render.height_px, "Image height, px (default 360)")->check(CLI::Range(1, 65536));
+  scene_render_cmd->add_option("--width", scene_render.width_px, "Image width, px (default 640)")->check(range(1, 65536));
+  scene_render_cmd->add_option("--height", scene_render.height_px, "Image height, px (default 360)")->check(range(1, 65536));
   scene_render_cmd->add_option("--sensor-width", scene_render.sensor_width_mm, "Sensor width of the pinhole framing, mm (default 36)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   scene_render_cmd->add_option("--pinhole-focal-length", scene_render.pinhole_focal_length_mm,
                                "Pinhole focal length of the framing, mm (default: the lens EFL, the thin lens's focal length; 50 with --pinhole)")
-      ->check(CLI::PositiveNumber);
-  scene_render_cmd->add_option("--threads", scene_render.threads, "Threads (default 0 = all cores)")->check(CLI::Range(0, 4096));
+      ->check(positive());
+  scene_render_cmd->add_option("--threads", scene_render.threads, "Threads (default 0 = all cores)")->check(range(0, 4096));
+
+  // Under --json an error is also one JSON object on stdout, so that a script reading stdout sees
+  // it: {"error": {"exit_code": N, "message": "..."}}.
+  bool json = false;
+  for (int i = 1; i < argc; ++i) json = json || std::string_view(argv[i]) == "--json";
+  auto fail = [json](int code, const std::string& message) {
+    std::cerr << "lensmith: " << message << "\n";
+    if (json) std::cout << ojson{{"error", {{"exit_code", code}, {"message", message}}}}.dump(2) << "\n";
+    return code;
+  };
+  // The first word that is not an option names the subcommand.
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view word = argv[i];
+    if (word.empty() || word.front() == '-') continue;
+    std::string names;
+    bool known = false;
+    for (const CLI::App* sub : app.get_subcommands({})) {
+      known = known || sub->get_name() == word;
+      names += (names.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!known) return fail(kExitUsage, "unknown subcommand '" + std::string(word) + "'; the subcommands are " + names);
+    break;
+  }
+
+  // CLI11 drops the empty piece of "--fields 0,,1": refuse it rather than read two fields.
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view word = argv[i];
+    std::string_view value;
+    if (word == "--fields" && i + 1 < argc) value = argv[i + 1];
+    if (word.rfind("--fields=", 0) == 0) value = word.substr(9);
+    if (!value.empty() && (value.front() == ',' || value.back() == ',' || value.find(",,") != std::string_view::npos)) {
+      return fail(kExitUsage, "--fields " + std::string(value) + ": an empty entry between commas; give each field, e.g. 0,0.7,1");
+    }
+  }
 
   try {
     app.parse(argc, argv);
@@ -342,6 +420,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
+    if (json) std::cout << ojson{{"error", {{"exit_code", kExitUsage}, {"message", e.what()}}}}.dump(2) << "\n";
     app.exit(e);
     return kExitUsage;
   }
@@ -359,18 +438,16 @@ int main(int argc, char** argv) {
     if (*validate_cmd) return run_validate(validate, global);
     if (*scene_render_cmd) return run_scene_render(scene_render, global);
     if (*fit_cmd) return run_fit(fit, global);
+  } catch (const lensmith::UsageError& e) {
+    return fail(kExitUsage, e.what());
   } catch (const lensmith::ComputationError& e) {
-    std::cerr << "lensmith: " << e.what() << "\n";
-    return kExitComputation;
+    return fail(kExitComputation, e.what());
   } catch (const lensmith::IoError& e) {
-    std::cerr << "lensmith: " << e.what() << "\n";
-    return kExitIo;
+    return fail(kExitIo, e.what());
   } catch (const lensmith::Error& e) {
-    std::cerr << "lensmith: " << e.what() << "\n";
-    return kExitInput;
+    return fail(kExitInput, e.what());
   } catch (const std::exception& e) {
-    std::cerr << "lensmith: internal error: " << e.what() << "\n";
-    return kExitInternal;
+    return fail(kExitInternal, std::string("internal error (please report it with the command line): ") + e.what());
   }
   return kExitUsage;
 }

@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "commands.h"
+#include "lensmith/render/image_io.h"
 #include "lensmith/analysis/analysis_context.h"
 #include "lensmith/core/errors.h"
 #include "lensmith/plot/analysis_plots.h"
@@ -18,12 +19,12 @@ AnalysisOptions make_analysis_options(const RealRayCommandOptions& options) {
   if (options.image == "paraxial") {
     a.image_plane = TracerOptions::ImagePlane::ParaxialFocus;
   } else if (options.image != "prescribed") {
-    throw OptionsError("--image " + options.image + ": must be prescribed or paraxial");
+    throw UsageError("--image " + options.image + ": must be prescribed or paraxial");
   }
   if (options.aim == "real") {
     a.aiming = RayAiming::RealStop;
   } else if (options.aim != "paraxial") {
-    throw OptionsError("--aim " + options.aim + ": must be paraxial or real");
+    throw UsageError("--aim " + options.aim + ": must be paraxial or real");
   }
   return a;
 }
@@ -39,13 +40,10 @@ plot::PlotOptions make_plot_options(const GlobalOptions& global) {
 }
 
 void write_picture(const plot::Canvas& canvas, const std::string& png, const std::string& lens, const GlobalOptions& global) {
-  std::error_code ec;
-  const std::string input_file = lens.substr(0, lens.rfind('#'));
-  if (std::filesystem::exists(input_file, ec) && std::filesystem::exists(png, ec) && std::filesystem::equivalent(input_file, png, ec)) {
-    throw IoError(png + ": is the input file; lensmith never overwrites its inputs");
-  }
+  ensure_not_an_input(png, {lens.substr(0, lens.rfind('#'))});
+  ensure_writable_location(png);
   canvas.write_png(png);
-  if (!global.quiet) std::cerr << "wrote " << png << " (" << canvas.width() << " x " << canvas.height() << ")\n";
+  report_written(png + " (" + std::to_string(canvas.width()) + " x " + std::to_string(canvas.height()) + ")", global);
 }
 
 }  // namespace lensmith::cli

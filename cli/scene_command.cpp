@@ -41,14 +41,15 @@ int run_scene_render(const SceneRenderOptions& o, const GlobalOptions& global) {
   const auto started = std::chrono::steady_clock::now();
   const int modes = (o.pinhole ? 1 : 0) + (o.lens.empty() ? 0 : 1) + (o.thin_lens ? 1 : 0);
   if (modes != 1) {
-    throw OptionsError("give exactly one of --pinhole, --lens LENS or --thin-lens --focal-length MM");
+    throw UsageError("give exactly one of --pinhole, --lens LENS or --thin-lens --focal-length MM");
   }
   const std::filesystem::path output = o.output;
   ensure_not_an_input(output, {o.scene});
+  ensure_writable_location(output);
   if (!o.depth.empty()) {
     ensure_not_an_input(o.depth, {o.scene});
     if (std::filesystem::absolute(o.depth).lexically_normal() == std::filesystem::absolute(output).lexically_normal()) {
-      throw OptionsError("--depth " + o.depth + " is the output image: give the depth another file");
+      throw UsageError("--depth " + o.depth + " is the output image: give the depth another file");
     }
   }
   const Scene scene = load_scene(o.scene);
@@ -70,9 +71,10 @@ int run_scene_render(const SceneRenderOptions& o, const GlobalOptions& global) {
     meta.extra.push_back({"frame", frame.to_string()});
     rgb = std::move(out.rgb);
     if (!o.depth.empty()) write_depth(o.depth, out.depth);
-    summary = "pinhole, " + frame.to_string();
+    summary = "pinhole, focal length " + format_rounded(frame.focal_length_px(), 5) + " px, horizontal field of view " +
+              format_rounded(frame.horizontal_fov_deg(), 4) + " deg";
   } else {
-    if (!o.focus_m) throw OptionsError("rendering through a lens needs --focus M (metres from the entrance pupil)");
+    if (!o.focus_m) throw UsageError("rendering through a lens needs --focus M (metres from the entrance pupil)");
     CameraOptions camera_options;
     camera_options.focus_distance_m = *o.focus_m;
     camera_options.f_number = o.f_number;
@@ -92,7 +94,7 @@ int run_scene_render(const SceneRenderOptions& o, const GlobalOptions& global) {
     std::optional<Camera> camera;
     LensRender out;
     if (o.thin_lens) {
-      if (!o.focal_length_mm) throw OptionsError("--thin-lens needs --focal-length MM");
+      if (!o.focal_length_mm) throw UsageError("--thin-lens needs --focal-length MM");
       camera = Camera::thin_lens(*o.focal_length_mm, camera_options, o.width_px, o.height_px);
       meta.lens = "thin lens f = " + format_number(*o.focal_length_mm) + " mm";
       meta.model = "thin lens ground truth";
@@ -126,8 +128,8 @@ int run_scene_render(const SceneRenderOptions& o, const GlobalOptions& global) {
     meta.extra.push_back({"negative_values_clamped", std::to_string(clamped)});
     meta.extra.push_back({"frame", camera->frame().to_string()});
     std::ostringstream s;
-    s << meta.lens << ", f/" << std::setprecision(3) << camera->f_number() << ", focus " << *o.focus_m << " m, "
-      << out.spp_used << " spp, estimated relative error " << std::setprecision(3) << out.estimated_relative_error
+    s << meta.lens << ", f/" << format_rounded(camera->f_number(), 3) << ", focus " << format_rounded(*o.focus_m, 4) << " m, "
+      << out.spp_used << " samples per pixel, estimated relative error " << format_rounded(out.estimated_relative_error, 2)
       << "\n  rays: " << out.rays.to_string();
     if (clamped > 0) s << "\n  " << clamped << " negative channel values (spectral noise) clamped to 0: raise --spp";
     summary = s.str();
@@ -135,9 +137,10 @@ int run_scene_render(const SceneRenderOptions& o, const GlobalOptions& global) {
   }
   write_output_image(output, rgb, meta);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  std::cout << "wrote " << output.string() << (o.depth.empty() ? std::string() : " and " + o.depth) << " ("
-            << rgb.width << " x " << rgb.height << ") in " << std::fixed << std::setprecision(2) << seconds << " s\n"
-            << "  " << summary << "\n";
+  std::ostringstream what;
+  what << output.string() << (o.depth.empty() ? std::string() : " and " + o.depth) << " (" << rgb.width << " x " << rgb.height
+       << ") in " << std::fixed << std::setprecision(2) << seconds << " s\n  " << summary;
+  report_written(what.str(), global);
   return kExitOk;
 }
 

@@ -40,6 +40,9 @@ SeidelOptions seidel_options_from(const SeidelCommandOptions& options) {
 
 int run_seidel(const SeidelCommandOptions& options, const GlobalOptions& global) {
   const Prescription lens = load_lens(options.lens, global);
+  if (!lens.field && !options.field_angle_deg) {
+    throw PrescriptionError("the lens \"" + lens.name + "\" states no field, and the Seidel sums need one (the chief ray): give --field-angle DEG");
+  }
   const SeidelAnalysis seidel(lens, seidel_options_from(options));
   if (!options.png.empty()) write_picture(plot::plot_seidel_diagram(seidel, lens.name), options.png, options.lens, global);
   if (!options.json) {

@@ -72,7 +72,7 @@ std::string check_pupil_text(const std::string& text) {
 int run_trace(const TraceCommandOptions& options, const GlobalOptions& global) {
   const Prescription lens = load_lens(options.lens, global);
   RayTraceOptions trace;
-  if (const std::string problem = check_pupil_text(options.pupil); !problem.empty()) throw OptionsError("--pupil " + problem);
+  if (const std::string problem = check_pupil_text(options.pupil); !problem.empty()) throw UsageError("--pupil " + problem);
   (void)read_pupil(options.pupil, trace.pupil);
   trace.wavelength_nm = options.wavelength_nm;
   if (options.field_angle_deg) trace.field = FieldPoint::angle_deg(*options.field_angle_deg);

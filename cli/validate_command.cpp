@@ -81,8 +81,7 @@ int run_validate(const ValidateCommandOptions& o, const GlobalOptions& global) {
 
   std::cout << psf_tables.substr(0, psf_tables.find("\n\n")) << "\n";
   if (!images.entries.empty()) std::cout << "\n" << images.to_markdown();
-  std::cout
-            << "wrote " << (dir / "report.md").string() << " and " << (dir / "psf.png").string() << "\n";
+  report_written((dir / "report.md").string() + " and " + (dir / "psf.png").string(), global);
   bool failed = false;
   for (const PsfModelSummary& s : result.summaries) {
     if (o.min_overlap && s.worst_overlap < *o.min_overlap) {

@@ -153,12 +153,12 @@ TEST_CASE("lensmith spot --png writes a PNG of the picture's size, the input is 
   CHECK(r.err.find("wrote " + png) != std::string::npos);
   CHECK(run_lensmith("--quiet spot sasian-triplet --png " + png).err.empty());
 
-  // A lens file given as LENS and as --png: refused with exit 5, the file untouched.
+  // A lens file given as LENS and as --png: refused with exit 2, the file untouched.
   const std::string lens = scratch.file("lens.json");
   REQUIRE(run_lensmith("convert sasian-triplet -o " + lens).exit_code == 0);
   const auto size_before = std::filesystem::file_size(lens);
   const auto refused = run_lensmith("spot " + lens + " --png " + lens);
-  CHECK(refused.exit_code == 5);
+  CHECK(refused.exit_code == 2);
   CHECK(refused.err.find("never overwrites") != std::string::npos);
   CHECK(std::filesystem::file_size(lens) == size_before);
 }
@@ -186,7 +186,7 @@ TEST_CASE("lensmith fan --json: the fan through the chief ray is zero, dead rays
       }
     }
   }
-  CHECK(run_lensmith("fan sasian-triplet --samples 20").exit_code == 3);  // odd counts only
+  CHECK(run_lensmith("fan sasian-triplet --samples 20").exit_code == 2);  // odd counts only
 }
 
 TEST_CASE("lensmith analyze: each --what prints JSON with its curve and writes its picture", "[cli][analyze][png]") {

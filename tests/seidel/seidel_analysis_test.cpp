@@ -204,7 +204,7 @@ TEST_CASE("Seidel: halving aperture and field divides S_I, S_III and S_V by 16 (
 TEST_CASE("Seidel: a lens without a field needs one to be given", "[seidel]") {
   Prescription p = testing::sasian_triplet();
   p.field.reset();
-  CHECK_THROWS_AS(SeidelAnalysis(p), ComputationError);
+  CHECK_THROWS_AS(SeidelAnalysis(p), PrescriptionError);
   SeidelOptions o;
   o.field_angle_deg = 10.0;
   CHECK_NOTHROW(SeidelAnalysis(p, o));

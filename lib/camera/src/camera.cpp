@@ -179,8 +179,9 @@ void Camera::finish() {
   const double w_focus = inverse_per_mm(focus_mm_);
   const double scale = 1.0 / (1.0 + (ref.z_front_principal_mm - z_perspective_mm_) * w_focus);
   if (!(scale > 0.0) || 1.0 / ref.efl_mm - w_focus * scale <= 0.0) {
-    throw ComputationError("cannot focus at " + format_number(options_.focus_distance_m) +
-                           " m: the plane is not beyond the front focal point (EFL " + format_number(ref.efl_mm) + " mm)");
+    throw ComputationError("cannot focus at " + format_rounded(options_.focus_distance_m, 6) +
+                           " m: the plane is not beyond the front focal point (EFL " + format_rounded(ref.efl_mm, 5) +
+                           " mm): focus farther away");
   }
   const GaussianImage focus_image = gaussian_image({1.0, 0.0, w_focus}, ref);
   z_sensor_mm_ = focus_image.z_mm;

@@ -54,8 +54,8 @@ CardinalPoints cardinal_points(const KernelMatrices& m, double n_object, double 
   const double power = -a.a12;
   if (!(std::abs(power) > kAfocalRelativePower * m.sum_abs_surface_power_per_mm)) {
     std::ostringstream msg;
-    msg << "afocal system: power " << power << " 1/mm is below " << kAfocalRelativePower
-        << " x the sum of the surface powers (" << m.sum_abs_surface_power_per_mm
+    msg << "afocal system: its power (" << (power == 0.0 ? 0.0 : power) << " 1/mm) is below " << kAfocalRelativePower
+        << " of the sum of its surfaces' powers (" << m.sum_abs_surface_power_per_mm
         << " 1/mm); it has no focal points, principal points or focal length";
     throw ComputationError(msg.str());
   }

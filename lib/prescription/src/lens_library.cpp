@@ -1,6 +1,7 @@
 #include "lensmith/prescription/lens_library.h"
 
 #include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <span>
 
@@ -83,6 +84,15 @@ LensReadResult LensLibrary::load_path_or_name(const std::string& path_or_id, con
   const std::string file_part = path_or_id.substr(0, path_or_id.rfind('#'));
   if (std::filesystem::exists(path_or_id, ec) || std::filesystem::exists(file_part, ec)) {
     return read_lens_file(path_or_id, catalogue);
+  }
+  // What names a file (a folder in it, or a lens file's extension) and is not there is a missing
+  // file; anything else may be a shipped lens's name.
+  const std::filesystem::path file(file_part);
+  std::string extension = file.extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (!find_embedded(path_or_id) &&
+      (file_part.find('/') != std::string::npos || extension == ".json" || extension == ".zmx" || extension == ".dat" || extension == ".seq")) {
+    throw IoError(file_part + ": no such file");
   }
   return load(path_or_id, catalogue);
 }

@@ -331,13 +331,13 @@ DepthMap read_depth(const DepthSource& source, const DepthReadOptions& options, 
                                    : "depth (" + lensmith::to_string(options.kind) + ") must be > 0 (+inf = infinitely far)";
   if (options.invalid == InvalidDepth::Error) {
     throw ImageFileError(bad + ": " + expected +
-                         "; set invalid depth to 'far' to treat such pixels as infinitely far, or to 'near' to give "
-                         "them the nearest valid depth");
+                         "; --invalid-depth far treats such pixels as infinitely far, --invalid-depth near gives them "
+                         "the nearest valid depth");
   }
   float replacement = kFar;
   if (options.invalid == InvalidDepth::Near) {
     if (nearest_m == kFar) {
-      throw ImageFileError(bad + ": " + expected + "; invalid depth 'near' needs a finite valid depth, and the map has none");
+      throw ImageFileError(bad + ": " + expected + "; --invalid-depth near needs a finite valid depth, and the map has none: use --invalid-depth far");
     }
     replacement = nearest_m;
   }
@@ -421,6 +421,15 @@ std::vector<std::pair<std::string, std::string>> read_image_metadata(const fs::p
   return read_image_metadata_pairs(path);
 }
 
+void ensure_writable_location(const fs::path& output) {
+  std::error_code ec;
+  const fs::path dir = output.has_parent_path() ? output.parent_path() : fs::path(".");
+  if (!fs::is_directory(dir, ec)) {
+    throw IoError("cannot write " + output.string() + ": the folder " + dir.string() + " does not exist");
+  }
+  if (fs::is_directory(output, ec)) throw IoError("cannot write " + output.string() + ": it is a folder");
+}
+
 void ensure_not_an_input(const fs::path& output, const std::vector<fs::path>& inputs) {
   for (const fs::path& input : inputs) {
     std::error_code ec;
@@ -434,8 +443,8 @@ void ensure_not_an_input(const fs::path& output, const std::vector<fs::path>& in
       same = !ec_output && !ec_input && a == b;
     }
     if (same) {
-      throw OptionsError("output " + output.string() + " is the input " + input.string() +
-                         ": writing it would destroy the input; choose another output file");
+      throw UsageError("output " + output.string() + " is the input " + input.string() +
+                       ": lensmith never overwrites its inputs; choose another output file");
     }
   }
 }

@@ -111,7 +111,7 @@ SeidelAnalysis::SeidelAnalysis(const Prescription& lens, const SeidelOptions& op
         Prescription p = with_overrides(lens, options);
         p.validate();
         if (!p.field) {
-          throw ComputationError("Seidel sums need a field (the chief ray): the lens gives none; pass a field angle or object height");
+          throw PrescriptionError("Seidel sums need a field (the chief ray): the lens gives none; pass a field angle or object height");
         }
         ParaxialOptions po;
         po.wavelength_nm = options.wavelength_nm;

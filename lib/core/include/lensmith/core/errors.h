@@ -58,6 +58,13 @@ class OptionsError : public Error {
   using Error::Error;
 };
 
+// A request that contradicts itself or lacks a part it needs (an output naming one of the inputs;
+// an option the call requires): the command line's fault, exit 2 in the CLI.
+class UsageError : public OptionsError {
+ public:
+  using OptionsError::OptionsError;
+};
+
 // A computation has no answer for this input (e.g. an afocal system has no focal points).
 class ComputationError : public Error {
  public:

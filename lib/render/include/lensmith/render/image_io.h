@@ -162,8 +162,11 @@ void write_float_exr(const std::filesystem::path& path, const Image& image, cons
 // Throws IoError.
 std::vector<std::pair<std::string, std::string>> read_image_metadata(const std::filesystem::path& path);
 
-// Throws OptionsError when `output` names the same file as one of `inputs` (the same file on disk
-// when both exist, else the same normalised absolute path), so a render cannot overwrite its input.
+// Throws UsageError when `output` names the same file as one of `inputs` (the same file on disk
+// when both exist, else the same normalised absolute path), so a command cannot overwrite its input.
 void ensure_not_an_input(const std::filesystem::path& output, const std::vector<std::filesystem::path>& inputs);
+// Throws IoError when `output` cannot be written where it is: its folder does not exist, or it is a
+// folder. Checked before a long computation, so that it does not end in a failed write.
+void ensure_writable_location(const std::filesystem::path& output);
 
 }  // namespace lensmith
