@@ -112,6 +112,12 @@ struct SpotCommandOptions {
 };
 int run_spot(const SpotCommandOptions& options, const GlobalOptions& global);
 
+struct LayoutCommandOptions {
+  RealRayCommandOptions common;  // lens, --fields, --field-angle, --aim (default real), --png
+  int rays = 5;                  // --rays: rays per field bundle, from pupil edge to edge (1-101)
+};
+int run_layout(const LayoutCommandOptions& options, const GlobalOptions& global);
+
 struct FanCommandOptions {
   RealRayCommandOptions common;
   int samples = 41;  // --samples: pupil points per fan, odd

@@ -196,6 +196,20 @@ int main(int argc, char** argv) {
   seidel_cmd->add_option("--png", seidel.png, "Also write the Seidel diagram (per-surface bar chart) to this PNG");
   seidel_cmd->add_flag("--json", seidel.json, "Print one JSON object (schema: docs/cli.md)");
 
+  LayoutCommandOptions layout;
+  layout.common.aim = "real";
+  CLI::App* layout_cmd = app.add_subcommand("layout", "The lens drawn in section with its stop, image plane and real ray bundles per field");
+  layout_cmd->add_option("lens", layout.common.lens, lens_help)->required();
+  layout_cmd->add_option("--fields", layout.common.relative_fields,
+                         "Fields of the bundles as fractions of the maximum field, comma separated, each 0 to 1 (default 0,0.7,1)")
+      ->delimiter(',')
+      ->check(CLI::Range(0.0, 1.0));
+  layout_cmd->add_option("--field-angle", layout.common.field_angle_deg, "The half field angle that field 1 means, degrees (default: the lens's)")
+      ->check(CLI::Range(1e-9, 89.999999));
+  layout_cmd->add_option("--rays", layout.rays, "Rays per bundle from pupil edge to edge (default 5; 1-101)")->check(CLI::Range(1, 101));
+  layout_cmd->add_option("--aim", layout.common.aim, "Ray aiming: real (default: rays fill the real stop) or paraxial")->check(aim_words);
+  layout_cmd->add_option("--png", layout.common.png, "Write the drawing to this PNG file (written atomically; never the input)");
+
   FanCommandOptions fan;
   CLI::App* fan_cmd = app.add_subcommand("fan", "Transverse ray fans (ey against py, ex against px) per field and wavelength");
   add_real_ray_options(fan_cmd, fan.common);
@@ -433,6 +447,7 @@ int main(int argc, char** argv) {
     if (*trace_cmd) return run_trace(trace, global);
     if (*spot_cmd) return run_spot(spot, global);
     if (*fan_cmd) return run_fan(fan, global);
+    if (*layout_cmd) return run_layout(layout, global);
     if (*analyze_cmd) return run_analyze(analyze, global);
     if (*bokeh_cmd) return run_bokeh(bokeh, global);
     if (*validate_cmd) return run_validate(validate, global);

@@ -10,6 +10,7 @@
 #include "commands.h"
 #include "lensmith/core/errors.h"
 #include "lensmith/core/text_file.h"
+#include "lensmith/plot/canvas.h"
 #include "lensmith/render/image_io.h"
 #include "lensmith/validate/image_validation.h"
 #include "lensmith/validate/psf_validation.h"
@@ -41,7 +42,9 @@ int run_validate(const ValidateCommandOptions& o, const GlobalOptions& global) {
   meta.f_number = camera.f_number();
   meta.focus_m = o.focus_m;
   meta.model = "exact | model | difference";
-  write_output_image(dir / "psf.png", psf_grid_picture(camera, models, Aperture::circular(), psf, model_options), meta);
+  write_output_image(dir / "psf.png",
+                     psf_grid_figure(camera, models, Aperture::circular(), psf, model_options, plot::Canvas::find_default_font().value_or("")),
+                     meta);
 
   std::ostringstream report;
   report << "# lensmith validate: " << lens.name << "\n\n"

@@ -105,3 +105,98 @@ TEST_CASE("plot options check the text size", "[plot]") {
   o.font_px = 2.0;
   CHECK_THROWS_WITH(o.validate(), Catch::Contains("font_px"));
 }
+
+namespace {
+
+// Every pair of labels drawn on `picture` is apart; a failure names both texts.
+void check_labels_apart(const Canvas& picture) {
+  const auto& boxes = picture.text_boxes();
+  REQUIRE(boxes.size() > 3);  // a font was found and labels were drawn
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    for (std::size_t j = i + 1; j < boxes.size(); ++j) {
+      INFO("\"" << boxes[i].text << "\" and \"" << boxes[j].text << "\"");
+      CHECK_FALSE(boxes[i].box.intersects(boxes[j].box));
+    }
+  }
+}
+
+}  // namespace
+
+TEST_CASE("spot diagram: no two labels overlap with five wavelengths, wide spots and lost rays", "[plot][spot][labels]") {
+  AnalysisOptions options;
+  options.relative_fields = {0.0, 0.5, 0.7, 1.0};
+  options.wavelengths_nm = {450.0, 486.1327, 550.0, 587.5618, 656.2725};
+  options.max_field_angle_deg = 20.0;  // the Angenieux f/1.1 vignettes and spreads its rays at this field
+  const SpotDiagram spots = compute_spot_diagram(AnalysisContext(lensmith::testing::angenieux_double_gauss(), options));
+  check_labels_apart(plot_spot_diagram(spots));
+}
+
+TEST_CASE("spot diagram: tick labels at the panels' edges and long loss notes stay apart", "[plot][spot][labels]") {
+  // Spots 195 um wide: the panels run to +/-200 um with labels "-200" and "200" on their edges, where
+  // neighbouring panels' labels meet; most rays lost, some missed, for the longest loss note.
+  SpotDiagram spots;
+  spots.lens_name = "synthetic";
+  spots.wavelengths_nm = {450.0, 486.1327, 550.0, 587.5618, 656.2725};
+  spots.reference_wavelength_nm = 587.5618;
+  spots.field_unit = "deg";
+  spots.working_f_number = 4.0;
+  for (int f = 0; f < 2; ++f) {
+    FieldSpot field;
+    field.field_label = f == 0 ? "0.00 deg" : "20.00 deg";
+    field.chief = {0.0, -12.345 * f, 100.0};
+    SpotStatistics stats;
+    stats.traced = 127;
+    stats.passed = 2;
+    stats.lost.vignetted = 100;
+    stats.lost.missed = 25;
+    stats.rms_radius_chief_mm = stats.geo_radius_chief_mm = 0.195;
+    for (double nm : spots.wavelengths_nm) {
+      Spot spot;
+      spot.wavelength_nm = nm;
+      spot.points = {{-0.195, field.chief.y_mm, 100.0}, {0.195, field.chief.y_mm, 100.0}};
+      spot.stats = stats;
+      field.spots.push_back(spot);
+    }
+    field.polychromatic = stats;
+    spots.fields.push_back(field);
+  }
+  check_labels_apart(plot_spot_diagram(spots));
+}
+
+TEST_CASE("spot diagram: the Airy radius of an f/4 lens at 587.6 nm is 1.22 x 0.5876 um x 4 = 2.87 um", "[plot][spot]") {
+  // Sasian triplet: EFL 50 mm, entrance pupil 12.5 mm (ray-optics' documentation), object at infinity.
+  const SpotDiagram spots = compute_spot_diagram(AnalysisContext(lensmith::testing::sasian_triplet()));
+  constexpr double kParaxialRounding = 1e-6;  // the prescription's 4-digit radii give f/4 to better than this
+  CHECK_THAT(spots.working_f_number, Catch::Matchers::WithinRel(4.0, 1e-3));
+  CHECK_THAT(spots.airy_radius_mm(587.5618), Catch::Matchers::WithinAbs(1.21967 * 587.5618e-6 * spots.working_f_number, kParaxialRounding));
+  CHECK_THAT(spots.airy_radius_mm(587.5618), Catch::Matchers::WithinRel(2.866e-3, 2e-3));
+}
+
+TEST_CASE("pupil picture: no two stopping surfaces share a swatch, even past the twenty colours", "[plot][pupil]") {
+  const Rgb pass{0.55f, 0.72f, 0.95f};  // the cells that reach the image (plot_pupil_shape)
+  std::vector<Swatch> swatches;
+  for (std::size_t rank = 0; rank < 60; ++rank) swatches.push_back(surface_swatch(rank));
+  for (std::size_t i = 0; i < swatches.size(); ++i) {
+    INFO("surface rank " << i);
+    CHECK_FALSE(swatches[i].colour == pass);
+    for (std::size_t j = i + 1; j < swatches.size(); ++j) CHECK_FALSE(swatches[i] == swatches[j]);
+  }
+  // Plain colours first: a lens with up to twenty stopping surfaces shows no hatching.
+  for (std::size_t i = 0; i < 20; ++i) CHECK(swatches[i].hatch == 0);
+  for (std::size_t i = 0; i < 20; ++i) {
+    for (std::size_t j = i + 1; j < 20; ++j) CHECK_FALSE(swatches[i].colour == swatches[j].colour);
+  }
+}
+
+TEST_CASE("pupil and Seidel pictures: no two labels overlap", "[plot][labels]") {
+  AnalysisOptions options;
+  options.relative_fields = {0.0, 0.5, 0.8, 1.0};
+  options.max_field_angle_deg = 20.0;
+  const AnalysisContext context(lensmith::testing::angenieux_double_gauss(), options);
+  PupilShapeOptions pupil;
+  pupil.grid = 24;
+  check_labels_apart(plot_pupil_shape(compute_pupil_shape(context, pupil)));
+  SeidelOptions seidel;
+  seidel.field_angle_deg = 20.0;
+  check_labels_apart(plot_seidel_diagram(SeidelAnalysis(lensmith::testing::angenieux_double_gauss(), seidel), "Angenieux"));
+}

@@ -65,6 +65,11 @@ std::string SpotStatistics::to_string() const {
   return os.str();
 }
 
+double SpotDiagram::airy_radius_mm(double wavelength_nm) const {
+  constexpr double kAiryFirstZero = 1.21967;  // first zero of J1(pi x) / (pi x), in units of lambda N
+  return kAiryFirstZero * mm_from_nm(wavelength_nm) * working_f_number;
+}
+
 SpotDiagram compute_spot_diagram(const AnalysisContext& context, const SpotOptions& options) {
   options.validate();
   SpotDiagram out;
@@ -74,6 +79,7 @@ SpotDiagram compute_spot_diagram(const AnalysisContext& context, const SpotOptio
   out.reference_wavelength_nm = context.reference_wavelength_nm();
   out.field_unit = context.field_unit();
   out.image_plane_z_mm = context.tracer().image_plane_z_mm();
+  out.working_f_number = context.paraxial().working_f_number();
   const std::vector<PupilCoordinate> pupil = options.sampling.samples();
 
   for (double relative : context.relative_fields()) {

@@ -9,14 +9,12 @@
 #include "lensmith/core/errors.h"
 #include "lensmith/core/units.h"
 #include "lensmith/plot/plot_axes.h"
+#include "figure_parts.h"
 
 namespace lensmith::plot {
 
-namespace {
+namespace detail {
 
-constexpr Rgb kText{0.1f, 0.1f, 0.1f};
-constexpr Rgb kNote{0.35f, 0.35f, 0.35f};
-constexpr Rgb kWarning{0.75f, 0.15f, 0.1f};
 
 std::string fixed(double value, int decimals) {
   char buffer[64];
@@ -83,12 +81,6 @@ void header(Canvas& canvas, const std::string& title, const std::string& lens, c
   }
 }
 
-// Legend entries in a row: a short line sample and its label, starting at `at`.
-struct LegendEntry {
-  std::string label;
-  LineStyle style;
-  bool dot = false;
-};
 void legend_row(Canvas& canvas, Point2 at, const std::vector<LegendEntry>& entries, const PlotOptions& o) {
   double x = at.x;
   for (const auto& e : entries) {
@@ -112,7 +104,9 @@ double nice_half_width(double extent) {
   return r.max > 0.0 ? r.max : extent;
 }
 
-}  // namespace
+}  // namespace detail
+
+using namespace detail;
 
 void PlotOptions::validate() const {
   if (!(font_px >= 8.0 && font_px <= 48.0)) throw OptionsError("PlotOptions::font_px = " + fixed(font_px, 2) + ": must be 8 to 48");
@@ -133,33 +127,68 @@ std::vector<Rgb> wavelength_colours(const std::vector<double>& wavelengths_nm) {
 }
 
 Canvas plot_spot_diagram(const SpotDiagram& spots, const PlotOptions& o) {
+  o.validate();
   const std::size_t waves = spots.wavelengths_nm.size();
   const int columns = static_cast<int>(waves > 1 ? waves + 1 : waves);
   const int rows = static_cast<int>(spots.fields.size());
-  const double panel = 230.0, gap_x = 26.0, gap_y = 30.0 + 2.8 * o.font_px;
-  const double left = 140.0, top = header_height(o) + 1.6 * o.font_px + 12.0, bottom = 100.0;
-  const int width = std::max(760, static_cast<int>(left + columns * panel + (columns - 1) * gap_x + 40.0));
-  const int height = static_cast<int>(top + rows * panel + (rows - 1) * gap_y + gap_y + 1.8 * o.font_px + bottom);
-  Canvas canvas = make_canvas(width, height, o);
   const std::vector<Rgb> colours = wavelength_colours(spots.wavelengths_nm);
+  const bool has_airy = std::isfinite(spots.working_f_number) && spots.working_f_number > 0.0;
+  const double airy_primary_mm = has_airy ? spots.airy_radius_mm(spots.reference_wavelength_nm) : 0.0;
 
-  // One scale for every panel: the largest distance of a ray from the chief ray.
+  // One scale for every panel: the largest distance of a ray from the chief ray, or the largest Airy
+  // circle when the spots are smaller than it.
   double extent = 0.0;
   for (const auto& f : spots.fields) {
     for (const auto& s : f.spots) {
       if (std::isfinite(s.stats.geo_radius_chief_mm)) extent = std::max(extent, s.stats.geo_radius_chief_mm);
     }
   }
+  if (has_airy) {
+    for (double nm : spots.wavelengths_nm) extent = std::max(extent, spots.airy_radius_mm(nm));
+  }
   const double half_um = nice_half_width(std::max(um_from_mm(extent) * 1.02, 0.1));  // at least 0.1 um
+  const std::vector<double> ticks = nice_ticks(-half_um, half_um, 4);
+  const double step_um = ticks.size() > 1 ? ticks[1] - ticks[0] : half_um;
+
+  // Measure the labels before laying out: neighbouring panels sit far enough apart that their tick
+  // labels never meet, and the row labels clear the widest y tick label.
+  Canvas ruler(1, 1);
+  ruler.set_font(o.font_path);
+  double widest_tick = 0.0;
+  for (double t : ticks) widest_tick = std::max(widest_tick, ruler.text_width(tick_label(t, step_um), o.font_px * 0.85));
+  const double panel = 230.0;
+  const double gap_x = std::max(30.0, widest_tick + 16.0);
+  const double note = 0.85 * o.font_px;                 // size of the numbers under each panel
+  const double note_lines = 3.0;                        // RMS / GEO, rays lost, why
+  const double note_height = note_lines * 1.3 * note + 6.0;
+  const double gap_y = 14.0 + note_height;
+  const double row_label = 1.3 * o.font_px;             // two vertical lines: the field, the image height
+  const double left = 24.0 + 2.0 * row_label + 28.0 + widest_tick + 1.6 * o.font_px;
+  const double top = header_height(o) + 1.5 * o.font_px + 1.6 * o.font_px + 12.0;
+  const double last_row_axis = 16.0 + 2.2 * o.font_px;  // x tick labels and the axis title under the last row
+  const int width = std::max(760, static_cast<int>(left + columns * panel + (columns - 1) * gap_x + 40.0 + 0.5 * widest_tick));
+  const int height = static_cast<int>(top + rows * panel + (rows - 1) * gap_y + last_row_axis + note_height + 50.0);
+  Canvas canvas = make_canvas(width, height, o);
+
   header(canvas, "Spot diagram", spots.lens_name,
          spots.sampling.to_string() + "; reference: chief ray at " + wavelength_label(spots.reference_wavelength_nm) +
              "; image plane z = " + fixed(spots.image_plane_z_mm, 3) + " mm; RMS and GEO radii about the chief ray",
          o);
+  if (has_airy) {
+    canvas.circle({26.0, header_height(o) + 0.75 * o.font_px}, 6.0, LineStyle{kBlack, 1.2});
+    canvas.text({38.0, header_height(o) + 0.75 * o.font_px},
+                "Airy circle 1.22 \xCE\xBB N_w about the chief ray at each panel's wavelength: N_w = " + fixed(spots.working_f_number, 2) + ", radius " +
+                    micrometres(airy_primary_mm) + " at " + wavelength_label(spots.reference_wavelength_nm) + " (all-wavelength panel)",
+                o.font_px * 0.9, kText, HAlign::Left, VAlign::Middle);
+  }
 
   for (int r = 0; r < rows; ++r) {
     const FieldSpot& f = spots.fields[static_cast<std::size_t>(r)];
     const double y0 = top + r * (panel + gap_y);
-    canvas.text({left - 112.0, y0 + 0.5 * panel}, "Field " + f.field_label, o.font_px * 1.05, kText, HAlign::Centre, VAlign::Middle, true);
+    canvas.text({24.0 + 0.5 * row_label, y0 + 0.5 * panel}, "Field " + f.field_label, o.font_px * 1.05, kText, HAlign::Centre, VAlign::Middle,
+                true);
+    canvas.text({24.0 + 1.5 * row_label, y0 + 0.5 * panel}, "image height " + fixed(f.chief.y_mm, 3) + " mm", o.font_px * 0.9, kNote,
+                HAlign::Centre, VAlign::Middle, true);
     for (int c = 0; c < columns; ++c) {
       const double x0 = left + c * (panel + gap_x);
       PlotAxes axes(canvas, {x0, y0}, {x0 + panel, y0 + panel}, {-half_um, half_um}, {-half_um, half_um});
@@ -176,6 +205,7 @@ Canvas plot_spot_diagram(const SpotDiagram& spots, const PlotOptions& o) {
         for (const ImagePoint& p : s.points) axes.dot(um_from_mm(p.x_mm - f.chief.x_mm), um_from_mm(p.y_mm - f.chief.y_mm), dot, colour);
       };
       const SpotStatistics* stats = nullptr;
+      double airy_mm = airy_primary_mm;
       if (overlay) {
         // Longest wavelength first so the short ones stay visible on top.
         for (std::size_t w = f.spots.size(); w-- > 0;) draw_spot(f.spots[w], colours[w]);
@@ -183,27 +213,30 @@ Canvas plot_spot_diagram(const SpotDiagram& spots, const PlotOptions& o) {
       } else {
         draw_spot(f.spots[static_cast<std::size_t>(c)], colours[static_cast<std::size_t>(c)]);
         stats = &f.spots[static_cast<std::size_t>(c)].stats;
+        if (has_airy) airy_mm = spots.airy_radius_mm(spots.wavelengths_nm[static_cast<std::size_t>(c)]);
       }
+      if (has_airy) canvas.circle(axes.to_pixel(0.0, 0.0), um_from_mm(airy_mm) / (2.0 * half_um) * panel, LineStyle{kBlack, 1.1});
       if (stats->passed == 0) {
         canvas.text({x0 + 0.5 * panel, y0 + 0.5 * panel - 14.0}, "no ray reaches the image", o.font_px * 0.85, kWarning, HAlign::Centre,
                     VAlign::Middle);
       }
-      const double ty = y0 + panel + (r == rows - 1 ? 16.0 + 2.2 * o.font_px : 10.0);
+      double ty = y0 + panel + (r == rows - 1 ? last_row_axis : 8.0);
       canvas.text({x0 + 0.5 * panel, ty}, "RMS " + micrometres(stats->rms_radius_chief_mm) + "   GEO " + micrometres(stats->geo_radius_chief_mm),
-                  o.font_px * 0.85, kText, HAlign::Centre, VAlign::Top);
+                  note, kText, HAlign::Centre, VAlign::Top);
       if (stats->lost.total() > 0) {
-        canvas.text({x0 + 0.5 * panel, ty + 1.3 * o.font_px},
-                    std::to_string(stats->lost.total()) + " of " + std::to_string(stats->traced) + " rays lost (" +
-                        (stats->lost.total() == stats->lost.vignetted ? "vignetted" : "vignetted, missed or TIR") + ")",
-                    o.font_px * 0.8, kWarning, HAlign::Centre, VAlign::Top);
+        // Two short lines that fit under the panel, never into the next one.
+        ty += 1.3 * note;
+        canvas.text({x0 + 0.5 * panel, ty}, std::to_string(stats->lost.total()) + " of " + std::to_string(stats->traced) + " rays lost",
+                    note * 0.95, kWarning, HAlign::Centre, VAlign::Top);
+        ty += 1.3 * note;
+        canvas.text({x0 + 0.5 * panel, ty}, stats->lost.total() == stats->lost.vignetted ? "(vignetted)" : "(vignetted, missed or TIR)",
+                    note * 0.95, kWarning, HAlign::Centre, VAlign::Top);
       }
     }
   }
   // Scale bar: one tick step of the panels.
-  const std::vector<double> ticks = nice_ticks(-half_um, half_um, 4);
-  const double step_um = ticks.size() > 1 ? ticks[1] - ticks[0] : half_um;
   const double bar_px = step_um / (2.0 * half_um) * panel;
-  const double by = height - 36.0;
+  const double by = height - 26.0;
   canvas.line({left, by}, {left + bar_px, by}, LineStyle{kText, 2.5});
   canvas.line({left, by - 5.0}, {left, by + 5.0}, LineStyle{kText, 1.5});
   canvas.line({left + bar_px, by - 5.0}, {left + bar_px, by + 5.0}, LineStyle{kText, 1.5});
@@ -434,24 +467,55 @@ Canvas plot_relative_illumination(const RelativeIllumination& ri, const PlotOpti
   return canvas;
 }
 
+Swatch surface_swatch(std::size_t rank) {
+  // Twenty light colours that differ from each other and from the pupil's blue (Kelly's colours of
+  // maximum contrast, lightened so the outline stays visible on them); then the same with hatching.
+  static constexpr Rgb kColours[] = {
+      {0.98f, 0.62f, 0.30f}, {0.99f, 0.86f, 0.35f}, {0.55f, 0.82f, 0.45f}, {0.72f, 0.55f, 0.88f}, {0.92f, 0.40f, 0.40f},
+      {0.45f, 0.80f, 0.75f}, {0.97f, 0.65f, 0.85f}, {0.72f, 0.55f, 0.40f}, {0.75f, 0.75f, 0.30f}, {0.65f, 0.65f, 0.65f},
+      {0.25f, 0.60f, 0.30f}, {0.85f, 0.30f, 0.75f}, {0.80f, 0.45f, 0.15f}, {0.45f, 0.30f, 0.65f}, {0.75f, 0.95f, 0.45f},
+      {0.60f, 0.20f, 0.25f}, {0.40f, 0.90f, 0.95f}, {0.93f, 0.85f, 0.70f}, {0.10f, 0.50f, 0.55f}, {0.30f, 0.30f, 0.30f}};
+  constexpr std::size_t kCount = std::size(kColours);
+  return {kColours[rank % kCount], static_cast<int>(rank / kCount)};
+}
+
+void fill_swatch(Canvas& canvas, Point2 top_left, Point2 bottom_right, const Swatch& swatch) {
+  canvas.fill_rect(top_left, bottom_right, swatch.colour);
+  if (swatch.hatch == 0) return;
+  // Hatching in canvas coordinates, so neighbouring cells continue each other's lines: 1 rising,
+  // 2 falling, 3 crossed, 4 and up: dots of a spacing that grows with the number.
+  const int x0 = static_cast<int>(std::floor(top_left.x)), x1 = static_cast<int>(std::ceil(bottom_right.x));
+  const int y0 = static_cast<int>(std::floor(top_left.y)), y1 = static_cast<int>(std::ceil(bottom_right.y));
+  const int period = 6 + swatch.hatch;
+  for (int y = y0; y < y1; ++y) {
+    for (int x = x0; x < x1; ++x) {
+      const int rising = ((x + y) % period + period) % period, falling = ((x - y) % period + period) % period;
+      bool mark = false;
+      if (swatch.hatch == 1) mark = rising < 2;
+      else if (swatch.hatch == 2) mark = falling < 2;
+      else if (swatch.hatch == 3) mark = rising < 2 || falling < 2;
+      else mark = (x % period) < 2 && (y % period) < 2;
+      if (mark) canvas.fill_rect({static_cast<double>(x), static_cast<double>(y)}, {x + 1.0, y + 1.0}, kWhite);
+    }
+  }
+}
+
 Canvas plot_pupil_shape(const PupilShape& shape, const PlotOptions& o) {
   const int count = static_cast<int>(shape.fields.size());
   const int columns = std::min(count, 4);
   const int rows = (count + columns - 1) / columns;
   const double panel = 250.0, gap_x = 80.0, gap_y = 60.0 + 3.0 * o.font_px;
   const double left = 90.0, top = header_height(o) + 2.0 * o.font_px + 20.0;
-  // Colours for the surfaces that stop rays, in surface order, light enough to show the outline.
-  std::map<int, Rgb> surface_colours;
-  const Rgb palette[] = {{0.98f, 0.62f, 0.45f}, {0.99f, 0.85f, 0.45f}, {0.75f, 0.60f, 0.90f}, {0.60f, 0.85f, 0.60f},
-                         {0.95f, 0.60f, 0.75f}, {0.65f, 0.80f, 0.80f}, {0.85f, 0.75f, 0.60f}, {0.80f, 0.80f, 0.50f}};
+  // A swatch per surface that stops rays, in surface order: never the same for two surfaces.
+  std::map<int, Swatch> surface_swatches;
   for (const auto& f : shape.fields) {
-    for (const auto& l : f.losses) surface_colours.emplace(l.surface, Rgb{});
+    for (const auto& l : f.losses) surface_swatches.emplace(l.surface, Swatch{});
   }
   {
     std::size_t i = 0;
-    for (auto& [surface, colour] : surface_colours) colour = palette[i++ % std::size(palette)];
+    for (auto& [surface, swatch] : surface_swatches) swatch = surface_swatch(i++);
   }
-  const int legend_rows = std::max(1, static_cast<int>(surface_colours.size() + 3) / 4);
+  const int legend_rows = std::max(1, static_cast<int>(surface_swatches.size() + 3) / 4);
   const int width = std::max(760, static_cast<int>(left + columns * panel + (columns - 1) * gap_x + 60.0));
   const int height = static_cast<int>(top + rows * panel + (rows - 1) * gap_y + 50.0 + 3.0 * o.font_px + legend_rows * 1.6 * o.font_px);
   Canvas canvas = make_canvas(width, height, o);
@@ -485,8 +549,12 @@ Canvas plot_pupil_shape(const PupilShape& shape, const PlotOptions& o) {
         const PupilCoordinate p = FieldPupilShape::cell_centre(f.grid, r, c);
         const Point2 a = axes.to_pixel(p.px - 0.5 * cell, p.py + 0.5 * cell);
         const Point2 b = axes.to_pixel(p.px + 0.5 * cell, p.py - 0.5 * cell);
-        const Rgb colour = pc.status == RayStatus::Ok ? pass : surface_colours[pc.surface];
-        canvas.fill_rect({std::round(a.x), std::round(a.y)}, {std::round(b.x), std::round(b.y)}, colour);
+        const Point2 ra{std::round(a.x), std::round(a.y)}, rb{std::round(b.x), std::round(b.y)};
+        if (pc.status == RayStatus::Ok) {
+          canvas.fill_rect(ra, rb, pass);
+        } else {
+          fill_swatch(canvas, ra, rb, surface_swatches[pc.surface]);
+        }
       }
     }
     axes.curve(ux, uy, LineStyle{kNote, 1.2, 5.0, 4.0});
@@ -509,8 +577,8 @@ Canvas plot_pupil_shape(const PupilShape& shape, const PlotOptions& o) {
   // Legend: which surface stopped the rays of each colour.
   double lx = 20.0, ly = height - 16.0 - legend_rows * 1.6 * o.font_px + 0.8 * o.font_px;
   int n = 0;
-  for (const auto& [surface, colour] : surface_colours) {
-    canvas.fill_rect({lx, ly - 7.0}, {lx + 14.0, ly + 7.0}, colour);
+  for (const auto& [surface, swatch] : surface_swatches) {
+    fill_swatch(canvas, {lx, ly - 7.0}, {lx + 14.0, ly + 7.0}, swatch);
     canvas.text({lx + 20.0, ly}, "stopped at surface " + std::to_string(surface), o.font_px * 0.85, kText, HAlign::Left, VAlign::Middle);
     lx += 200.0;
     if (++n % 4 == 0) {
@@ -531,16 +599,14 @@ Canvas plot_seidel_diagram(const SeidelAnalysis& seidel, const std::string& lens
     const char* label;
     Rgb colour;
   };
-  // Colours as in the usual Seidel diagram: one per aberration, the sum group drawn the same way.
-  // OpticStudio's short names: spherical, coma, astigmatism, Petzval, distortion, axial and lateral colour.
-  const Term terms[] = {{"SPHA", Rgb{0.10f, 0.30f, 0.85f}}, {"COMA", Rgb{0.90f, 0.45f, 0.05f}}, {"ASTI", Rgb{0.15f, 0.60f, 0.20f}},
-                        {"PETZ", Rgb{0.80f, 0.15f, 0.15f}}, {"DIST", Rgb{0.50f, 0.30f, 0.70f}}, {"CLA", Rgb{0.45f, 0.45f, 0.45f}},
-                        {"CTR", Rgb{0.85f, 0.60f, 0.80f}}};
+  // The columns of `lensmith seidel`'s table, in its order and with its names.
+  const Term terms[] = {{"S_I", Rgb{0.10f, 0.30f, 0.85f}},  {"S_II", Rgb{0.90f, 0.45f, 0.05f}}, {"S_III", Rgb{0.15f, 0.60f, 0.20f}},
+                        {"S_IV", Rgb{0.80f, 0.15f, 0.15f}}, {"S_V", Rgb{0.50f, 0.30f, 0.70f}},  {"C_I", Rgb{0.45f, 0.45f, 0.45f}},
+                        {"C_II", Rgb{0.85f, 0.55f, 0.78f}}};
   constexpr int kTerms = 7;
-  const double k = 1.0 / (2.0 * seidel.image_index() * seidel.image_slope());
-  auto values = [k](const SeidelSums& s) {
-    return std::array<double, kTerms>{s.S1 * k, s.S2 * k, s.S3 * k, s.S4 * k, s.S5 * k, s.C1 * 2.0 * k, s.C2 * 2.0 * k};
-  };
+  // Welford's sums exactly as the text output prints them (mm, their own signs): no rescaling, so a
+  // bar can be checked against the table.
+  auto values = [](const SeidelSums& s) { return std::array<double, kTerms>{s.S1, s.S2, s.S3, s.S4, s.S5, s.C1, s.C2}; };
   std::vector<std::array<double, kTerms>> groups;
   for (const SeidelSums& s : seidel.surfaces()) groups.push_back(values(s));
   groups.push_back(values(seidel.sums()));
@@ -553,36 +619,46 @@ Canvas plot_seidel_diagram(const SeidelAnalysis& seidel, const std::string& lens
   }
   if (hi - lo <= 0.0) hi = lo + 1e-6;
 
-  const double group_px = std::clamp(600.0 / static_cast<double>(groups.size()), 36.0, 90.0);
-  const double width = kPanelLeft + group_px * static_cast<double>(groups.size()) + 60.0;
+  // Surfaces side by side, then half a group of space and the sum on a light band.
+  const double count = static_cast<double>(groups.size());
+  const double group_px = std::clamp(700.0 / count, 40.0, 90.0);
+  const double sum_gap_px = 0.5 * group_px;
+  const double right = kPanelLeft + group_px * count + sum_gap_px;
   const double top = header_height(o) + 2.0 * o.font_px + 34.0;
-  Canvas canvas(static_cast<int>(std::max(width, 820.0)), static_cast<int>(top + kPanelHeight + 4.0 * o.font_px + 30.0));
-  canvas.set_font(o.font_path);
-  const double right = kPanelLeft + group_px * static_cast<double>(groups.size());
-  PlotAxes axes(canvas, {kPanelLeft, top}, {right, top + kPanelHeight}, {0.0, static_cast<double>(groups.size())}, nice_range(lo, hi, 6));
+  Canvas canvas = make_canvas(static_cast<int>(std::max(right + 60.0, 820.0)), static_cast<int>(top + kPanelHeight + 4.0 * o.font_px + 30.0), o);
+  PlotAxes axes(canvas, {kPanelLeft, top}, {right, top + kPanelHeight}, {0.0, 1.0}, nice_range(lo, hi, 6));
   header(canvas, "Seidel diagram", lens_name,
-         "transverse third-order contributions per surface at " + wavelength_label(seidel.wavelength_nm()) +
-             " (mm; Smith's forms S/(2n'u'), colour C/(n'u')): spherical, coma, astigmatism, Petzval, distortion, axial and lateral "
-             "colour; last group: sum",
+         "Welford's Seidel sums per surface at " + wavelength_label(seidel.wavelength_nm()) +
+             " (mm) as `lensmith seidel` prints them: S_I spherical (> 0 undercorrected), S_II coma, S_III astigmatism, "
+             "S_IV Petzval, S_V distortion, C_I axial and C_II lateral colour",
          o);
+  const double sum_x0 = kPanelLeft + group_px * (count - 1.0) + sum_gap_px;
+  canvas.fill_rect({sum_x0, top}, {right, top + kPanelHeight}, Rgb{0.94f, 0.94f, 0.94f});
   AxesText text;
   text.font_px = o.font_px;
-  text.y_label = "contribution (mm)";
+  text.y_label = "Seidel sum (mm)";
+  text.x_grid = false;  // vertical lines between groups would read as element boundaries
+  text.x_tick_marks = false;
   axes.draw_frame(text, false, true, 5, 6);
-  axes.draw_zero_lines(true, false);
   const double bar = group_px * 0.8 / kTerms;
+  const Point2 zero = axes.to_pixel(0.0, 0.0);
   for (std::size_t g = 0; g < groups.size(); ++g) {
-    const double x0 = kPanelLeft + group_px * static_cast<double>(g) + group_px * 0.1;
+    const bool sum = g + 1 == groups.size();
+    const double gx = sum ? sum_x0 : kPanelLeft + group_px * static_cast<double>(g);
+    const double x0 = gx + group_px * 0.1;
     for (int t = 0; t < kTerms; ++t) {
-      const Point2 zero = axes.to_pixel(0.0, 0.0);
       const Point2 end = axes.to_pixel(0.0, groups[g][static_cast<std::size_t>(t)]);
       const double xa = x0 + bar * t;
       canvas.fill_rect({xa, std::min(zero.y, end.y)}, {xa + bar * 0.9, std::max(zero.y, end.y)}, terms[t].colour);
     }
-    const std::string label = g + 1 == groups.size() ? std::string("sum") : std::to_string(g + 1);
-    canvas.text({x0 + group_px * 0.4, top + kPanelHeight + 6.0}, label, o.font_px * 0.9, kText, HAlign::Centre, VAlign::Top);
+    // A tick mark under the group's centre, outside the frame: an axis tick, not a separator.
+    const double cx = gx + 0.5 * group_px;
+    canvas.line({cx, top + kPanelHeight}, {cx, top + kPanelHeight + 5.0}, LineStyle{kText, 1.2});
+    canvas.text({cx, top + kPanelHeight + 8.0}, sum ? std::string("sum") : std::to_string(g + 1), o.font_px * 0.9, kText, HAlign::Centre,
+                VAlign::Top);
   }
-  canvas.text({(kPanelLeft + right) / 2.0, top + kPanelHeight + 1.6 * o.font_px + 6.0}, "surface", o.font_px, kText, HAlign::Centre, VAlign::Top);
+  canvas.line({kPanelLeft, zero.y}, {right, zero.y}, LineStyle{kText, 1.2});
+  canvas.text({(kPanelLeft + right) / 2.0, top + kPanelHeight + 1.6 * o.font_px + 8.0}, "surface", o.font_px, kText, HAlign::Centre, VAlign::Top);
   std::vector<LegendEntry> legend;
   for (const Term& t : terms) legend.push_back({t.label, LineStyle{t.colour, 8.0}});
   legend_row(canvas, {kPanelLeft, top - 1.4 * o.font_px}, legend, o);

@@ -203,6 +203,39 @@ void Canvas::fill_rect(Point2 top_left, Point2 bottom_right, Rgb colour) {
   }
 }
 
+void Canvas::fill_polygon(std::span<const Point2> points, Rgb colour) {
+  if (points.size() < 3) return;
+  double top = points[0].y, bottom = points[0].y;
+  for (const Point2& p : points) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y)) return;
+    top = std::min(top, p.y);
+    bottom = std::max(bottom, p.y);
+  }
+  constexpr int kSubRows = 4;
+  std::vector<float> row(static_cast<std::size_t>(width_));
+  std::vector<double> crossings;
+  for (int y = std::max(0, static_cast<int>(std::floor(top))); y < std::min(height_, static_cast<int>(std::ceil(bottom)) + 1); ++y) {
+    std::fill(row.begin(), row.end(), 0.0f);
+    for (int s = 0; s < kSubRows; ++s) {
+      const double sy = y + (s + 0.5) / kSubRows;
+      crossings.clear();
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        const Point2 a = points[i], b = points[(i + 1) % points.size()];
+        if ((a.y <= sy) != (b.y <= sy)) crossings.push_back(a.x + (sy - a.y) / (b.y - a.y) * (b.x - a.x));
+      }
+      std::sort(crossings.begin(), crossings.end());
+      for (std::size_t i = 0; i + 1 < crossings.size(); i += 2) {
+        const double x0 = std::clamp(crossings[i], 0.0, static_cast<double>(width_));
+        const double x1 = std::clamp(crossings[i + 1], 0.0, static_cast<double>(width_));
+        for (int x = static_cast<int>(std::floor(x0)); x < static_cast<int>(std::ceil(x1)) && x < width_; ++x) {
+          row[static_cast<std::size_t>(x)] += static_cast<float>((std::min(x1, x + 1.0) - std::max(x0, static_cast<double>(x))) / kSubRows);
+        }
+      }
+    }
+    for (int x = 0; x < width_; ++x) blend(x, y, colour, row[static_cast<std::size_t>(x)]);
+  }
+}
+
 void Canvas::rect(Point2 top_left, Point2 bottom_right, const LineStyle& style) {
   const Point2 points[5] = {top_left, {bottom_right.x, top_left.y}, bottom_right, {top_left.x, bottom_right.y}, top_left};
   polyline(points, style);
@@ -258,7 +291,10 @@ void Canvas::text(Point2 anchor, std::string_view utf8, double size_px, Rgb colo
   if (v == VAlign::Top) ay = pad;
   if (v == VAlign::Middle) ay = pad + 0.5 * (ascent + 0.35 * size);  // middle of the capital letters
   if (v == VAlign::Bottom) ay = pad + ascent + descent;
+  const double ink_top = pad + 1.0, ink_bottom = pad + ascent + descent - 1.0;  // rows between the tallest and deepest letters
   if (!vertical) {
+    const double left = static_cast<double>(std::lround(anchor.x - ax)) + pad, top = static_cast<double>(std::lround(anchor.y - ay));
+    text_boxes_.push_back({{left, top + ink_top, left + total, top + ink_bottom}, std::string(utf8)});
     blend_mask(mask, mask_width, mask_height, static_cast<int>(std::lround(anchor.x - ax)), static_cast<int>(std::lround(anchor.y - ay)),
                colour);
     return;
@@ -267,6 +303,7 @@ void Canvas::text(Point2 anchor, std::string_view utf8, double size_px, Rgb colo
   const double cu = pad + 0.5 * total;
   const int x0 = static_cast<int>(std::lround(anchor.x - ay));
   const int y0 = static_cast<int>(std::lround(anchor.y + cu));
+  text_boxes_.push_back({{x0 + ink_top, y0 - pad - total, x0 + ink_bottom, static_cast<double>(y0 - pad)}, std::string(utf8)});
   for (int w = 0; w < mask_height; ++w) {
     for (int u = 0; u < mask_width; ++u) blend(x0 + w, y0 - u, colour, mask[static_cast<std::size_t>(w * mask_width + u)]);
   }

@@ -102,9 +102,9 @@ void PlotAxes::draw_frame(const AxesText& text, bool tick_labels_x, bool tick_la
   const double y_step = yt.size() > 1 ? yt[1] - yt[0] : y_.max - y_.min;
   const LineStyle grid{kGrid, 1.0};
   const LineStyle tick{kFrame, 1.2};
-  for (double t : xt) {
+  for (double t : text.x_tick_marks ? xt : std::vector<double>{}) {
     const Point2 p = to_pixel(t, y_.min);
-    canvas_.line({p.x, top_left_.y}, {p.x, bottom_right_.y}, grid);
+    if (text.x_grid) canvas_.line({p.x, top_left_.y}, {p.x, bottom_right_.y}, grid);
     canvas_.line({p.x, bottom_right_.y}, {p.x, bottom_right_.y + 5.0}, tick);
     if (tick_labels_x) canvas_.text({p.x, bottom_right_.y + 8.0}, tick_label(t, x_step), fs * 0.85, kFrame, HAlign::Centre, VAlign::Top);
   }

@@ -8,6 +8,9 @@
 
 #include "lensmith/core/errors.h"
 #include "lensmith/core/units.h"
+#include "lensmith/plot/canvas.h"
+#include "lensmith/plot/plot_axes.h"
+#include "lensmith/render/image_io.h"
 
 namespace lensmith {
 
@@ -134,8 +137,24 @@ std::string PsfValidation::to_markdown() const {
   return os.str();
 }
 
-Image psf_grid_picture(const Camera& camera, const std::vector<RayModelKind>& models, const Aperture& aperture,
-                       const PsfValidationOptions& options, const RayModelOptions& model_options) {
+namespace {
+
+// One row of the PSF grid: which point it shows and the comparison window's half-width.
+struct PsfGridRow {
+  double relative_field = 0.0;
+  double depth_m = 0.0;
+  double half_width_mm = 0.0;  // 0 when the exact model lost every ray (an empty row)
+};
+
+struct PsfGrid {
+  Image tiles;
+  int tile = 0;  // tile side, px
+  int gap = 0;   // between tiles and around the block, px
+  std::vector<PsfGridRow> rows;
+};
+
+PsfGrid psf_grid(const Camera& camera, const std::vector<RayModelKind>& models, const Aperture& aperture,
+                 const PsfValidationOptions& options, const RayModelOptions& model_options) {
   options.validate();
   const auto exact = make_ray_model(RayModelKind::Exact, camera, model_options);
   std::vector<std::unique_ptr<RayModel>> fast;
@@ -146,12 +165,14 @@ Image psf_grid_picture(const Camera& camera, const std::vector<RayModelKind>& mo
   const int tile = bins * zoom;
   const int columns = 1 + 2 * static_cast<int>(models.size());
   const int rows = static_cast<int>(options.relative_fields.size() * depths.size());
+  std::vector<PsfGridRow> rows_info;
   Image out(columns * (tile + gap) + gap, rows * (tile + gap) + gap, 3, 0.08f);
   const double wavelength = camera.reference_wavelength_nm();
   int row = 0;
   for (double field : options.relative_fields) {
     for (double depth : depths) {
       const ScenePoint point = scene_point(camera, field, depth);
+      PsfGridRow info{field, depth, 0.0};
       const PointSpread reference = trace_point_spread(*exact, point, wavelength, aperture, options.pupil_samples_per_axis);
       auto put = [&](const Image& binned, int column, int channel_mask, float scale) {
         for (int y = 0; y < tile; ++y) {
@@ -169,6 +190,7 @@ Image psf_grid_picture(const Camera& camera, const std::vector<RayModelKind>& mo
         double half = 0.0;
         const double min_half_width_mm = options.min_half_width_px / std::abs(camera.px_per_sensor_mm());
         for (const PointSpread& s : spreads) half = std::max(half, comparison_half_width_mm(reference, s, min_half_width_mm));
+        info.half_width_mm = half;
         const Image ref = bin_point_spread(reference, reference.centroid_x_mm, reference.centroid_y_mm, half, bins);
         const float peak = *std::max_element(ref.data.begin(), ref.data.end());
         const float scale = peak > 0.0f ? 1.0f / peak : 1.0f;
@@ -181,7 +203,79 @@ Image psf_grid_picture(const Camera& camera, const std::vector<RayModelKind>& mo
           put(diff, 2 + 2 * static_cast<int>(m), 1, scale);  // red
         }
       }
+      rows_info.push_back(info);
       ++row;
+    }
+  }
+  return {std::move(out), tile, gap, std::move(rows_info)};
+}
+
+}  // namespace
+
+Image psf_grid_picture(const Camera& camera, const std::vector<RayModelKind>& models, const Aperture& aperture,
+                       const PsfValidationOptions& options, const RayModelOptions& model_options) {
+  return psf_grid(camera, models, aperture, options, model_options).tiles;
+}
+
+Image psf_grid_figure(const Camera& camera, const std::vector<RayModelKind>& models, const Aperture& aperture,
+                      const PsfValidationOptions& options, const RayModelOptions& model_options, const std::string& font_path) {
+  const PsfGrid grid = psf_grid(camera, models, aperture, options, model_options);
+  constexpr double kFontPx = 13.0;
+  const plot::Rgb kText{0.1f, 0.1f, 0.1f}, kNote{0.38f, 0.38f, 0.38f};
+  const double label_width = 190.0, top = 60.0, bottom = 34.0;
+  plot::Canvas canvas(static_cast<int>(label_width + grid.tiles.width + 10), static_cast<int>(top + grid.tiles.height + bottom));
+  if (!font_path.empty()) canvas.set_font(font_path);
+  // The tiles as they were encoded before (linear values shown through sRGB), on the white figure.
+  for (int y = 0; y < grid.tiles.height; ++y) {
+    for (int x = 0; x < grid.tiles.width; ++x) {
+      const plot::Rgb c{srgb_encode(grid.tiles.at(x, y, 0)), srgb_encode(grid.tiles.at(x, y, 1)), srgb_encode(grid.tiles.at(x, y, 2))};
+      canvas.fill_rect({label_width + x, top + y}, {label_width + x + 1.0, top + y + 1.0}, c);
+    }
+  }
+  canvas.text({10.0, 8.0},
+              "PSFs at " + plot::tick_label(camera.reference_wavelength_nm(), 0.1) +
+                  " nm, each tile scaled to the exact PSF's peak; |diff| = |model - exact| in red",
+              kFontPx, kText, plot::HAlign::Left, plot::VAlign::Top);
+  // Column labels: exact, then each model and its difference.
+  auto column_centre = [&](int column) { return label_width + grid.gap + column * (grid.tile + grid.gap) + 0.5 * grid.tile; };
+  canvas.text({column_centre(0), top - 6.0}, "exact", kFontPx, kText, plot::HAlign::Centre, plot::VAlign::Bottom);
+  for (std::size_t m = 0; m < models.size(); ++m) {
+    canvas.text({column_centre(1 + 2 * static_cast<int>(m)), top - 6.0}, to_string(models[m]), kFontPx, kText, plot::HAlign::Centre,
+                plot::VAlign::Bottom);
+    canvas.text({column_centre(2 + 2 * static_cast<int>(m)), top - 6.0}, "|diff|", kFontPx, kText, plot::HAlign::Centre, plot::VAlign::Bottom);
+  }
+  // Row labels: the field and depth, the window, and a scale bar on the sensor in micrometres.
+  for (std::size_t r = 0; r < grid.rows.size(); ++r) {
+    const PsfGridRow& row = grid.rows[r];
+    const double y0 = top + grid.gap + static_cast<double>(r) * (grid.tile + grid.gap);
+    canvas.text({10.0, y0 + 4.0}, "field " + plot::tick_label(row.relative_field, 0.01) + ", depth " + depth_text(row.depth_m) + (std::isinf(row.depth_m) ? "" : " m"),
+                kFontPx, kText, plot::HAlign::Left, plot::VAlign::Top);
+    if (row.half_width_mm <= 0.0) {
+      canvas.text({10.0, y0 + 24.0}, "no exact ray reaches the sensor", kFontPx * 0.9, kNote, plot::HAlign::Left, plot::VAlign::Top);
+      continue;
+    }
+    const double window_um = um_from_mm(2.0 * row.half_width_mm);
+    canvas.text({10.0, y0 + 24.0}, "tile " + plot::tick_label(window_um, window_um < 10.0 ? 0.01 : 0.1) + " \xC2\xB5m across", kFontPx * 0.9,
+                kNote, plot::HAlign::Left, plot::VAlign::Top);
+    const std::vector<double> ticks = plot::nice_ticks(0.0, window_um, 3);
+    const double bar_um = ticks.size() > 1 ? ticks[1] - ticks[0] : window_um;
+    const double bar_px = bar_um / window_um * grid.tile;
+    const double by = y0 + 56.0;
+    canvas.line({10.0, by}, {10.0 + bar_px, by}, plot::LineStyle{kText, 2.5});
+    canvas.line({10.0, by - 4.0}, {10.0, by + 4.0}, plot::LineStyle{kText, 1.2});
+    canvas.line({10.0 + bar_px, by - 4.0}, {10.0 + bar_px, by + 4.0}, plot::LineStyle{kText, 1.2});
+    canvas.text({16.0 + bar_px, by}, plot::tick_label(bar_um, bar_um) + " \xC2\xB5m", kFontPx * 0.9, kText, plot::HAlign::Left,
+                plot::VAlign::Middle);
+  }
+  canvas.text({10.0, canvas.height() - 10.0}, "field: fraction of the frame's half-width; depth: from the camera; scale bars: on the sensor",
+              kFontPx * 0.9, kNote, plot::HAlign::Left, plot::VAlign::Bottom);
+  Image out(canvas.width(), canvas.height(), 3);
+  for (int y = 0; y < canvas.height(); ++y) {
+    for (int x = 0; x < canvas.width(); ++x) {
+      const plot::Rgb c = canvas.pixel(x, y);
+      out.at(x, y, 0) = srgb_decode(c.r);
+      out.at(x, y, 1) = srgb_decode(c.g);
+      out.at(x, y, 2) = srgb_decode(c.b);
     }
   }
   return out;

@@ -56,7 +56,13 @@ struct SpotDiagram {
   double reference_wavelength_nm = 0.0;
   std::string field_unit;
   double image_plane_z_mm = 0.0;
+  // Working f-number in image space, 1 / (2 n' |u'|) of the paraxial marginal ray at the reference
+  // wavelength and the prescription's object distance (every field shares that conjugate): the Airy
+  // disc's first dark ring has radius 1.22 lambda N_w (Born & Wolf, Principles of Optics, 8.5.2).
+  double working_f_number = 0.0;
   std::vector<FieldSpot> fields;
+  // 1.22 lambda N_w, mm, at `wavelength_nm`.
+  double airy_radius_mm(double wavelength_nm) const;
   std::string to_string() const;  // a table of radii in micrometres per field and wavelength
   friend std::ostream& operator<<(std::ostream& os, const SpotDiagram& s) { return os << s.to_string(); }
 };

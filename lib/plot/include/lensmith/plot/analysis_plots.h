@@ -30,8 +30,9 @@ struct PlotOptions {
 // Colours for wavelengths by rank: the shortest blue, the longest red, green between.
 std::vector<Rgb> wavelength_colours(const std::vector<double>& wavelengths_nm);
 
-// Fields (rows) x wavelengths (columns, plus an overlay of all when there are several); every panel
-// centred on the reference chief ray at one common scale in micrometres, RMS and GEO radii below.
+// Fields (rows, labelled with the chief ray's image height) x wavelengths (columns, plus an overlay of
+// all when there are several); every panel centred on the reference chief ray at one common scale in
+// micrometres with the Airy circle (1.22 lambda N_w) about it, RMS and GEO radii and lost rays below.
 Canvas plot_spot_diagram(const SpotDiagram& spots, const PlotOptions& options = {});
 // Per field a tangential (ey against py) and a sagittal (ex against px) panel, one curve per
 // wavelength, a common error scale in micrometres; a ray that died leaves a gap.
@@ -44,14 +45,25 @@ Canvas plot_field_curves(const FieldCurves& curves, const PlotOptions& options =
 Canvas plot_chromatic_focal_shift(const ChromaticFocalShift& shift, const PlotOptions& options = {});
 // Relative illumination, vignetting factor and the cos^4 estimate against field.
 Canvas plot_relative_illumination(const RelativeIllumination& illumination, const PlotOptions& options = {});
+// How the pupil picture marks the rays a surface stopped: a light colour, plain (hatch 0) or hatched
+// (1 rising lines, 2 falling, 3 crossed, 4 and up dotted) when more surfaces stop rays than there are colours.
+struct Swatch {
+  Rgb colour;
+  int hatch = 0;
+  friend bool operator==(const Swatch&, const Swatch&) = default;
+};
+// The swatch of the rank-th surface (0-based, in surface order) that stops rays: no two ranks share one.
+Swatch surface_swatch(std::size_t rank);
+// Fills the rectangle with `swatch` (hatching continues across neighbouring rectangles).
+void fill_swatch(Canvas& canvas, Point2 top_left, Point2 bottom_right, const Swatch& swatch);
+
 // The entrance pupil per field: cells that pass, cells lost coloured by the surface that stopped
 // them, the outline of the passing region and its area fraction.
 Canvas plot_pupil_shape(const PupilShape& shape, const PlotOptions& options = {});
 
-// The Seidel diagram designers know from OpticStudio: per surface and for the sum, grouped bars of
-// the transverse third-order contributions (Smith's forms, mm): spherical S_I/(2n'u'), coma
-// S_II/(2n'u'), astigmatism S_III/(2n'u'), Petzval S_IV/(2n'u'), distortion S_V/(2n'u'), axial
-// colour C_I/(n'u') and lateral colour C_II/(n'u').
+// The Seidel diagram: per surface and for the sum, grouped bars of Welford's sums S_I..S_V, C_I and C_II
+// (mm) with the numbers and signs `lensmith seidel` prints (SeidelAnalysis::to_string), a zero line, and
+// tick marks under the groups instead of vertical grid lines (which read as element boundaries).
 Canvas plot_seidel_diagram(const SeidelAnalysis& seidel, const std::string& lens_name, const PlotOptions& options = {});
 
 }  // namespace lensmith::plot

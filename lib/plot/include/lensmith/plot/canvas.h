@@ -38,6 +38,12 @@ struct LineStyle {
   double gap_px = 0.0;    // gap between dashes
 };
 
+// A pixel rectangle [x0, x1) x [y0, y1): where a label was drawn (Canvas::text_boxes).
+struct PixelBox {
+  double x0 = 0.0, y0 = 0.0, x1 = 0.0, y1 = 0.0;
+  bool intersects(const PixelBox& o) const { return x0 < o.x1 && o.x0 < x1 && y0 < o.y1 && o.y0 < y1; }
+};
+
 enum class HAlign { Left, Centre, Right };
 enum class VAlign { Top, Middle, Baseline, Bottom };
 
@@ -65,6 +71,9 @@ class Canvas {
   void fill_disc(Point2 centre, double radius_px, Rgb colour);
   void circle(Point2 centre, double radius_px, const LineStyle& style);
   void fill_rect(Point2 top_left, Point2 bottom_right, Rgb colour);
+  // The inside of a closed polygon (even-odd rule, the last point joined to the first), anti-aliased
+  // along y by 4 sub-rows per pixel and along x by the exact coverage of each span's end pixels.
+  void fill_polygon(std::span<const Point2> points, Rgb colour);
   void rect(Point2 top_left, Point2 bottom_right, const LineStyle& style);
 
   // UTF-8 text at size_px (the em height, rounded to whole pixels), kerned; any letter the font
@@ -75,6 +84,13 @@ class Canvas {
             VAlign v = VAlign::Baseline, bool vertical = false);
   // Width of `utf8` drawn at `size_px`, pixels (0 without a font).
   double text_width(std::string_view utf8, double size_px) const;
+  // The box of every label drawn so far (advance width by ascent + descent; rotated for vertical
+  // text), with its text: pictures are tested for labels that collide.
+  struct TextBox {
+    PixelBox box;
+    std::string text;
+  };
+  const std::vector<TextBox>& text_boxes() const { return text_boxes_; }
 
   // Writes an 8-bit sRGB-encoded PNG through a temporary file in the same folder and a rename.
   // Throws IoError naming the path.
@@ -94,7 +110,8 @@ class Canvas {
   int height_ = 0;
   std::vector<float> pixels_;  // RGB, row-major, linear values in [0, 1] treated as display values
   std::optional<std::string> font_;
-  std::shared_ptr<const TrueTypeFont> face_;  // font_ parsed; shared by copies of the canvas
+  std::shared_ptr<const TrueTypeFont> face_;
+  std::vector<TextBox> text_boxes_;  // font_ parsed; shared by copies of the canvas
 };
 
 }  // namespace lensmith::plot

@@ -28,6 +28,8 @@ struct AxesText {
   std::string x_label;  // below, with the unit: "py (normalised)"
   std::string y_label;  // left, vertical: "ey (µm)"
   double font_px = 14.0;
+  bool x_grid = true;        // vertical grid lines at the x ticks
+  bool x_tick_marks = true;  // tick marks (and labels) along x; false: the caller draws its own
 };
 
 class PlotAxes {

@@ -59,4 +59,11 @@ PsfValidation validate_point_spreads(const Camera& camera, const std::vector<Ray
 Image psf_grid_picture(const Camera& camera, const std::vector<RayModelKind>& models, const Aperture& aperture,
                        const PsfValidationOptions& options = {}, const RayModelOptions& model_options = {});
 
+// The same tiles as a figure a person can read (`lensmith validate`'s psf.png): each row labelled
+// with its field and depth and a scale bar in micrometres on the sensor (rows differ: each has its
+// own comparison window), each column with exact, the model's name or |diff|. Linear RGB on white.
+// `font_path` empty: no text (tiles and scale bars only).
+Image psf_grid_figure(const Camera& camera, const std::vector<RayModelKind>& models, const Aperture& aperture,
+                      const PsfValidationOptions& options, const RayModelOptions& model_options, const std::string& font_path);
+
 }  // namespace lensmith
