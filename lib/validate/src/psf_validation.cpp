@@ -267,7 +267,7 @@ Image psf_grid_figure(const Camera& camera, const std::vector<RayModelKind>& mod
     canvas.text({16.0 + bar_px, by}, plot::tick_label(bar_um, bar_um) + " \xC2\xB5m", kFontPx * 0.9, kText, plot::HAlign::Left,
                 plot::VAlign::Middle);
   }
-  canvas.text({10.0, canvas.height() - 10.0}, "field: fraction of the frame's half-width; depth: from the camera; scale bars: on the sensor",
+  canvas.text({10.0, canvas.height() - 10.0}, "field: fraction of the frame's half-width; depth: from the entrance pupil; scale bars: on the sensor",
               kFontPx * 0.9, kNote, plot::HAlign::Left, plot::VAlign::Bottom);
   Image out(canvas.width(), canvas.height(), 3);
   for (int y = 0; y < canvas.height(); ++y) {
