@@ -22,9 +22,10 @@
 // rather than one polynomial in y0 for the whole frame matters for wide-angle lenses, whose
 // aberrations grow faster than y0^3 towards the corner: one global fit trades the centre's accuracy
 // for the corner's. The spot's shape (the hits less their centroid) fixes the pupil-dependent terms,
-// the centroid the distortion. Between fitted wavelengths the difference to the sums is interpolated
-// linearly, so that the sums' chromatic variation of the third order is kept; on the axis the
-// radial term (D y0^2, zero in the sums) carries the real lens's best focus shift.
+// the centroid the distortion. Between fitted wavelengths the terms are interpolated linearly (the
+// differences to the sums were tried first: a model glass's sums vary unevenly between 380 and
+// 480 nm, and the difference carried that into colour fringes). On the axis the radial term
+// (D y0^2, zero in the sums) carries the real lens's best focus shift.
 #include <omp.h>
 
 #include <Eigen/Dense>
@@ -52,6 +53,10 @@ constexpr int kMinFitRays = 16;
 // Where fewer rays than this pass the full grid in either model, the grid is laid again over the box
 // around what passes.
 constexpr std::size_t kDenseBelow = 48;
+// A fit whose spot over the model's own passing pupil reaches more than this many times as far as
+// the real spot's and the sums' (plus a pixel) is extrapolating where no real ray passed: the field
+// keeps its sums.
+constexpr double kExtrapolationGrowth = 1.5;
 // Where the real rays reach less than this pupil radius, the spherical term (rho^3) is not fitted.
 constexpr double kSphericalReach = 0.5;
 // Ridge added to the normal equations, relative to their mean diagonal: keeps a term the rays do not
@@ -138,6 +143,48 @@ bool fit_field(const SeidelRayGeometry& geometry, const std::vector<PupilPoint>&
   return std::isfinite(t.distortion);
 }
 
+// The largest distance (mm) from their centroid of the points `pupil[p]` with `use[p].ok` maps to
+// by `terms`.
+double spot_reach_mm(const SeidelRayGeometry& geometry, const std::vector<PupilPoint>& pupil, const std::vector<SensorHit>& use,
+                     const FieldTerms& terms) {
+  std::vector<std::pair<double, double>> points;
+  double sx = 0.0, sy = 0.0;
+  for (std::size_t p = 0; p < pupil.size(); ++p) {
+    if (!use[p].ok) continue;
+    double x, y;
+    geometry.sensor_point(pupil[p], terms, x, y);
+    points.emplace_back(x, y);
+    sx += x, sy += y;
+  }
+  if (points.empty()) return 0.0;
+  sx /= static_cast<double>(points.size()), sy /= static_cast<double>(points.size());
+  double reach = 0.0;
+  for (const auto& [x, y] : points) reach = std::max(reach, std::hypot(x - sx, y - sy));
+  return reach;
+}
+
+// Whether the fitted terms, carried over the pupil the model itself passes (its first-order
+// clipping, which is not the real lens's where a clear aperture cuts a cat's eye), throw rays far
+// beyond both the real spot and the sums' one: a third-order fit to a clipped beam's rays can grow
+// large where no ray constrained it (a 35 mm lens's frame corner: B = 0.78 mm, 14 px at the rim).
+// The field then keeps its sums.
+bool extrapolates(const SeidelRayGeometry& geometry, const std::vector<PupilPoint>& pupil, const std::vector<SensorHit>& hits,
+                  const std::vector<SensorHit>& own, const FieldTerms& fit, const FieldTerms& sums, double pixel_mm) {
+  std::vector<std::pair<double, double>> points;
+  double sx = 0.0, sy = 0.0;
+  for (const SensorHit& h : hits) {
+    if (h.ok) points.emplace_back(h.x_mm, h.y_mm), sx += h.x_mm, sy += h.y_mm;
+  }
+  double real = 0.0;
+  if (!points.empty()) {
+    sx /= static_cast<double>(points.size()), sy /= static_cast<double>(points.size());
+    for (const auto& [x, y] : points) real = std::max(real, std::hypot(x - sx, y - sy));
+  }
+  const double fitted = spot_reach_mm(geometry, pupil, own, fit);
+  const double summed = spot_reach_mm(geometry, pupil, own, sums);
+  return fitted > kExtrapolationGrowth * std::max(real, summed) + pixel_mm;
+}
+
 }  // namespace
 
 FittedAberrations::FittedAberrations(const Camera& camera, const ExactModel& exact, const AberrationTable& table,
@@ -152,8 +199,8 @@ FittedAberrations::FittedAberrations(const Camera& camera, const ExactModel& exa
     wavelengths_nm_.push_back(lambdas[node_index[n]]);
   }
   for (int k = 0; k < kFitFields; ++k) fields_.push_back(static_cast<double>(k) / (kFitFields - 1));
-  delta_.assign(distances.size() * nodes * fields_.size(), FieldTerms{});
-  light_.assign(delta_.size(), 1.0);
+  terms_.assign(distances.size() * nodes * fields_.size(), FieldTerms{});
+  light_.assign(terms_.size(), 1.0);
   std::vector<PupilPoint> full;
   pupil_grid(-1.0, 1.0, -1.0, 1.0, full);
   const int tasks = static_cast<int>(distances.size() * nodes);
@@ -166,6 +213,7 @@ FittedAberrations::FittedAberrations(const Camera& camera, const ExactModel& exa
     const FirstOrderSample fo = camera.first_order(s.wavelength_nm);
     // The depth, from the perspective centre, of the table's object distance (from surface 1).
     const double w = inverse_per_mm(s.object_distance_mm + camera.z_perspective_mm());
+    const double pixel_mm = 1.0 / std::abs(camera.px_per_sensor_mm());
     std::vector<PupilPoint> pupil;
     std::vector<SensorHit> hits, own;
     for (std::size_t k = 0; k < fields_.size(); ++k) {
@@ -205,14 +253,15 @@ FittedAberrations::FittedAberrations(const Camera& camera, const ExactModel& exa
         if (own[p].ok) own_light += own[p].weight;
       }
       if (own_light > 0.0) light_[(j * nodes + n) * fields_.size() + k] = real_light / own_light;
-      if (!ok) {
+      const FieldTerms sums = FieldTerms::at(c, geometry.y0);
+      FieldTerms& t = terms_[(j * nodes + n) * fields_.size() + k];
+      if (!ok || extrapolates(geometry, pupil, hits, own, fit, sums, pixel_mm)) {
         ++kept;
+        t = sums;
         continue;
       }
       ++fitted;
-      const FieldTerms sums = FieldTerms::at(c, geometry.y0);
-      FieldTerms& d = delta_[(j * nodes + n) * fields_.size() + k];
-      for (int m = 0; m < 5; ++m) d[m] = fit[m] - sums[m];
+      t = fit;
     }
   }
   // Both models' weights are normalised so that the on-axis point of the focus plane passes a mean
@@ -237,7 +286,7 @@ FittedAberrations::FittedAberrations(const Camera& camera, const ExactModel& exa
   kept_ = kept;
 }
 
-double FittedAberrations::correct(double wavelength_nm, double object_distance_mm, double y0, FieldTerms& terms) const {
+double FittedAberrations::fitted_terms(double wavelength_nm, double object_distance_mm, double y0, FieldTerms& terms) const {
   const std::pair<std::size_t, double> jd = grid_interval(inverse_distances_per_mm_, inverse_per_mm(object_distance_mm));
   const std::pair<std::size_t, double> nw = grid_interval(wavelengths_nm_, wavelength_nm);
   const std::pair<std::size_t, double> kf = grid_interval(fields_, y0);
@@ -253,7 +302,7 @@ double FittedAberrations::correct(double wavelength_nm, double object_distance_m
     return near + (far - near) * jd.second;
   };
   for (int m = 0; m < 5; ++m) {
-    terms[m] += interpolate([&](std::size_t jj, std::size_t nn, std::size_t kk) { return delta(jj, nn, kk)[m]; });
+    terms[m] = interpolate([&](std::size_t jj, std::size_t nn, std::size_t kk) { return at(jj, nn, kk)[m]; });
   }
   return interpolate([&](std::size_t jj, std::size_t nn, std::size_t kk) {
     return light_[(jj * wavelengths_nm_.size() + nn) * fields_.size() + kk];

@@ -200,19 +200,19 @@ class ExactModel;
 
 // The seidel model's aberration terms fitted to real rays (RayModelOptions::seidel_coefficients,
 // fitted_aberrations.cpp says why and how): per object distance of the model's table, field and a
-// few wavelengths, the difference between the least-squares FieldTerms of the exact model's rays
-// and the terms of the Seidel sums, to be added to the latter; and the ratio of the light the real
-// lens passes (the exact model's weights summed over the rays that pass) to the model's own.
+// few wavelengths, the least-squares FieldTerms of the exact model's rays (the sums' where a fit is
+// not possible); and the ratio of the light the real lens passes (the exact model's weights summed
+// over the rays that pass) to the model's own.
 class FittedAberrations {
  public:
   // The model's own map (weights and first-order clipping), for the light ratio.
   using ModelMap = std::function<void(const ScenePoint&, double, std::span<const PupilPoint>, std::span<SensorHit>)>;
   // Fits `table` (made for `camera`'s lens at its f-number) against `exact` (the same camera).
   FittedAberrations(const Camera& camera, const ExactModel& exact, const AberrationTable& table, const ModelMap& model);
-  // Adds the fitted correction at this wavelength, object distance (mm, from surface 1) and field
-  // y0 (in the table's units) to `terms` and returns the light ratio there: trilinear in
-  // wavelength, inverse distance and field.
-  double correct(double wavelength_nm, double object_distance_mm, double y0, FieldTerms& terms) const;
+  // The fitted terms at this wavelength, object distance (mm, from surface 1) and field y0 (in the
+  // table's units) into `terms`, and the light ratio there as the result: trilinear in wavelength,
+  // inverse distance and field.
+  double fitted_terms(double wavelength_nm, double object_distance_mm, double y0, FieldTerms& terms) const;
   // (distance, wavelength, field) samples fitted, and those that kept the sums (too few rays passed).
   int fitted() const { return fitted_; }
   int kept() const { return kept_; }
@@ -221,12 +221,12 @@ class FittedAberrations {
   std::vector<double> inverse_distances_per_mm_;  // ascending, the table's
   std::vector<double> wavelengths_nm_;            // ascending
   std::vector<double> fields_;                    // y0, ascending from 0
-  std::vector<FieldTerms> delta_;                 // [distance][wavelength][field]
+  std::vector<FieldTerms> terms_;                 // [distance][wavelength][field]
   std::vector<double> light_;                     // [distance][wavelength][field]
   int fitted_ = 0;
   int kept_ = 0;
-  const FieldTerms& delta(std::size_t j, std::size_t n, std::size_t k) const {
-    return delta_[(j * wavelengths_nm_.size() + n) * fields_.size() + k];
+  const FieldTerms& at(std::size_t j, std::size_t n, std::size_t k) const {
+    return terms_[(j * wavelengths_nm_.size() + n) * fields_.size() + k];
   }
 };
 

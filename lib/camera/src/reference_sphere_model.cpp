@@ -180,7 +180,7 @@ void ReferenceSphereModel::map_with(const ScenePoint& point, double wavelength_n
   const SeidelRayGeometry geometry(camera_, fo, point, c.max_field_tangent);
   FieldTerms terms = FieldTerms::at(c, geometry.y0);
   // Fitted: the real lens's terms, and its light relative to the first-order weights and clipping.
-  const double light = fitted_ ? fitted_->correct(wavelength_nm, std::max(object_distance_mm, 1.0), geometry.y0, terms) : 1.0;
+  const double light = fitted_ ? fitted_->fitted_terms(wavelength_nm, std::max(object_distance_mm, 1.0), geometry.y0, terms) : 1.0;
   for (std::size_t i = 0; i < pupil.size(); ++i) {
     double x_mm, y_mm;
     geometry.sensor_point(pupil[i], terms, x_mm, y_mm);

@@ -98,6 +98,19 @@ bool deposit_nested_rings(const std::vector<std::span<const Point2f>>& rings, co
       twice += static_cast<double>(a.x) * b.y - static_cast<double>(b.x) * a.y;
     }
     if (k == 1) orientation = twice < 0.0 ? -1.0 : 1.0;
+    // SplatBuffer spreads a polygon between its two chains from the topmost to the bottommost
+    // vertex: right only for a y-monotone ring (one rise and one fall of y around it). A mapped ring
+    // that turns back in y (a strongly aberrated or clipped beam: a 35 mm lens's frame corners)
+    // would be smeared along its chains, and differences of such rings leave streaks: triangles.
+    int turns = 0;
+    double last_dy = 0.0;
+    for (std::size_t j = 0; j <= ring.size(); ++j) {
+      const double dy = static_cast<double>(ring[(j + 1) % ring.size()].y) - ring[j % ring.size()].y;
+      if (dy == 0.0) continue;
+      if (last_dy != 0.0 && (dy > 0.0) != (last_dy > 0.0)) ++turns;
+      last_dy = dy;
+    }
+    if (turns > 2) return false;
     const double area = 0.5 * twice * orientation;
     if (!(area > areas[static_cast<std::size_t>(k) - 1] + 1e-3 * std::max(area, 1e-9))) return false;
     areas[static_cast<std::size_t>(k)] = area;
