@@ -54,42 +54,85 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   read.validate();
   const Image image = read_radiance_image(o.image, read);
 
-  // Camera and ray model.
+  // Framing: the flags, else what the input EXR says of its own pinhole camera (lensmith scene
+  // render writes lensmith:focal_length_mm and lensmith:sensor_width_mm), else 36 mm and the lens's EFL.
   CameraOptions camera;
-  camera.focus_distance_m = o.focus_m;
   camera.f_number = o.f_number;
-  camera.framing.sensor_width_mm = o.sensor_width_mm;
+  camera.framing.sensor_width_mm = o.sensor_width_mm.value_or(36.0);
   camera.framing.focal_length_mm = o.pinhole_focal_length_mm;
   camera.framing.horizontal_fov_deg = o.hfov_deg;
+  std::vector<std::string> from_file;
+  for (const auto& [key, value] : read_image_metadata(o.image)) {
+    const std::optional<double> number = parse_finite_number(value);
+    if (!number || !(*number > 0.0)) continue;
+    if (key == "lensmith:focal_length_mm" && !o.pinhole_focal_length_mm && !o.hfov_deg) {
+      camera.framing.focal_length_mm = *number;
+      from_file.push_back("pinhole focal length " + value + " mm");
+    }
+    if (key == "lensmith:sensor_width_mm" && !o.sensor_width_mm) {
+      camera.framing.sensor_width_mm = *number;
+      from_file.push_back("sensor width " + value + " mm");
+    }
+  }
+  if (!from_file.empty() && !global.quiet) {
+    std::cerr << "note: framing from " << o.image << ":";
+    for (std::size_t i = 0; i < from_file.size(); ++i) std::cerr << (i ? "," : "") << " " << from_file[i];
+    std::cerr << " (its lensmith attributes; the flags override them)\n";
+  }
   std::string lens_name;
   RayModelKind kind = o.model.empty() ? (o.thin_lens ? RayModelKind::Thin : RayModelKind::Seidel) : parse_ray_model_kind(o.model);
-  std::optional<Camera> cam;
+  // The lens (or thin lens) and the focal length the framing defaults to.
+  std::optional<Prescription> lens;
+  double default_focal_mm = 0.0;
   if (o.thin_lens) {
     if (kind != RayModelKind::Thin) {
       throw UsageError("--thin-lens has no prescription: only --model thin applies (got --model " + o.model + ")");
     }
     if (!o.focal_length_mm) throw UsageError("--thin-lens needs --focal-length MM");
-    cam = Camera::thin_lens(*o.focal_length_mm, camera, image.width, image.height);
-    lens_name = "thin lens f = " + std::to_string(*o.focal_length_mm) + " mm";
+    default_focal_mm = *o.focal_length_mm;
+    lens_name = "thin lens f = " + format_rounded(*o.focal_length_mm, 6) + " mm";
   } else {
     if (o.lens.empty()) throw UsageError("give --lens LENS (a file or shipped lens name) or --thin-lens --focal-length MM");
-    const Prescription lens = load_lens(o.lens, global);
-    lens_name = lens.name.empty() ? o.lens : lens.name;
-    if (kind == RayModelKind::Thin) {
-      // The ideal thin lens with this lens's focal length and f-number.
-      const ParaxialSystem p(lens);
-      if (!camera.f_number) camera.f_number = p.f_number();
-      cam = Camera::thin_lens(p.efl_mm(), camera, image.width, image.height);
-    } else {
-      cam = Camera::from_lens(lens, camera, image.width, image.height);
-      warn_about_aperture(*cam, global);
-    }
+    lens = load_lens(o.lens, global);
+    lens_name = lens->name.empty() ? o.lens : lens->name;
+    default_focal_mm = ParaxialSystem(*lens).efl_mm();
   }
+  if (!o.focus_m && o.focus_pixel.empty()) throw UsageError("give --focus M (metres) or --focus-pixel X,Y");
   DepthReadOptions depth_options;
   depth_options.kind = parse_depth_kind(o.depth_kind);
   depth_options.unit = parse_depth_unit(o.depth_unit);
   depth_options.invalid = parse_invalid_depth(o.invalid_depth);
-  const DepthMap depth = read_depth(depth_source, depth_options, cam->frame());
+  // The camera's framing is the pinhole frame the depth is read in (Camera::from_lens and thin_lens
+  // build the same one).
+  const PinholeFrame frame = PinholeFrame::from_options(image.width, image.height, camera.framing, default_focal_mm);
+  const DepthMap depth = read_depth(depth_source, depth_options, frame);
+  if (!o.focus_pixel.empty()) {
+    // X,Y: integers inside the image.
+    const std::size_t comma = o.focus_pixel.find(',');
+    const std::optional<double> x = comma == std::string::npos ? std::nullopt : parse_finite_number(o.focus_pixel.substr(0, comma));
+    const std::optional<double> y = comma == std::string::npos ? std::nullopt : parse_finite_number(o.focus_pixel.substr(comma + 1));
+    if (!x || !y || *x != std::floor(*x) || *y != std::floor(*y) || *x < 0 || *y < 0 || *x >= image.width || *y >= image.height) {
+      throw UsageError("--focus-pixel " + o.focus_pixel + ": expected X,Y, whole pixels inside the " + std::to_string(image.width) +
+                       " x " + std::to_string(image.height) + " image (0,0 = top left)");
+    }
+    const float z = depth.at(static_cast<int>(*x), static_cast<int>(*y));
+    camera.focus_distance_m = z;
+    if (!global.quiet) std::cerr << "note: focus " << format_rounded(z, 5) << " m, the depth at pixel (" << o.focus_pixel << ")\n";
+  } else {
+    camera.focus_distance_m = *o.focus_m;
+  }
+  std::optional<Camera> cam;
+  if (o.thin_lens) {
+    cam = Camera::thin_lens(*o.focal_length_mm, camera, image.width, image.height);
+  } else if (kind == RayModelKind::Thin) {
+    // The ideal thin lens with this lens's focal length and f-number.
+    const ParaxialSystem p(*lens);
+    if (!camera.f_number) camera.f_number = p.f_number();
+    cam = Camera::thin_lens(p.efl_mm(), camera, image.width, image.height);
+  } else {
+    cam = Camera::from_lens(*lens, camera, image.width, image.height);
+    warn_about_aperture(*cam, global);
+  }
   float nearest_m = std::numeric_limits<float>::infinity();
   for (float z : depth.z_m) nearest_m = std::min(nearest_m, z);
   RayModelOptions model_options;
@@ -124,7 +167,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   meta.model = std::string(to_string(kind));
   meta.lensmith_version = LENSMITH_VERSION;
   meta.f_number = cam->f_number();
-  meta.focus_m = o.focus_m;
+  meta.focus_m = camera.focus_distance_m;
   meta.extra = {{"aperture", aperture.to_string()}, {"hidden_surfaces", std::string(to_string(options.hidden))},
                 {"edge_pixels", o.edge_pixels},
                 {"vignetting", options.vignetting ? "natural" : "off"},
@@ -135,7 +178,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   std::ostringstream what;
   what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds
        << " s (rendering " << render_seconds << " s)\n  " << lens_name << ", model " << to_string(kind) << ", f/"
-       << format_rounded(cam->f_number(), 3) << ", focus " << format_rounded(o.focus_m, 4) << " m, " << aperture.to_string()
+       << format_rounded(cam->f_number(), 3) << ", focus " << format_rounded(camera.focus_distance_m, 4) << " m, " << aperture.to_string()
        << " aperture\n  " << stats.layers << " depth layers " << format_rounded(stats.layer_spacing_px, 3) << " px apart, largest blur "
        << format_rounded(stats.max_abs_coc_px, 3) << " px; " << stats.footprints << " footprints";
   if (stats.triangles > 0) what << " (" << stats.triangles << " triangles)";

@@ -144,8 +144,9 @@ struct BokehCommandOptions {
   bool thin_lens = false;                    // --thin-lens: an ideal thin lens instead
   std::optional<double> focal_length_mm;     // --focal-length (thin lens)
   std::optional<double> f_number;            // --fstop; default: the lens's own
-  double focus_m = 0.0;                      // --focus, metres from the camera (entrance pupil)
-  double sensor_width_mm = 36.0;             // --sensor-width of the pinhole image
+  std::optional<double> focus_m;             // --focus, metres from the entrance pupil (or --focus-pixel)
+  std::string focus_pixel;                   // --focus-pixel X,Y: focus on the depth map's value there
+  std::optional<double> sensor_width_mm;     // --sensor-width of the pinhole image; default the EXR's or 36
   std::optional<double> pinhole_focal_length_mm;  // --pinhole-focal-length; default: the lens EFL
   std::optional<double> hfov_deg;            // --hfov instead
   std::optional<int> blades;                 // --blades N

@@ -252,12 +252,15 @@ int main(int argc, char** argv) {
   bokeh_thin->excludes(bokeh_lens);
   bokeh_cmd->add_option("--focal-length", bokeh.focal_length_mm, "Thin-lens focal length, mm (> 0)")->check(positive())->needs(bokeh_thin);
   bokeh_cmd->add_option("--fstop", bokeh.f_number, "f-number (default: the lens's own; 0.5-512)")->check(range(0.5, 512.0));
-  bokeh_cmd->add_option("--focus", bokeh.focus_m, "Focus distance, metres from the lens's entrance pupil (the perspective centre; > 0, inf for infinity)")->required()
-      ->check(focus_distance_check());
-  bokeh_cmd->add_option("--sensor-width", bokeh.sensor_width_mm, "Sensor width of the input image's pinhole camera, mm (default 36)")
+  CLI::Option* bokeh_focus =
+      bokeh_cmd->add_option("--focus", bokeh.focus_m, "Focus distance, metres from the lens's entrance pupil (the perspective centre; > 0, inf for infinity)")
+          ->check(focus_distance_check());
+  bokeh_cmd->add_option("--focus-pixel", bokeh.focus_pixel, "Focus on the depth at this pixel of the input, X,Y (0,0 = top left), instead of --focus")
+      ->excludes(bokeh_focus);
+  bokeh_cmd->add_option("--sensor-width", bokeh.sensor_width_mm, "Sensor width of the input image's pinhole camera, mm (default: the EXR's lensmith:sensor_width_mm, else 36)")
       ->check(positive());
   CLI::Option* bokeh_pf = bokeh_cmd->add_option("--pinhole-focal-length", bokeh.pinhole_focal_length_mm,
-                                                "Focal length of the input's pinhole camera, mm (default: the lens EFL)")
+                                                "Focal length of the input's pinhole camera, mm (default: the EXR's lensmith:focal_length_mm, else the lens EFL)")
                               ->check(positive());
   bokeh_cmd->add_option("--hfov", bokeh.hfov_deg, "Horizontal field of view of the input image, degrees (instead of the focal length)")
       ->check(range(0.01, 179.99))->excludes(bokeh_pf);

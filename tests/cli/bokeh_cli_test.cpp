@@ -88,3 +88,21 @@ TEST_CASE("lensmith bokeh rejects a depth map of another size and a thin lens wi
   CHECK(t.err.find("--focal-length") != std::string::npos);
   CHECK_FALSE(fs::exists(out));
 }
+
+TEST_CASE("lensmith bokeh --focus-pixel focuses on the depth under that pixel, and the EXR's own framing is used", "[cli][bokeh]") {
+  // examples/README.md: the checker target hangs on the wall at 3 m (x 459-548, y 165-224); the
+  // scene was rendered with a 50 mm pinhole on a 36 mm sensor and says so in its attributes.
+  const fs::path exr = scratch("focus-pixel.exr");
+  const auto r = run_lensmith("bokeh --image " + kScene + " --thin-lens --focal-length 85 --fstop 2 --focus-pixel 500,190 -o " +
+                              exr.string());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(std::stod(value_of(lensmith::read_image_metadata(exr), "lensmith:focus_m")) == Approx(3.0));
+  CHECK(r.err.find("framing from") != std::string::npos);
+  CHECK(r.err.find("pinhole focal length 50 mm") != std::string::npos);
+  // Outside the image, malformed, or together with --focus: the command line's fault.
+  CHECK(run_lensmith("bokeh --image " + kScene + " --thin-lens --focal-length 85 --focus-pixel 640,10 -o " + exr.string()).exit_code == 2);
+  CHECK(run_lensmith("bokeh --image " + kScene + " --thin-lens --focal-length 85 --focus-pixel 5 -o " + exr.string()).exit_code == 2);
+  CHECK(run_lensmith("bokeh --image " + kScene + " --thin-lens --focal-length 85 --focus 3 --focus-pixel 5,5 -o " + exr.string()).exit_code == 2);
+  CHECK(run_lensmith("bokeh --image " + kScene + " --thin-lens --focal-length 85 -o " + exr.string()).exit_code == 2);
+}
