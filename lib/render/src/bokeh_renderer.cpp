@@ -114,6 +114,7 @@ Image render(const Image& image, const DepthMap& depth, const RayModel& model, c
       for (std::size_t i = 0; i < layer.size(); ++i) plans[i] = scatter.plan(layer[i], scratch);
     }
 
+    std::atomic<int> bands_done{0};
     // Each band of rows scatters the footprints that reach it, then composites its rows of this
     // layer over the result so far.
 #pragma omp parallel num_threads(threads)
@@ -168,8 +169,15 @@ Image render(const Image& image, const DepthMap& depth, const RayModel& model, c
             }
           }
         }
-        if (!any) continue;  // nothing of this layer reaches these rows: the result is unchanged
-        render_detail::composite_layer_over(layer_rgba, stretch ? &hole_rgba : nullptr, result, w, row_begin, row_end);
+        if (any) render_detail::composite_layer_over(layer_rgba, stretch ? &hole_rgba : nullptr, result, w, row_begin, row_end);
+        // Progress in even steps: this layer's share of the sources times the bands it has done.
+        if (options.progress) {
+          const double fraction = (static_cast<double>(done) + static_cast<double>(layers.members[u].size()) *
+                                                                    static_cast<double>(++bands_done) / bands) /
+                                  static_cast<double>(sources.size());
+#pragma omp critical(lensmith_bokeh_progress)
+          options.progress(fraction);
+        }
       }
       footprints += local_footprints;
       triangles += local_triangles;

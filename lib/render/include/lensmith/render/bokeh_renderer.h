@@ -58,7 +58,9 @@ struct BokehOptions {
   int spectral_samples = 16;             // wavelength nodes of the quadrature (3..64)
   double chromatic_tolerance_px = 0.5;   // largest colour separation left unresolved within a pixel's bokeh
   double max_blur_px = 1000.0;           // nearer points are clamped to this blur diameter (output px)
-  std::function<void(double)> progress;  // called with the fraction done (0..1), from the calling thread
+  // Called with the fraction done (0..1) after each band of rows of each layer, from the rendering
+  // threads one at a time (never concurrently): it must not assume the calling thread.
+  std::function<void(double)> progress;
   void validate() const;                 // throws OptionsError naming the option
   std::string to_string() const;
 };
