@@ -53,6 +53,13 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   read.highlight_threshold = o.highlight_threshold;
   read.validate();
   const Image image = read_radiance_image(o.image, read);
+  // A transparent element (a CG layer over nothing) keeps its alpha: defocused with the same rays as
+  // its (premultiplied) colour, into an RGBA OpenEXR.
+  std::optional<std::vector<float>> alpha = read_alpha(o.image);
+  if (alpha && !output_keeps_alpha(output)) {
+    if (!global.quiet) std::cerr << "note: " << o.image << " has alpha; only an OpenEXR output (.exr) keeps it, " << output.string() << " gets RGB\n";
+    alpha.reset();
+  }
 
   // Framing: the flags, else what the input EXR says of its own pinhole camera (lensmith scene
   // render writes lensmith:focal_length_mm and lensmith:sensor_width_mm), else 36 mm and the lens's EFL.
@@ -158,7 +165,24 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   options.progress = [&bar](double f) { bar.update(f); };
   BokehStatistics stats;
   const auto render_started = std::chrono::steady_clock::now();
-  const Image out = render_bokeh(image, depth, *model, aperture, options, &stats);
+  Image out = render_bokeh(image, depth, *model, aperture, options, &stats);
+  if (alpha) {
+    // Alpha as a grey picture through the same model: no colour (one wavelength) and no vignetting
+    // (an opaque surface stays opaque however little light the lens takes from it).
+    Image grey(image.width, image.height, 3, 0.0f);
+    for (std::size_t i = 0; i < alpha->size(); ++i) grey.data[3 * i] = grey.data[3 * i + 1] = grey.data[3 * i + 2] = (*alpha)[i];
+    BokehOptions coverage = options;
+    coverage.spectral = false;
+    coverage.vignetting = false;
+    coverage.progress = nullptr;
+    const Image a = render_bokeh(grey, depth, *model, aperture, coverage);
+    Image rgba(image.width, image.height, 4, 0.0f);
+    for (std::size_t i = 0; i < alpha->size(); ++i) {
+      for (int c = 0; c < 3; ++c) rgba.data[4 * i + static_cast<std::size_t>(c)] = out.data[3 * i + static_cast<std::size_t>(c)];
+      rgba.data[4 * i + 3] = std::clamp(a.data[3 * i], 0.0f, 1.0f);
+    }
+    out = std::move(rgba);
+  }
   const double render_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - render_started).count();
   bar.finish();
 

@@ -106,3 +106,47 @@ TEST_CASE("lensmith bokeh --focus-pixel focuses on the depth under that pixel, a
   CHECK(run_lensmith("bokeh --image " + kScene + " --thin-lens --focal-length 85 --focus 3 --focus-pixel 5,5 -o " + exr.string()).exit_code == 2);
   CHECK(run_lensmith("bokeh --image " + kScene + " --thin-lens --focal-length 85 -o " + exr.string()).exit_code == 2);
 }
+
+TEST_CASE("lensmith bokeh keeps an RGBA input's alpha, defocused with its colour, in an RGBA OpenEXR", "[cli][bokeh][alpha]") {
+  // A CG element over nothing: an opaque 16 x 16 square (premultiplied colour 0.5) in a transparent
+  // 64 x 48 frame, all at 2 m. Focused there it stays as it is; focused at 0.5 m (a 4.8 px blur at
+  // f/1.4) its alpha spreads
+  // like its colour and keeps its total (the scatter conserves energy; nothing reaches the frame's
+  // edge), transparent corners stay transparent.
+  const int w = 64, h = 48;
+  lensmith::Image rgbaz(w, h, 5, 0.0f);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const bool inside = x >= 24 && x < 40 && y >= 16 && y < 32;
+      for (int c = 0; c < 3; ++c) rgbaz.at(x, y, c) = inside ? 0.5f : 0.0f;
+      rgbaz.at(x, y, 3) = inside ? 1.0f : 0.0f;
+      rgbaz.at(x, y, 4) = 2.0f;
+    }
+  }
+  const fs::path in = scratch("element.exr");
+  lensmith::write_float_exr(in, rgbaz, {"R", "G", "B", "A", "Z"});
+  for (const double focus : {2.0, 0.5}) {
+    const fs::path out = scratch("element-out.exr");
+    const auto r = run_lensmith("bokeh --image " + in.string() + " --thin-lens --focal-length 50 --fstop 1.4 --focus " +
+                                std::to_string(focus) + " -o " + out.string() + " --quiet");
+    INFO("focus " << focus << " m: " << r.err);
+    REQUIRE(r.exit_code == 0);
+    const auto alpha = lensmith::read_alpha(out);
+    REQUIRE(alpha.has_value());
+    double total = 0.0;
+    for (float a : *alpha) total += a;
+    CHECK(total == Approx(256.0).epsilon(0.02));
+    CHECK((*alpha)[0] == Approx(0.0).margin(1e-4));
+    if (focus == 2.0) {
+      CHECK((*alpha)[static_cast<std::size_t>(24 * w + 32)] == Approx(1.0).margin(1e-3));
+    } else {
+      CHECK((*alpha)[static_cast<std::size_t>(24 * w + 32)] == Approx(1.0).margin(0.01));  // the middle of the square
+      CHECK((*alpha)[static_cast<std::size_t>(24 * w + 22)] > 0.05);                       // spread 2 px beyond its edge
+    }
+  }
+  // A PNG cannot hold it: RGB with a note.
+  const auto png = run_lensmith("bokeh --image " + in.string() + " --thin-lens --focal-length 50 --fstop 2 --focus 2 -o " +
+                                scratch("element.png").string());
+  CHECK(png.exit_code == 0);
+  CHECK(png.err.find("only an OpenEXR output") != std::string::npos);
+}

@@ -120,6 +120,24 @@ std::string RadianceReadOptions::to_string() const {
          format_number(highlight_gain) + ")";
 }
 
+std::optional<std::vector<float>> read_alpha(const fs::path& path) {
+  const RasterInfo info = read_raster_info(path);
+  const int index = info.channel_index("A");
+  if (index < 0) return std::nullopt;
+  const int channels[1] = {index};
+  Raster alpha = read_raster(path, info, channels);
+  for (std::size_t i = 0; i < alpha.samples.size(); ++i) {
+    float& a = alpha.samples[i];
+    if (!(a >= 0.0f && a <= 1.0f + 1e-3f)) {
+      throw ImageFileError(path.string() + ": alpha at pixel (" + std::to_string(i % static_cast<std::size_t>(alpha.width)) + ", " +
+                           std::to_string(i / static_cast<std::size_t>(alpha.width)) + ") is " + format_number(a) +
+                           ": expected 0 to 1");
+    }
+    a = std::min(a, 1.0f);
+  }
+  return std::move(alpha.samples);
+}
+
 Image read_radiance_image(const fs::path& path, const RadianceReadOptions& options) {
   options.validate();
   const RasterInfo info = read_raster_info(path);
@@ -359,10 +377,13 @@ std::string OutputMetadata::to_string() const {
   return join(parts);
 }
 
+bool output_keeps_alpha(const fs::path& path) { return output_format(path) == OutputFormat::Exr; }
+
 void write_output_image(const fs::path& path, const Image& linear_rgb, const OutputMetadata& meta) {
   const OutputFormat format = output_format(path);
-  if (linear_rgb.channels != 3 || linear_rgb.width < 1 || linear_rgb.height < 1) {
-    throw OptionsError(path.string() + ": cannot write " + linear_rgb.to_string() + ": expected RGB, 3 channels");
+  const bool rgba_exr = linear_rgb.channels == 4 && format == OutputFormat::Exr;
+  if ((linear_rgb.channels != 3 && !rgba_exr) || linear_rgb.width < 1 || linear_rgb.height < 1) {
+    throw OptionsError(path.string() + ": cannot write " + linear_rgb.to_string() + ": expected RGB, 3 channels (RGBA, 4, to OpenEXR)");
   }
   check_no_nan(path, linear_rgb);
 
@@ -376,6 +397,10 @@ void write_output_image(const fs::path& path, const Image& linear_rgb, const Out
   if (meta.focus_m > 0.0) attributes.push_back({"lensmith:focus_m", meta.focus_m});
   for (const auto& [key, value] : meta.extra) attributes.push_back({"lensmith:" + key, value});
 
+  if (rgba_exr) {
+    write_exr(path, PixelsView<float>{linear_rgb.width, linear_rgb.height, 4, linear_rgb.data}, {"R", "G", "B", "A"}, attributes);
+    return;
+  }
   const PixelsView<float> linear{linear_rgb.width, linear_rgb.height, 3, linear_rgb.data};
   if (format == OutputFormat::Exr) {
     write_exr(path, linear, {"R", "G", "B"}, attributes);

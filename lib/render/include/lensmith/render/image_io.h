@@ -5,6 +5,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <utility>
@@ -61,6 +62,11 @@ struct RadianceReadOptions {
 // another format (the message lists the formats read), ImageFileError for the refusals above,
 // OptionsError for invalid options.
 Image read_radiance_image(const std::filesystem::path& path, const RadianceReadOptions& options = {});
+
+// The picture's alpha channel ("A", as OpenEXR, PNG, TIFF name it), width x height floats in [0, 1]
+// (integers normalised), or nothing when it has none. Throws ImageFileError naming the first pixel
+// whose alpha is NaN, negative or above 1 by more than rounding, IoError when the file cannot be read.
+std::optional<std::vector<float>> read_alpha(const std::filesystem::path& path);
 
 // A depth input named on a command line as FILE[:CHANNEL].
 struct DepthSource {
@@ -132,9 +138,10 @@ struct OutputMetadata {
   friend std::ostream& operator<<(std::ostream& os, const OutputMetadata& m) { return os << m.to_string(); }
 };
 
-// Writes a linear RGB image (3 channels, else OptionsError; a NaN is a ComputationError naming the
-// pixel, since whatever made the image failed), the format chosen by the extension (any case):
-//   .exr             32-bit float RGB, ZIP compression, linear as given;
+// Writes a linear RGB image (3 channels, or 4 (RGBA, premultiplied) to OpenEXR only, else
+// OptionsError; a NaN is a ComputationError naming the pixel, since whatever made the image
+// failed), the format chosen by the extension (any case):
+//   .exr             32-bit float RGB or RGBA, ZIP compression, linear as given;
 //   .hdr             Radiance RGBE float (run-length encoded), linear as given;
 //   .png .jpg .jpeg  8-bit sRGB (srgb_encode, clamped to [0, 1], rounded; PNG with an sRGB chunk,
 //                    JPEG quality 95 without chroma subsampling);
@@ -149,6 +156,9 @@ struct OutputMetadata {
 // leaves a half-written picture. Throws OptionsError for another extension (listing the supported
 // ones) and IoError when writing fails.
 void write_output_image(const std::filesystem::path& path, const Image& linear_rgb, const OutputMetadata& meta);
+// Whether write_output_image keeps an alpha channel for this path (OpenEXR); throws as it does for
+// an unsupported extension.
+bool output_keeps_alpha(const std::filesystem::path& path);
 
 // Writes every channel of `image` to a 32-bit float EXR (ZIP) with the given channel names (one
 // per channel): depth or other passes for tools that read them by name. Written atomically like
