@@ -48,6 +48,9 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   if (!o.aperture_image.empty()) inputs.emplace_back(o.aperture_image);
   ensure_not_an_input(output, inputs);
   ensure_writable_location(output);
+  if (o.keep_depth && !output_keeps_alpha(output)) {
+    throw UsageError("--keep-depth needs an OpenEXR output (.exr): " + output.string() + " cannot hold a depth channel");
+  }
   RadianceReadOptions read;
   read.highlight_gain = o.highlight_gain;
   read.highlight_threshold = o.highlight_threshold;
@@ -197,7 +200,22 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
                 {"vignetting", options.vignetting ? "natural" : "off"},
                 {"spectral", options.spectral ? std::to_string(options.spectral_samples) + " nodes" : "off"}};
   if (kind == RayModelKind::Seidel) meta.extra.emplace_back("seidel_coefficients", o.seidel_coefficients);
-  write_output_image(output, out, meta);
+  std::vector<std::string> channels;
+  if (o.keep_depth) {
+    // The depth as read (planar metres from the entrance pupil): a compositor's Z for the picture's
+    // in-focus geometry; the blurred picture has no single depth per pixel.
+    channels = out.channels == 4 ? std::vector<std::string>{"R", "G", "B", "A", "Z"} : std::vector<std::string>{"R", "G", "B", "Z"};
+    Image with_z(out.width, out.height, out.channels + 1, 0.0f);
+    for (std::size_t i = 0; i < depth.z_m.size(); ++i) {
+      for (int c = 0; c < out.channels; ++c) {
+        with_z.data[i * static_cast<std::size_t>(with_z.channels) + static_cast<std::size_t>(c)] =
+            out.data[i * static_cast<std::size_t>(out.channels) + static_cast<std::size_t>(c)];
+      }
+      with_z.data[i * static_cast<std::size_t>(with_z.channels) + static_cast<std::size_t>(out.channels)] = depth.z_m[i];
+    }
+    out = std::move(with_z);
+  }
+  write_output_image(output, out, meta, channels);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   std::ostringstream what;
   what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds

@@ -255,6 +255,8 @@ int main(int argc, char** argv) {
   CLI::Option* bokeh_focus =
       bokeh_cmd->add_option("--focus", bokeh.focus_m, "Focus distance, metres from the lens's entrance pupil (the perspective centre; > 0, inf for infinity)")
           ->check(focus_distance_check());
+  bokeh_cmd->add_flag("--keep-depth", bokeh.keep_depth,
+                      "Write the input's depth (planar metres from the entrance pupil, inf for the sky) as the Z channel of an .exr output");
   bokeh_cmd->add_option("--focus-pixel", bokeh.focus_pixel, "Focus on the depth at this pixel of the input, X,Y (0,0 = top left), instead of --focus")
       ->excludes(bokeh_focus);
   bokeh_cmd->add_option("--sensor-width", bokeh.sensor_width_mm, "Sensor width of the input image's pinhole camera, mm (default: the EXR's lensmith:sensor_width_mm, else 36)")

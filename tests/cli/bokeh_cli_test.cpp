@@ -144,7 +144,17 @@ TEST_CASE("lensmith bokeh keeps an RGBA input's alpha, defocused with its colour
       CHECK((*alpha)[static_cast<std::size_t>(24 * w + 22)] > 0.05);                       // spread 2 px beyond its edge
     }
   }
-  // A PNG cannot hold it: RGB with a note.
+  // --keep-depth adds the input's depth as Z beside R, G, B, A.
+  const fs::path with_z = scratch("element-z.exr");
+  REQUIRE(run_lensmith("bokeh --image " + in.string() + " --thin-lens --focal-length 50 --fstop 1.4 --focus 0.5 --keep-depth -o " +
+                       with_z.string() + " --quiet").exit_code == 0);
+  const lensmith::DepthMap z = lensmith::read_depth(lensmith::DepthSource::parse(with_z.string() + ":Z"), {},
+                                                    lensmith::PinholeFrame(w, h, 1.0));
+  CHECK(z.z_m.front() == Approx(2.0));
+  CHECK(lensmith::read_alpha(with_z).has_value());
+  CHECK(run_lensmith("bokeh --image " + in.string() + " --thin-lens --focal-length 50 --focus 2 --keep-depth -o " +
+                     scratch("z.png").string()).exit_code == 2);
+  // A PNG cannot hold alpha: RGB with a note.
   const auto png = run_lensmith("bokeh --image " + in.string() + " --thin-lens --focal-length 50 --fstop 2 --focus 2 -o " +
                                 scratch("element.png").string());
   CHECK(png.exit_code == 0);

@@ -379,11 +379,17 @@ std::string OutputMetadata::to_string() const {
 
 bool output_keeps_alpha(const fs::path& path) { return output_format(path) == OutputFormat::Exr; }
 
-void write_output_image(const fs::path& path, const Image& linear_rgb, const OutputMetadata& meta) {
+void write_output_image(const fs::path& path, const Image& linear_rgb, const OutputMetadata& meta,
+                        const std::vector<std::string>& channel_names) {
   const OutputFormat format = output_format(path);
-  const bool rgba_exr = linear_rgb.channels == 4 && format == OutputFormat::Exr;
-  if ((linear_rgb.channels != 3 && !rgba_exr) || linear_rgb.width < 1 || linear_rgb.height < 1) {
-    throw OptionsError(path.string() + ": cannot write " + linear_rgb.to_string() + ": expected RGB, 3 channels (RGBA, 4, to OpenEXR)");
+  std::vector<std::string> names = channel_names;
+  if (names.empty()) names = linear_rgb.channels == 4 ? std::vector<std::string>{"R", "G", "B", "A"} : std::vector<std::string>{"R", "G", "B"};
+  const bool named_ok = static_cast<int>(names.size()) == linear_rgb.channels && names.size() >= 3 && names[0] == "R" &&
+                        names[1] == "G" && names[2] == "B";
+  const bool rgba_exr = linear_rgb.channels > 3 && format == OutputFormat::Exr;
+  if (!named_ok || (linear_rgb.channels != 3 && !rgba_exr) || linear_rgb.width < 1 || linear_rgb.height < 1) {
+    throw OptionsError(path.string() + ": cannot write " + linear_rgb.to_string() +
+                       ": expected RGB, 3 channels (more, named R, G, B first, to OpenEXR only)");
   }
   check_no_nan(path, linear_rgb);
 
@@ -398,7 +404,7 @@ void write_output_image(const fs::path& path, const Image& linear_rgb, const Out
   for (const auto& [key, value] : meta.extra) attributes.push_back({"lensmith:" + key, value});
 
   if (rgba_exr) {
-    write_exr(path, PixelsView<float>{linear_rgb.width, linear_rgb.height, 4, linear_rgb.data}, {"R", "G", "B", "A"}, attributes);
+    write_exr(path, PixelsView<float>{linear_rgb.width, linear_rgb.height, linear_rgb.channels, linear_rgb.data}, names, attributes);
     return;
   }
   const PixelsView<float> linear{linear_rgb.width, linear_rgb.height, 3, linear_rgb.data};

@@ -155,7 +155,10 @@ struct OutputMetadata {
 // The file is written to a temporary file beside `path` and renamed onto it, so a failure never
 // leaves a half-written picture. Throws OptionsError for another extension (listing the supported
 // ones) and IoError when writing fails.
-void write_output_image(const std::filesystem::path& path, const Image& linear_rgb, const OutputMetadata& meta);
+// `channel_names` (OpenEXR only) names the image's channels when it carries more than RGB(A), e.g.
+// {"R", "G", "B", "A", "Z"}: the first three must be R, G, B.
+void write_output_image(const std::filesystem::path& path, const Image& linear_rgb, const OutputMetadata& meta,
+                        const std::vector<std::string>& channel_names = {});
 // Whether write_output_image keeps an alpha channel for this path (OpenEXR); throws as it does for
 // an unsupported extension.
 bool output_keeps_alpha(const std::filesystem::path& path);
