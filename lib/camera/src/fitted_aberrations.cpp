@@ -1,5 +1,5 @@
 // Third-order coefficients fitted to real rays, for the seidel model (RayModelOptions::
-// seidel_coefficients, docs/bokeh.md "Which ray model").
+// seidel_coefficients, docs/bokeh.md "Seidel coefficients").
 //
 // Why: Asberg's method (Marsicano 2023, sec. 3.10) moves each ray by the third-order aberration
 // vector computed from the Seidel sums. A corrected lens balances its third-order aberrations against
@@ -22,10 +22,9 @@
 // rather than one polynomial in y0 for the whole frame matters for wide-angle lenses, whose
 // aberrations grow faster than y0^3 towards the corner: one global fit trades the centre's accuracy
 // for the corner's. The spot's shape (the hits less their centroid) fixes the pupil-dependent terms,
-// the centroid the distortion. Between fitted wavelengths the terms are interpolated linearly (the
-// differences to the sums were tried first: a model glass's sums vary unevenly between 380 and
-// 480 nm, and the difference carried that into colour fringes). On the axis the radial term
-// (D y0^2, zero in the sums) carries the real lens's best focus shift.
+// the centroid the distortion. Between the fitted wavelengths the terms themselves are interpolated
+// linearly. On the axis the radial term (D y0^2, zero in the sums) carries the real lens's best
+// focus shift.
 #include <omp.h>
 
 #include <Eigen/Dense>
