@@ -97,11 +97,12 @@ class RayModel {
 // Where the seidel model's Born & Wolf coefficients come from, at each object distance and
 // wavelength of its table.
 //   fitted  the least-squares fit of the third-order aberration vector to the exact tracer's rays at
-//           the camera's f-number, over the frame (default): the best third-order description of the
+//           the camera's f-number, over the frame (opt-in until the faint colour arcs it leaves on
+//           some in-focus texture are found, docs/bokeh.md): the best third-order description of the
 //           real lens, higher orders included where they balance the third (a corrected double Gauss
 //           at f/2: third-order sums predict 0.10 mm of transverse spherical aberration at the rim,
 //           the real rays 0.04 mm of the opposite sign)
-//   sums    Welford's Seidel sums, the truncation Asberg's method uses: right for the lens's
+//   sums    Welford's Seidel sums, the truncation Asberg's method uses (default): right for the lens's
 //           third-order part, too large wherever higher orders correct it
 enum class SeidelCoefficients { Fitted, Sums };
 std::string_view to_string(SeidelCoefficients source);
@@ -116,8 +117,8 @@ struct RayModelOptions {
   // poly: a fit of the camera's lens (LensFit::fit or LensFit::read); empty: fitted when the model is
   // made, with LensFitOptions{} (several seconds).
   std::shared_ptr<const LensFit> fit;
-  // seidel: fitted to the exact tracer's rays (about 0.1 s) or the Seidel sums.
-  SeidelCoefficients seidel_coefficients = SeidelCoefficients::Fitted;
+  // seidel: the Seidel sums, or fitted to the exact tracer's rays (about 0.1 s more).
+  SeidelCoefficients seidel_coefficients = SeidelCoefficients::Sums;
   void validate() const;             // throws OptionsError
 };
 
