@@ -25,11 +25,8 @@
 // the centroid the distortion. Between the fitted wavelengths the terms themselves are interpolated
 // linearly. On the axis the radial term (D y0^2, zero in the sums) carries the real lens's best
 // focus shift.
-#include <omp.h>
-
 #include <Eigen/Dense>
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <vector>
 
@@ -142,24 +139,28 @@ bool fit_field(const SeidelRayGeometry& geometry, const std::vector<PupilPoint>&
   return std::isfinite(t.distortion);
 }
 
-// The largest distance (mm) from their centroid of the points `pupil[p]` with `use[p].ok` maps to
-// by `terms`.
+// The largest distance (mm) of `points` from their centroid; 0 for none.
+double reach_about_centroid(const std::vector<std::pair<double, double>>& points) {
+  if (points.empty()) return 0.0;
+  double sx = 0.0, sy = 0.0;
+  for (const auto& [x, y] : points) sx += x, sy += y;
+  sx /= static_cast<double>(points.size()), sy /= static_cast<double>(points.size());
+  double reach = 0.0;
+  for (const auto& [x, y] : points) reach = std::max(reach, std::hypot(x - sx, y - sy));
+  return reach;
+}
+
+// The reach of the spot the points `pupil[p]` with `use[p].ok` map to by `terms`.
 double spot_reach_mm(const SeidelRayGeometry& geometry, const std::vector<PupilPoint>& pupil, const std::vector<SensorHit>& use,
                      const FieldTerms& terms) {
   std::vector<std::pair<double, double>> points;
-  double sx = 0.0, sy = 0.0;
   for (std::size_t p = 0; p < pupil.size(); ++p) {
     if (!use[p].ok) continue;
     double x, y;
     geometry.sensor_point(pupil[p], terms, x, y);
     points.emplace_back(x, y);
-    sx += x, sy += y;
   }
-  if (points.empty()) return 0.0;
-  sx /= static_cast<double>(points.size()), sy /= static_cast<double>(points.size());
-  double reach = 0.0;
-  for (const auto& [x, y] : points) reach = std::max(reach, std::hypot(x - sx, y - sy));
-  return reach;
+  return reach_about_centroid(points);
 }
 
 // Whether the fitted terms, carried over the pupil the model itself passes (its first-order
@@ -169,19 +170,13 @@ double spot_reach_mm(const SeidelRayGeometry& geometry, const std::vector<PupilP
 // The field then keeps its sums.
 bool extrapolates(const SeidelRayGeometry& geometry, const std::vector<PupilPoint>& pupil, const std::vector<SensorHit>& hits,
                   const std::vector<SensorHit>& own, const FieldTerms& fit, const FieldTerms& sums, double pixel_mm) {
-  std::vector<std::pair<double, double>> points;
-  double sx = 0.0, sy = 0.0;
+  std::vector<std::pair<double, double>> real;
   for (const SensorHit& h : hits) {
-    if (h.ok) points.emplace_back(h.x_mm, h.y_mm), sx += h.x_mm, sy += h.y_mm;
-  }
-  double real = 0.0;
-  if (!points.empty()) {
-    sx /= static_cast<double>(points.size()), sy /= static_cast<double>(points.size());
-    for (const auto& [x, y] : points) real = std::max(real, std::hypot(x - sx, y - sy));
+    if (h.ok) real.emplace_back(h.x_mm, h.y_mm);
   }
   const double fitted = spot_reach_mm(geometry, pupil, own, fit);
   const double summed = spot_reach_mm(geometry, pupil, own, sums);
-  return fitted > kExtrapolationGrowth * std::max(real, summed) + pixel_mm;
+  return fitted > kExtrapolationGrowth * std::max(reach_about_centroid(real), summed) + pixel_mm;
 }
 
 }  // namespace
@@ -203,8 +198,7 @@ FittedAberrations::FittedAberrations(const Camera& camera, const ExactModel& exa
   std::vector<PupilPoint> full;
   pupil_grid(-1.0, 1.0, -1.0, 1.0, full);
   const int tasks = static_cast<int>(distances.size() * nodes);
-  int fitted = 0, kept = 0;
-#pragma omp parallel for schedule(dynamic, 1) reduction(+ : fitted, kept)
+#pragma omp parallel for schedule(dynamic, 1)
   for (int task = 0; task < tasks; ++task) {
     const std::size_t j = static_cast<std::size_t>(task) / nodes, n = static_cast<std::size_t>(task) % nodes;
     const AberrationSample& s = table.sample(node_index[n], j);
@@ -255,11 +249,9 @@ FittedAberrations::FittedAberrations(const Camera& camera, const ExactModel& exa
       const FieldTerms sums = FieldTerms::at(c, geometry.y0);
       FieldTerms& t = terms_[(j * nodes + n) * fields_.size() + k];
       if (!ok || extrapolates(geometry, pupil, hits, own, fit, sums, pixel_mm)) {
-        ++kept;
         t = sums;
         continue;
       }
-      ++fitted;
       t = fit;
     }
   }
@@ -281,8 +273,6 @@ FittedAberrations::FittedAberrations(const Camera& camera, const ExactModel& exa
       for (std::size_t k = 0; k < fields_.size(); ++k) light_[(j * nodes + n) * fields_.size() + k] *= own_light / real_light;
     }
   }
-  fitted_ = fitted;
-  kept_ = kept;
 }
 
 double FittedAberrations::fitted_terms(double wavelength_nm, double object_distance_mm, double y0, FieldTerms& terms) const {

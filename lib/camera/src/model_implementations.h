@@ -213,9 +213,6 @@ class FittedAberrations {
   // table's units) into `terms`, and the light ratio there as the result: trilinear in wavelength,
   // inverse distance and field.
   double fitted_terms(double wavelength_nm, double object_distance_mm, double y0, FieldTerms& terms) const;
-  // (distance, wavelength, field) samples fitted, and those that kept the sums (too few rays passed).
-  int fitted() const { return fitted_; }
-  int kept() const { return kept_; }
 
  private:
   std::vector<double> inverse_distances_per_mm_;  // ascending, the table's
@@ -223,8 +220,6 @@ class FittedAberrations {
   std::vector<double> fields_;                    // y0, ascending from 0
   std::vector<FieldTerms> terms_;                 // [distance][wavelength][field]
   std::vector<double> light_;                     // [distance][wavelength][field]
-  int fitted_ = 0;
-  int kept_ = 0;
   const FieldTerms& at(std::size_t j, std::size_t n, std::size_t k) const {
     return terms_[(j * wavelengths_nm_.size() + n) * fields_.size() + k];
   }
