@@ -53,6 +53,10 @@ inline double mean_axial_patch_solid_angle(double w, double z_perspective_mm, do
 // circle is on the stop's edge by definition, and must not be lost to the aiming's rounding.
 inline constexpr double kAimTolerance = 1e-4;
 inline constexpr double kStopEdgeTolerance = 2.0 * kAimTolerance;
+// Traces the exact model may spend aiming one ray at its stop point (a Broyden quasi-Newton: the
+// Sasian triplet's frame at 1.2 m needs at most 4, the Canon 35 mm f/1.8's bundled scene 99.99999 %
+// within 4 and the rest within 9; a ray not aimed is lost).
+inline constexpr int kAimIterations = 10;
 
 // Wavelengths at which WeightNormalisation tabulates (the on-axis solid angle varies smoothly).
 inline constexpr int kNormalisationWavelengths = 9;
