@@ -8,6 +8,23 @@
 
 namespace lensmith {
 
+double passing_share(double clearance_a, double clearance_b, double clearance_c) {
+  const double a = clearance_a, b = clearance_b, c = clearance_c;
+  const int positive = (a >= 0.0) + (b >= 0.0) + (c >= 0.0);
+  if (positive == 3) return 1.0;
+  if (positive == 0) return 0.0;
+  // Order so that `lone` is the corner alone on its side.
+  double lone = a, u = b, v = c;
+  const bool lone_positive = positive == 1;
+  if ((b >= 0.0) == lone_positive) {
+    lone = b, u = a, v = c;
+  } else if ((c >= 0.0) == lone_positive) {
+    lone = c, u = a, v = b;
+  }
+  const double corner = lone * lone / ((lone - u) * (lone - v));
+  return lone_positive ? corner : 1.0 - corner;
+}
+
 std::string_view to_string(RayModelKind kind) {
   switch (kind) {
     case RayModelKind::Thin: return "thin";

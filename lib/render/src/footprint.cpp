@@ -76,13 +76,52 @@ void reach_clip(const std::vector<PupilPoint>& outline, double scale, const std:
   }
 }
 
+// Whether a ring that rises and falls once in y (two chains from its topmost to its bottommost
+// vertex) is simple: its two chains must not cross. One that does is a figure eight (a near-focus
+// beam with coma and astigmatism maps a pupil ring so), whose signed area, the difference of its
+// two lobes, can be near zero: spread over that area its light would become large positive and
+// negative densities. Each chain vertex strictly between the ends is compared with the other chain
+// at its height; both walks are monotone in y, so O(vertices).
+bool monotone_ring_is_simple(std::span<const Point2f> ring) {
+  const std::size_t n = ring.size();
+  std::size_t top = 0, bottom = 0;
+  for (std::size_t i = 1; i < n; ++i) {
+    if (ring[i].y < ring[top].y) top = i;
+    if (ring[i].y > ring[bottom].y) bottom = i;
+  }
+  const double y_top = ring[top].y, y_bottom = ring[bottom].y;
+  auto next = [n](std::size_t i, bool forward) { return forward ? (i + 1 == n ? 0 : i + 1) : (i == 0 ? n - 1 : i - 1); };
+  int side = 0;  // the sign of (this chain's x - the other's) seen so far
+  for (const bool forward : {true, false}) {
+    // `other` walks the opposite chain, staying on the edge that spans the current height.
+    std::size_t other = top;
+    for (std::size_t i = next(top, forward); i != bottom; i = next(i, forward)) {
+      const double y = ring[i].y;
+      if (!(y > y_top && y < y_bottom)) continue;
+      while (static_cast<double>(ring[next(other, !forward)].y) < y) other = next(other, !forward);
+      const Point2f& a = ring[other];
+      const Point2f& b = ring[next(other, !forward)];
+      const double t = b.y > a.y ? (y - a.y) / (static_cast<double>(b.y) - a.y) : 0.0;
+      const double dx = ring[i].x - (a.x + t * (static_cast<double>(b.x) - a.x));
+      const int s = (dx > 0.0) - (dx < 0.0);
+      // Measured from the forward chain: the backward chain's differences count with their sign flipped.
+      const int from_forward = forward ? s : -s;
+      if (from_forward == 0) continue;
+      if (side == 0) side = from_forward;
+      if (from_forward != side) return false;
+    }
+  }
+  return true;
+}
+
 // Nested ring polygons of any vertex counts (rings[k - 1], mapped to the output) with the pupil
 // areas they enclose (pupil_areas[k], pupil_areas[0] = 0) and their rays' mean radiometric weights
 // (ring_weights[k], [0] the centre ray's): annulus k carries the light of its pupil area over
 // `full_pupil_area` (so what first-order vignetting cuts off is missing) and the coverage of its
 // pupil area over the ring set's (an opaque point, however vignetted), spread evenly over its mapped
 // area. Rings are merged where the densities differ by less than kRingMergeTolerance. Returns false,
-// depositing nothing, where the mapped rings are not nested (a fold or caustic).
+// depositing nothing, where the mapped rings are not nested or one crosses itself (a fold or
+// caustic).
 bool deposit_nested_rings(const std::vector<std::span<const Point2f>>& rings, const std::vector<double>& pupil_areas,
                           const std::vector<double>& ring_weights, double full_pupil_area, const std::array<float, 4>& value,
                           bool weighted, SplatBuffer& buffer, std::vector<double>& areas) {
@@ -110,7 +149,7 @@ bool deposit_nested_rings(const std::vector<std::span<const Point2f>>& rings, co
       if (last_dy != 0.0 && (dy > 0.0) != (last_dy > 0.0)) ++turns;
       last_dy = dy;
     }
-    if (turns > 2) return false;
+    if (turns > 2 || !monotone_ring_is_simple(ring)) return false;
     const double area = 0.5 * twice * orientation;
     if (!(area > areas[static_cast<std::size_t>(k) - 1] + 1e-3 * std::max(area, 1e-9))) return false;
     areas[static_cast<std::size_t>(k)] = area;
@@ -182,25 +221,6 @@ bool deposit_ring_polygons(const PupilMesh& mesh, const std::vector<SensorHit>& 
   }
   return deposit_nested_rings(scratch.ring_spans, scratch.pupil_areas, scratch.ring_weights, 1.0, value, weighted, buffer,
                               scratch.areas);
-}
-
-// The share of a triangle's area where a function linear over it, with values a, b, c at the
-// corners, is >= 0: with one corner on the positive side the small triangle cut off there has the
-// share p^2 / ((p - q)(p - r)) of the area (similar triangles along its two edges).
-double positive_share(double a, double b, double c) {
-  const int positive = (a >= 0.0) + (b >= 0.0) + (c >= 0.0);
-  if (positive == 3) return 1.0;
-  if (positive == 0) return 0.0;
-  // Order so that `lone` is the corner alone on its side.
-  double lone = a, u = b, v = c;
-  const bool lone_positive = positive == 1;
-  if ((b >= 0.0) == lone_positive) {
-    lone = b, u = a, v = c;
-  } else if ((c >= 0.0) == lone_positive) {
-    lone = c, u = a, v = b;
-  }
-  const double corner = lone * lone / ((lone - u) * (lone - v));
-  return lone_positive ? corner : 1.0 - corner;
 }
 
 }  // namespace
@@ -502,7 +522,7 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
       const SensorHit& b = hits[static_cast<std::size_t>(tri.b)];
       const SensorHit& c = hits[static_cast<std::size_t>(tri.c)];
       if (!(a.ok || a.unclipped) || !(b.ok || b.unclipped) || !(c.ok || c.unclipped)) return 0.0;
-      return positive_share(a.clearance, b.clearance, c.clearance);
+      return passing_share(a.clearance, b.clearance, c.clearance);
     };
     // Colour carries the transmitted fraction and the rays' radiometric weights (vignetting darkens);
     // coverage is normalised over the light that passes, so a vignetted point is still an opaque

@@ -61,6 +61,11 @@ struct SensorHit {
   double clearance = 1.0;
 };
 
+// The share of a pupil triangle that passes, to first order: where the linear interpolation of its
+// corners' clearances is >= 0 (with one corner alone on its side of 0, the small triangle there has
+// the share p^2 / ((p - q)(p - r)) of the area, by similar triangles along its two edges).
+double passing_share(double clearance_a, double clearance_b, double clearance_c);
+
 class RayModel {
  public:
   virtual ~RayModel() = default;
