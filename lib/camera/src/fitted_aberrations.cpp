@@ -41,7 +41,7 @@ namespace {
 constexpr int kFitWavelengths = 5;
 // Fields per distance and wavelength, at y0 = k / (kFitFields - 1).
 constexpr int kFitFields = 9;
-// Pupil grid per axis; the points inside the unit disc are used (112 of 144).
+// Cells per axis of the pupil lattice; the fit uses its corners inside the unit disc (113 of 169).
 constexpr int kFitPupilGrid = 12;
 // A field needs at least this many passing rays (each gives two equations for five unknowns); with
 // fewer it keeps the sums.
@@ -60,16 +60,51 @@ constexpr double kSphericalReach = 0.5;
 constexpr double kRidge = 1e-9;
 
 
-// The points of a kFitPupilGrid x kFitPupilGrid grid of equal cells over [x0, x1] x [y0, y1] that lie
-// in the unit pupil.
-void pupil_grid(double x0, double x1, double y0, double y1, std::vector<PupilPoint>& out) {
+// The corners of a kFitPupilGrid x kFitPupilGrid lattice of equal cells over [x0, x1] x [y0, y1],
+// row by row ((kFitPupilGrid + 1)^2 points, those outside the unit pupil too: the light integrates
+// over cells that the iris cuts).
+void pupil_lattice(double x0, double x1, double y0, double y1, std::vector<PupilPoint>& out) {
   out.clear();
-  for (int i = 0; i < kFitPupilGrid; ++i) {
-    for (int j = 0; j < kFitPupilGrid; ++j) {
-      const PupilPoint q{x0 + (x1 - x0) * (i + 0.5) / kFitPupilGrid, y0 + (y1 - y0) * (j + 0.5) / kFitPupilGrid};
-      if (q.x * q.x + q.y * q.y <= 1.0) out.push_back(q);
+  for (int j = 0; j <= kFitPupilGrid; ++j) {
+    for (int i = 0; i <= kFitPupilGrid; ++i) {
+      out.push_back({x0 + (x1 - x0) * i / kFitPupilGrid, y0 + (y1 - y0) * j / kFitPupilGrid});
     }
   }
+}
+
+bool in_pupil(const PupilPoint& q) { return q.x * q.x + q.y * q.y <= 1.0; }
+
+// The light a model passes through the lattice `pupil` (pupil_lattice) with `hits`: each cell as
+// two triangles, each passing the share of its area where the linear interpolation of its corners'
+// clearances (with the iris's, 1 - |q|) is >= 0 (passing_share), times its corners' mean weight.
+// Counting passing lattice points instead would step by a whole cell wherever the edge of a
+// vignetted beam crosses one: on a 12 x 12 grid the light of the Canon 35 mm's defocused corner
+// beams wobbled by up to 8 % from field to field, and a uniform sky came out in bands.
+double lattice_light(const std::vector<PupilPoint>& pupil, const std::vector<SensorHit>& hits, double cell_area) {
+  const auto side = static_cast<std::size_t>(kFitPupilGrid) + 1;
+  auto clearance = [&](std::size_t p) {
+    const double iris = 1.0 - std::hypot(pupil[p].x, pupil[p].y);
+    return hits[p].ok || hits[p].unclipped ? std::min(hits[p].clearance, iris) : std::min(-1.0, iris);
+  };
+  auto weight = [&](std::size_t a, std::size_t b, std::size_t c) {
+    double sum = 0.0;
+    int count = 0;
+    for (const std::size_t p : {a, b, c}) {
+      if (!(hits[p].ok || hits[p].unclipped)) continue;
+      sum += hits[p].weight;
+      ++count;
+    }
+    return count > 0 ? sum / count : 0.0;
+  };
+  double light = 0.0;
+  for (std::size_t j = 0; j + 1 < side; ++j) {
+    for (std::size_t i = 0; i + 1 < side; ++i) {
+      const std::size_t a = j * side + i, b = a + 1, c = a + side, d = c + 1;
+      light += 0.5 * cell_area * passing_share(clearance(a), clearance(b), clearance(d)) * weight(a, b, d);
+      light += 0.5 * cell_area * passing_share(clearance(a), clearance(d), clearance(c)) * weight(a, d, c);
+    }
+  }
+  return light;
 }
 
 // The least-squares terms of the real rays `hits` of one scene point through `pupil` (see the file
@@ -150,12 +185,12 @@ double reach_about_centroid(const std::vector<std::pair<double, double>>& points
   return reach;
 }
 
-// The reach of the spot the points `pupil[p]` with `use[p].ok` map to by `terms`.
+// The reach of the spot the points `pupil[p]` in the unit pupil with `use[p].ok` map to by `terms`.
 double spot_reach_mm(const SeidelRayGeometry& geometry, const std::vector<PupilPoint>& pupil, const std::vector<SensorHit>& use,
                      const FieldTerms& terms) {
   std::vector<std::pair<double, double>> points;
   for (std::size_t p = 0; p < pupil.size(); ++p) {
-    if (!use[p].ok) continue;
+    if (!use[p].ok || !in_pupil(pupil[p])) continue;
     double x, y;
     geometry.sensor_point(pupil[p], terms, x, y);
     points.emplace_back(x, y);
@@ -196,7 +231,8 @@ FittedAberrations::FittedAberrations(const Camera& camera, const ExactModel& exa
   terms_.assign(distances.size() * nodes * fields_.size(), FieldTerms{});
   light_.assign(terms_.size(), 1.0);
   std::vector<PupilPoint> full;
-  pupil_grid(-1.0, 1.0, -1.0, 1.0, full);
+  pupil_lattice(-1.0, 1.0, -1.0, 1.0, full);
+  const double full_cell_area = 4.0 / (kFitPupilGrid * kFitPupilGrid);
   const int tasks = static_cast<int>(distances.size() * nodes);
 #pragma omp parallel for schedule(dynamic, 1)
   for (int task = 0; task < tasks; ++task) {
@@ -222,15 +258,19 @@ FittedAberrations::FittedAberrations(const Camera& camera, const ExactModel& exa
       std::size_t passing = 0, own_passing = 0;
       double x0 = kInfinity, x1 = -kInfinity, y0 = kInfinity, y1 = -kInfinity;
       for (std::size_t p = 0; p < pupil.size(); ++p) {
+        if (!in_pupil(pupil[p])) continue;
         passing += hits[p].ok;
         own_passing += own[p].ok;
         if (!(hits[p].ok || own[p].ok)) continue;
         x0 = std::min(x0, pupil[p].x), x1 = std::max(x1, pupil[p].x);
         y0 = std::min(y0, pupil[p].y), y1 = std::max(y1, pupil[p].y);
       }
+      double cell_area = full_cell_area;
       if ((passing < kDenseBelow || own_passing < kDenseBelow) && x0 <= x1) {
         const double cell = 2.0 / kFitPupilGrid;
-        pupil_grid(std::max(-1.0, x0 - cell), std::min(1.0, x1 + cell), std::max(-1.0, y0 - cell), std::min(1.0, y1 + cell), pupil);
+        x0 = std::max(-1.0, x0 - cell), x1 = std::min(1.0, x1 + cell), y0 = std::max(-1.0, y0 - cell), y1 = std::min(1.0, y1 + cell);
+        pupil_lattice(x0, x1, y0, y1, pupil);
+        cell_area = (x1 - x0) * (y1 - y0) / (kFitPupilGrid * kFitPupilGrid);
         hits.resize(pupil.size());
         own.resize(pupil.size());
         exact.map(point, s.wavelength_nm, pupil, hits);
@@ -238,13 +278,8 @@ FittedAberrations::FittedAberrations(const Camera& camera, const ExactModel& exa
       }
       FieldTerms fit;
       const bool ok = fit_field(geometry, pupil, hits, fit);
-      // The light: the same pupil grid (of equal cells) through both, so its discretisation cancels
-      // in the ratio.
-      double real_light = 0.0, own_light = 0.0;
-      for (std::size_t p = 0; p < pupil.size(); ++p) {
-        if (hits[p].ok) real_light += hits[p].weight;
-        if (own[p].ok) own_light += own[p].weight;
-      }
+      // The light: the same lattice through both.
+      const double real_light = lattice_light(pupil, hits, cell_area), own_light = lattice_light(pupil, own, cell_area);
       if (own_light > 0.0) light_[(j * nodes + n) * fields_.size() + k] = real_light / own_light;
       const FieldTerms sums = FieldTerms::at(c, geometry.y0);
       FieldTerms& t = terms_[(j * nodes + n) * fields_.size() + k];
@@ -256,18 +291,14 @@ FittedAberrations::FittedAberrations(const Camera& camera, const ExactModel& exa
     }
   }
   // Both models' weights are normalised so that the on-axis point of the focus plane passes a mean
-  // of 1 over the pupil (ray_model.h); on this grid their ratio there departs from 1 only by how
-  // the grid meets the two clipping edges: divide that out per wavelength.
+  // of 1 over the pupil (ray_model.h); on this lattice their ratio there departs from 1 only by how
+  // the interpolated clearances meet the two clipping edges: divide that out per wavelength.
   for (std::size_t n = 0; n < nodes; ++n) {
     std::vector<SensorHit> hits(full.size()), own(full.size());
     const ScenePoint axis{0.0, 0.0, inverse_per_mm(camera.focus_distance_mm())};
     exact.map(axis, wavelengths_nm_[n], full, hits);
     model(axis, wavelengths_nm_[n], full, own);
-    double real_light = 0.0, own_light = 0.0;
-    for (std::size_t p = 0; p < full.size(); ++p) {
-      if (hits[p].ok) real_light += hits[p].weight;
-      if (own[p].ok) own_light += own[p].weight;
-    }
+    const double real_light = lattice_light(full, hits, full_cell_area), own_light = lattice_light(full, own, full_cell_area);
     if (!(real_light > 0.0 && own_light > 0.0)) continue;
     for (std::size_t j = 0; j < distances.size(); ++j) {
       for (std::size_t k = 0; k < fields_.size(); ++k) light_[(j * nodes + n) * fields_.size() + k] *= own_light / real_light;
