@@ -154,7 +154,8 @@ Image render(const Image& image, const DepthMap& depth, const RayModel& model, c
           SplatBuffer& buffer = use(kind);
           SplatBuffer& fine = plans[i].mesh >= 0 ? use(0) : buffer;
           scatter.deposit(layer[i], plans[i], buffer, fine, scratch, local_triangles);
-          local_footprints += static_cast<std::size_t>(plans[i].groups);
+          // A footprint cross-faded between two group counts deposits both splits.
+          local_footprints += static_cast<std::size_t>(plans[i].groups + (plans[i].blend < 1.0f ? plans[i].groups - 1 : 0));
         }
         bool any = false;
         for (int set = 0; set < (stretch ? 2 : 1); ++set) {

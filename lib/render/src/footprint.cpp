@@ -33,6 +33,9 @@ constexpr double kRingMergeTolerance = 0.02;
 // under 5 % of its size, invisible in a disc that large (bench/blender's scenes: within 0.1 dB).
 constexpr double kHalfResolutionPx = 40.0;
 constexpr double kQuarterResolutionPx = 96.0;
+// Share of the chromatic tolerance over which a footprint's light is cross-faded from n - 1 to n
+// wavelength groups (FootprintScatter::plan): the points there deposit both splits.
+constexpr double kGroupBlend = 0.25;
 // Grid cells of an aperture-picture mesh per pixel of footprint size.
 constexpr double kPxPerGridCell = 1.5;
 
@@ -256,8 +259,9 @@ bool FootprintScatter::clip_rings(const FootprintPlan& p, FootprintScratch& scra
   return true;
 }
 
-bool FootprintScatter::deposit_clipped_rings(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p,
-                                             const std::array<float, 4>& value, SplatBuffer& buffer, FootprintScratch& scratch) const {
+void FootprintScatter::deposit_clipped_rings(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p,
+                                             const std::array<float, 4>& value, SplatBuffer& buffer, SplatBuffer& fine,
+                                             FootprintScratch& scratch, std::size_t& triangles) const {
   const int rings = meshes_.mesh(p.mesh).rings;
   const std::vector<PupilPoint>& outline = meshes_.dense_outline(PupilMeshTable::sector_step_of_mesh(p.mesh));
   const std::vector<PupilPoint>& pupil = scratch.ring_pupil;
@@ -279,8 +283,43 @@ bool FootprintScatter::deposit_clipped_rings(const ScenePoint& point, double wav
     for (std::size_t i = begin; i < end; ++i) sum += hits[i].weight;
     scratch.ring_weights.push_back(sum / static_cast<double>(end - begin));
   }
-  return deposit_nested_rings(scratch.ring_spans, scratch.pupil_areas, scratch.ring_weights, pupil_polygon_area(outline), value,
-                              options_.vignetting, buffer, scratch.areas);
+  const double full_pupil_area = pupil_polygon_area(outline);
+  if (deposit_nested_rings(scratch.ring_spans, scratch.pupil_areas, scratch.ring_weights, full_pupil_area, value,
+                           options_.vignetting, buffer, scratch.areas)) {
+    return;
+  }
+  // The same clipped rings as triangles: a fan from the centre, then two per cell between rings
+  // (every ring has the outline's vertex count). Each carries its own pupil area's light and
+  // coverage, so that the beam keeps its clipped shape: the mesh's triangles, clipped in place by
+  // interpolated clearances, would spread a coarse mesh's edge cells over their unclipped images,
+  // and where neighbouring sources switch between the two the sky showed seams.
+  const double pupil_total = scratch.pupil_areas.back();
+  if (!(pupil_total > 0.0)) return;
+  const double light_area = options_.vignetting ? full_pupil_area : pupil_total;
+  auto triangle = [&](std::size_t a, std::size_t b, std::size_t c) {
+    const double area = 0.5 * std::abs((pupil[b].x - pupil[a].x) * (pupil[c].y - pupil[a].y) -
+                                       (pupil[c].x - pupil[a].x) * (pupil[b].y - pupil[a].y));
+    if (!(area > 0.0)) return;
+    const double weight = options_.vignetting ? (hits[a].weight + hits[b].weight + hits[c].weight) / 3.0 : 1.0;
+    const auto f = static_cast<float>(area / light_area * weight);
+    const auto cover = static_cast<float>(area / pupil_total);
+    fine.add_triangle(points[a], points[b], points[c], {value[0] * f, value[1] * f, value[2] * f, value[3] * cover});
+    ++triangles;
+  };
+  const std::size_t n = outline.size();
+  for (int k = 1; k <= rings; ++k) {
+    const std::size_t outer = scratch.ring_offsets[static_cast<std::size_t>(k) - 1];
+    for (std::size_t j = 0; j < n; ++j) {
+      const std::size_t j1 = (j + 1) % n;
+      if (k == 1) {
+        triangle(0, outer + j, outer + j1);
+        continue;
+      }
+      const std::size_t inner = scratch.ring_offsets[static_cast<std::size_t>(k) - 2];
+      triangle(inner + j, outer + j, outer + j1);
+      triangle(inner + j, outer + j1, inner + j1);
+    }
+  }
 }
 
 std::array<float, 4> FootprintScatter::lit(const std::array<float, 4>& value, double weight) const {
@@ -387,7 +426,16 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
   }
   const double size = std::max(x_max - x_min, y_max - y_min);
   // Coverage has no colour: one group carries it.
-  p.groups = s.coverage_only ? 1 : std::clamp(static_cast<int>(std::ceil(spread / options_.chromatic_tolerance_px)), 1, groups_.max_count());
+  // A point whose colour spread just crossed into one
+  // more group than its neighbour's is split both ways, its light cross-faded between the two over
+  // kGroupBlend of the tolerance: each split places its colours at its groups' wavelengths, and a
+  // hard switch moved them by a fraction of a pixel between neighbouring points, which a uniform
+  // sky showed as coloured lines of up to 5 % along the switch.
+  const double groups_needed = spread / options_.chromatic_tolerance_px;
+  p.groups = s.coverage_only ? 1 : std::clamp(static_cast<int>(std::ceil(groups_needed)), 1, groups_.max_count());
+  if (p.groups > 1 && groups_needed < p.groups) {
+    p.blend = static_cast<float>(std::min(1.0, (groups_needed - (p.groups - 1)) / kGroupBlend));
+  }
   p.level = size >= kQuarterResolutionPx ? 2 : size >= kHalfResolutionPx ? 1 : 0;
   const double cell_px = 1 << p.level;
   const double margin = kTentMarginPx * cell_px + (near_affine ? 0.0 : kMeshMarginFraction * size);
@@ -461,10 +509,11 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
   // A polar mesh of a model that clips by discs: its rings clipped once for every wavelength.
   const bool rings_clipped = p.mesh >= 0 && !scratch.discs.empty() && meshes_.mesh(p.mesh).sectors > 0 &&
                              aperture_.is_uniform_convex() && clip_rings(p, scratch);
-  for (const SpectralGroup& g : groups_.split(p.groups)) {
+  // One wavelength group's share of the light.
+  auto deposit_group = [&](const SpectralGroup& g, float share) {
     std::array<float, 4> value{};
-    for (std::size_t c = 0; c < 3; ++c) value[c] = g.m[c][0] * s.rgb[0] + g.m[c][1] * s.rgb[1] + g.m[c][2] * s.rgb[2];
-    value[3] = g.alpha * s.coverage;
+    for (std::size_t c = 0; c < 3; ++c) value[c] = share * (g.m[c][0] * s.rgb[0] + g.m[c][1] * s.rgb[1] + g.m[c][2] * s.rgb[2]);
+    value[3] = share * g.alpha * s.coverage;
     if (p.outline == FootprintPlan::kPoint) {
       static constexpr std::array<PupilPoint, 1> kCentre{{{0.0, 0.0}}};
       hits.resize(1);
@@ -474,13 +523,13 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
       } else {
         model_.map_passing(point, g.wavelength_nm, kCentre, std::span<SensorHit>(hits.data(), 1));
       }
-      if (!hits[0].ok) continue;
+      if (!hits[0].ok) return;
       const PixelPoint c = camera_.output_pixel(hits[0].x_mm, hits[0].y_mm);
       std::array<float, 4> v = lit(value, hits[0].weight);
       const auto light = static_cast<float>(options_.vignetting ? passing : 1.0);
       for (std::size_t k = 0; k < 3; ++k) v[k] *= light;
       buffer.add_point({static_cast<float>(c.x), static_cast<float>(c.y)}, v);
-      continue;
+      return;
     }
     if (p.mesh < 0) {
       // Affine model, uniform convex aperture: the outline, less what first-order vignetting cuts
@@ -501,10 +550,13 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
       const auto light = static_cast<float>(options_.vignetting ? passing : 1.0);
       for (std::size_t c = 0; c < 3; ++c) v[c] *= light;
       buffer.add_polygon(points, v);
-      continue;
+      return;
     }
     const PupilMesh& mesh = meshes_.mesh(p.mesh);
-    if (rings_clipped && deposit_clipped_rings(point, g.wavelength_nm, p, value, buffer, scratch)) continue;
+    if (rings_clipped) {
+      deposit_clipped_rings(point, g.wavelength_nm, p, value, buffer, fine, scratch, triangles);
+      return;
+    }
     hits.resize(mesh.points.size());
     model_.map(point, g.wavelength_nm, mesh.points, hits);
     points.resize(mesh.points.size());
@@ -513,7 +565,7 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
       const PixelPoint q = camera_.output_pixel(hits[i].x_mm, hits[i].y_mm);
       points[i] = {static_cast<float>(q.x), static_cast<float>(q.y)};
     }
-    if (mesh.sectors > 0 && deposit_ring_polygons(mesh, hits, points, value, options_.vignetting, buffer, scratch)) continue;
+    if (mesh.sectors > 0 && deposit_ring_polygons(mesh, hits, points, value, options_.vignetting, buffer, scratch)) return;
     // A triangle whose corners a clear aperture partly stops (exact, poly) passes the part of its
     // area where the linear interpolation of their clearances is >= 0, in place: the beam's edge
     // falls inside it, to first order.
@@ -529,7 +581,7 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
     // surface. Without vignetting the colour is normalised the same way.
     double passed = 0.0;
     for (const PupilTriangle& tri : mesh.triangles) passed += tri.weight * triangle_passing(tri);
-    if (!(passed > 0.0)) continue;
+    if (!(passed > 0.0)) return;
     // Where the model describes its clipping as discs, the light that passes is known exactly (the
     // outline less the discs); the triangles' linear interpolation only distributes it.
     const double exact_share = !scratch.discs.empty() && aperture_.is_uniform_convex() ? passing : passed;
@@ -544,6 +596,10 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
                         {value[0] * w, value[1] * w, value[2] * w, static_cast<float>(value[3] * tri.weight * fraction / passed)});
       ++triangles;
     }
+  };
+  for (const SpectralGroup& g : groups_.split(p.groups)) deposit_group(g, p.blend);
+  if (p.blend < 1.0f) {
+    for (const SpectralGroup& g : groups_.split(p.groups - 1)) deposit_group(g, 1.0f - p.blend);
   }
 }
 

@@ -27,6 +27,7 @@ struct FootprintPlan {
   float y_min = 0.0f;  // rows the footprint may touch (px, with margin)
   float y_max = 0.0f;
   int groups = 1;      // wavelength groups
+  float blend = 1.0f;  // share of the light in `groups` groups; the rest in groups - 1 (a smooth switch)
   int mesh = -1;       // PupilMeshTable mesh index, or -1 for the single-polygon and point paths
   int outline = 0;     // PupilMeshTable sector step (single polygon), or kPoint
   int level = 0;       // the splat grid: 2^level output px per cell side (large footprints are coarse)
@@ -64,10 +65,12 @@ class FootprintScatter {
 
  private:
   // A polar mesh's rings clipped by scratch.discs (first-order vignetting), mapped and deposited as
-  // nested rings; false, depositing nothing, where they do not nest.
+  // nested rings, or where they do not nest (a cat's eye mapped to a crescent that turns back in
+  // y), as the triangles between them into `fine` (adding them to `triangles`).
   bool clip_rings(const FootprintPlan& p, FootprintScratch& scratch) const;  // into scratch.ring_pupil; false: do not nest
-  bool deposit_clipped_rings(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p,
-                             const std::array<float, 4>& value, SplatBuffer& buffer, FootprintScratch& scratch) const;
+  void deposit_clipped_rings(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p,
+                             const std::array<float, 4>& value, SplatBuffer& buffer, SplatBuffer& fine,
+                             FootprintScratch& scratch, std::size_t& triangles) const;
   // `value` with its light (not its coverage) scaled by a ray's radiometric weight (SensorHit), when
   // BokehOptions::vignetting is on.
   std::array<float, 4> lit(const std::array<float, 4>& value, double weight) const;
