@@ -219,7 +219,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   std::ostringstream what;
   what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds
-       << " s (rendering " << render_seconds << " s)\n  " << lens_name << ", model " << to_string(kind) << ", f/"
+       << " s (rendering " << render_seconds << " s)\n  " << lens_name << ", model " << to_string(kind) << (kind == RayModelKind::Seidel ? " (" + o.seidel_coefficients + " terms)" : std::string()) << ", f/"
        << format_rounded(cam->f_number(), 3) << ", focus " << format_rounded(camera.focus_distance_m, 4) << " m, " << aperture.to_string()
        << " aperture\n  " << stats.layers << " depth layers " << format_rounded(stats.layer_spacing_px, 3) << " px apart, largest blur "
        << format_rounded(stats.max_abs_coc_px, 3) << " px; " << stats.footprints << " footprints";

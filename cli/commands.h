@@ -154,7 +154,7 @@ struct BokehCommandOptions {
   double blade_rotation_deg = 0.0;           // --blade-rotation
   std::string aperture_image;                // --aperture-image PNG
   std::string model;                         // --model thin|paraxial|seidel|exact; default seidel (thin with --thin-lens)
-  std::string seidel_coefficients = "sums";    // --seidel-coefficients fitted|sums (RayModelOptions)
+  std::string seidel_coefficients = "fitted";  // --seidel-coefficients fitted|sums (RayModelOptions)
   std::string hidden = "extend";             // --hidden extend|stretch
   std::string edge_pixels = "split";         // --edge-pixels split|keep
   bool no_vignetting = false;                // --no-vignetting: every point as bright as on the axis
@@ -175,7 +175,7 @@ struct ValidateCommandOptions {
   double focus_m = 3.0;                           // --focus, metres
   std::string out = "validation";                 // --out DIR: report.md and psf.png
   std::vector<std::string> models{"paraxial", "seidel"};  // --models
-  std::string seidel_coefficients = "sums";       // --seidel-coefficients fitted|sums
+  std::string seidel_coefficients = "fitted";     // --seidel-coefficients fitted|sums
   int width_px = 1920;                            // --width/--height: the frame the fields refer to
   int height_px = 1080;
   int pupil_samples = 96;                         // --pupil-samples per axis

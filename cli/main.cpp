@@ -274,7 +274,7 @@ int main(int argc, char** argv) {
   bokeh_cmd->add_option("--model", bokeh.model, "thin | paraxial | seidel (default) | poly | exact")
       ->check(CLI::IsMember({"thin", "paraxial", "seidel", "poly", "exact"}));
   bokeh_cmd->add_option("--seidel-coefficients", bokeh.seidel_coefficients,
-                        "seidel model: sums (default: Seidel sums, Asberg) | fitted (third order fitted to the real rays: closer PSFs, but faint colour arcs on some in-focus texture, being fixed)")
+                        "seidel model: fitted (default: third-order terms fitted per field to the real rays) | sums (the Seidel sums, Asberg's method as published)")
       ->check(CLI::IsMember({"fitted", "sums"}));
   bokeh_cmd->add_option("--fit", bokeh.fit, "Fit file for --model poly (lensmith fit -o); default: fit the lens in this run")
       ->check(CLI::ExistingFile);
@@ -310,7 +310,7 @@ int main(int argc, char** argv) {
   validate_cmd->add_option("--models", validate.models, "Models to compare with exact (default paraxial seidel; also poly)")
       ->check(CLI::IsMember({"paraxial", "seidel", "poly"}));
   validate_cmd->add_option("--seidel-coefficients", validate.seidel_coefficients,
-                           "seidel model: sums (default) | fitted (third order fitted to the real rays)")
+                           "seidel model: fitted (default: third-order terms fitted per field to the real rays) | sums (the Seidel sums, Asberg's method as published)")
       ->check(CLI::IsMember({"fitted", "sums"}));
   validate_cmd->add_option("--fit", validate.fit, "Fit file for the poly model (lensmith fit -o); default: fit the lens in this run")
       ->check(CLI::ExistingFile);

@@ -48,6 +48,11 @@ TEST_CASE("A PSF shifted by 5 um shows a 5 um centroid offset, the same size, an
 }
 
 TEST_CASE("The Seidel model's PSFs come closer to the exact tracer's as the f-number grows", "[validate]") {
+  // With the Seidel sums: the truncated third order describes a lens better the smaller its aperture
+  // (Welford 1986, sec. 8.4). The fitted terms are close at every f-number (0.96 from f/4 here), so
+  // the trend is a property of the sums.
+  RayModelOptions sums;
+  sums.seidel_coefficients = SeidelCoefficients::Sums;
   PsfValidationOptions o;
   o.relative_fields = {0.0, 0.7};
   o.depths_m = {1.5, 6.0};
@@ -55,7 +60,7 @@ TEST_CASE("The Seidel model's PSFs come closer to the exact tracer's as the f-nu
   o.pupil_samples_per_axis = 32;
   double previous = 0.0;
   for (const double n : {2.0, 4.0, 8.0}) {
-    const PsfValidation v = validate_point_spreads(biotar(n), {RayModelKind::Seidel}, Aperture::circular(), o);
+    const PsfValidation v = validate_point_spreads(biotar(n), {RayModelKind::Seidel}, Aperture::circular(), o, sums);
     REQUIRE(v.summaries.size() == 1);
     const PsfModelSummary& s = v.summaries.front();
     INFO("f/" << n << ": mean overlap " << s.mean_overlap << ", worst " << s.worst_overlap << ", max offset "

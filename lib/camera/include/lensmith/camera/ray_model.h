@@ -122,8 +122,9 @@ struct RayModelOptions {
   // poly: a fit of the camera's lens (LensFit::fit or LensFit::read); empty: fitted when the model is
   // made, with LensFitOptions{} (several seconds).
   std::shared_ptr<const LensFit> fit;
-  // seidel: the Seidel sums, or fitted to the exact tracer's rays (about 0.1 s more).
-  SeidelCoefficients seidel_coefficients = SeidelCoefficients::Sums;
+  // seidel: fitted to the exact tracer's rays (about 0.1 s more), or the Seidel sums (Asberg's
+  // method as published).
+  SeidelCoefficients seidel_coefficients = SeidelCoefficients::Fitted;
   void validate() const;             // throws OptionsError
 };
 

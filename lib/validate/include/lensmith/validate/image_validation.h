@@ -18,7 +18,7 @@ struct ImageValidationOptions {
   std::vector<std::filesystem::path> scenes;  // lensmith-scene JSON files
   std::vector<RayModelKind> models{RayModelKind::Paraxial, RayModelKind::Seidel};
   std::shared_ptr<const LensFit> fit;  // for the poly model; empty: fitted when needed
-  SeidelCoefficients seidel_coefficients = SeidelCoefficients::Sums;  // for the seidel model
+  SeidelCoefficients seidel_coefficients = SeidelCoefficients::Fitted;  // for the seidel model
   int width_px = 320;
   int height_px = 180;
   int spp = 64;                 // samples per pixel of the ground truth
