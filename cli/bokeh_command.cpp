@@ -64,6 +64,34 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     alpha.reset();
   }
 
+  // Render passes (AOVs) of an EXR input: kept in focus as Nuke's defocus nodes leave the channels
+  // they do not process, defocused with the picture's rays, or dropped.
+  OtherChannels other = o.other_channels == "drop" ? OtherChannels{} : read_other_channels(o.image);
+  if (!other.names.empty() && !output_keeps_alpha(output)) {
+    if (!global.quiet) {
+      std::cerr << "note: " << o.image << " has " << other.names.size() << " other channels; only an OpenEXR output (.exr) keeps them\n";
+    }
+    other = {};
+  }
+  // The output is checked for values no computation should make; a pass's NaN or infinity is the
+  // input's, and said as such.
+  for (std::size_t i = 0; i < other.samples.size(); ++i) {
+    if (std::isfinite(other.samples[i])) continue;
+    const std::size_t pixel = i / other.names.size(), w = static_cast<std::size_t>(image.width);
+    throw ImageFileError(o.image + ": channel " + other.names[i % other.names.size()] + " at pixel (" + std::to_string(pixel % w) + ", " +
+                         std::to_string(pixel / w) + ") is " + format_number(other.samples[i]) +
+                         ": the passes written beside the picture must be finite (--other-channels drop leaves them out)");
+  }
+  if (!other.names.empty() && !global.quiet) {
+    std::string names;
+    for (std::size_t i = 0; i < other.names.size() && i < 6; ++i) names += (i ? ", " : "") + other.names[i];
+    if (other.names.size() > 6) names += ", ...";
+    std::cerr << "note: " << other.names.size() << " other channels of " << o.image << " (" << names << ") "
+              << (o.other_channels == "keep" ? "kept unchanged, in focus (--other-channels defocus blurs them with the picture, drop leaves them out)"
+                                             : "defocused with the picture's rays")
+              << "\n";
+  }
+
   // Framing: the flags, else what the input EXR says of its own pinhole camera (lensmith scene
   // render writes lensmith:focal_length_mm and lensmith:sensor_width_mm), else 36 mm and the lens's EFL.
   CameraOptions camera;
@@ -186,6 +214,28 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     }
     out = std::move(rgba);
   }
+  if (o.other_channels == "defocus" && !other.names.empty()) {
+    // Three passes at a time as a picture through the same model and depth, with the lens's
+    // vignetting (light passes keep adding up to the picture) but without colour fringes: a pass's
+    // channels are not colours of one spectrum.
+    BokehOptions passes = options;
+    passes.spectral = false;
+    passes.progress = nullptr;
+    const std::size_t n = other.names.size(), pixels = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
+    for (std::size_t first = 0; first < n; first += 3) {
+      Image group(image.width, image.height, 3, 0.0f);
+      for (std::size_t i = 0; i < pixels; ++i) {
+        for (std::size_t c = 0; c < 3 && first + c < n; ++c) {
+          const float v = other.samples[i * n + first + c];
+          group.data[3 * i + c] = v;
+        }
+      }
+      const Image blurred = render_bokeh(group, depth, *model, aperture, passes);
+      for (std::size_t i = 0; i < pixels; ++i) {
+        for (std::size_t c = 0; c < 3 && first + c < n; ++c) other.samples[i * n + first + c] = blurred.data[3 * i + c];
+      }
+    }
+  }
   const double render_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - render_started).count();
   bar.finish();
 
@@ -214,6 +264,19 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
       with_z.data[i * static_cast<std::size_t>(with_z.channels) + static_cast<std::size_t>(out.channels)] = depth.z_m[i];
     }
     out = std::move(with_z);
+  }
+  if (!other.names.empty()) {
+    // After R, G, B (A, Z): the passes under their own names.
+    if (channels.empty()) channels = out.channels == 4 ? std::vector<std::string>{"R", "G", "B", "A"} : std::vector<std::string>{"R", "G", "B"};
+    const std::size_t n = other.names.size(), base = static_cast<std::size_t>(out.channels);
+    Image all(out.width, out.height, out.channels + static_cast<int>(n), 0.0f);
+    for (std::size_t i = 0; i < static_cast<std::size_t>(out.width) * static_cast<std::size_t>(out.height); ++i) {
+      for (std::size_t c = 0; c < base; ++c) all.data[i * (base + n) + c] = out.data[i * base + c];
+      for (std::size_t c = 0; c < n; ++c) all.data[i * (base + n) + base + c] = other.samples[i * n + c];
+    }
+    channels.insert(channels.end(), other.names.begin(), other.names.end());
+    out = std::move(all);
+    meta.extra.emplace_back("other_channels", o.other_channels);
   }
   write_output_image(output, out, meta, channels);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

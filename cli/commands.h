@@ -147,6 +147,7 @@ struct BokehCommandOptions {
   std::optional<double> focus_m;             // --focus, metres from the entrance pupil (or --focus-pixel)
   std::string focus_pixel;                   // --focus-pixel X,Y: focus on the depth map's value there
   bool keep_depth = false;                   // --keep-depth: the input's planar depth as Z in an EXR output
+  std::string other_channels = "keep";       // --other-channels keep|defocus|drop: an EXR input's other passes
   std::optional<double> sensor_width_mm;     // --sensor-width of the pinhole image; default the EXR's or 36
   std::optional<double> pinhole_focal_length_mm;  // --pinhole-focal-length; default: the lens EFL
   std::optional<double> hfov_deg;            // --hfov instead

@@ -240,7 +240,7 @@ int main(int argc, char** argv) {
   CLI::App* bokeh_cmd = app.add_subcommand(
       "bokeh", "Photograph an all-in-focus image and its depth through a lens: defocus, bokeh shape, aberrations");
   bokeh_cmd->add_option("--image", bokeh.image, "All-in-focus image: EXR/HDR linear radiance, or 8/16-bit sRGB")->required();
-  bokeh_cmd->add_option("--depth", bokeh.depth, "Depth FILE[:CHANNEL] (default: the image's own Z, then depth.Z, then first channel)");
+  bokeh_cmd->add_option("--depth", bokeh.depth, "Depth FILE[:CHANNEL] (default: the image's own Z, depth.Z or a layer's Depth.Z; a one-channel file is its depth)");
   bokeh_cmd->add_option("--depth-kind", bokeh.depth_kind, "z (planar, default) | distance (from the camera) | inverse (1/z)")
       ->check(CLI::IsMember({"z", "distance", "inverse"}));
   bokeh_cmd->add_option("--depth-unit", bokeh.depth_unit, "m (default) | cm | mm")->check(CLI::IsMember({"m", "cm", "mm"}));
@@ -255,6 +255,9 @@ int main(int argc, char** argv) {
   CLI::Option* bokeh_focus =
       bokeh_cmd->add_option("--focus", bokeh.focus_m, "Focus distance, metres from the lens's entrance pupil (the perspective centre; > 0, inf for infinity)")
           ->check(focus_distance_check());
+  bokeh_cmd->add_option("--other-channels", bokeh.other_channels,
+                        "An EXR input's channels besides R, G, B, A and Z (render passes) in an EXR output: keep (default: unchanged, in focus) | defocus (each through the picture's rays, without colour fringes) | drop")
+      ->check(CLI::IsMember({"keep", "defocus", "drop"}));
   bokeh_cmd->add_flag("--keep-depth", bokeh.keep_depth,
                       "Write the input's depth (planar metres from the entrance pupil, inf for the sky) as the Z channel of an .exr output");
   bokeh_cmd->add_option("--focus-pixel", bokeh.focus_pixel, "Focus on the depth at this pixel of the input, X,Y (0,0 = top left), instead of --focus")

@@ -1,9 +1,12 @@
 // `lensmith bokeh` as a user runs it: outputs and their metadata, and clear errors for bad input.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <string>
+#include <vector>
 
 #include "lensmith/render/image_io.h"
 #include "run_lensmith.h"
@@ -159,4 +162,83 @@ TEST_CASE("lensmith bokeh keeps an RGBA input's alpha, defocused with its colour
                                 scratch("element.png").string());
   CHECK(png.exit_code == 0);
   CHECK(png.err.find("only an OpenEXR output") != std::string::npos);
+}
+
+TEST_CASE("lensmith bokeh passes an EXR's other channels through: kept in focus, defocused with the picture, or dropped",
+          "[cli][bokeh][aovs]") {
+  // Render passes beside the beauty: a light pass (diffuse.R/G/B, here equal to R, G, B) and a data
+  // pass (N.x, constant). Half the frame at the focus distance, half nearer (blurred).
+  const int w = 64, h = 48;
+  lensmith::Image in_img(w, h, 8, 0.0f);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const float v = ((x / 6 + y / 6) % 2 == 0) ? 0.8f : 0.1f;
+      const float rgb[3] = {v, 0.5f * v, 0.25f + 0.5f * v};
+      for (int c = 0; c < 3; ++c) in_img.at(x, y, c) = in_img.at(x, y, 4 + c) = rgb[c];
+      in_img.at(x, y, 3) = x < w / 2 ? 2.0f : 0.8f;  // Z, m
+      in_img.at(x, y, 7) = 0.3f;                     // N.x
+    }
+  }
+  const fs::path in = scratch("passes.exr");
+  lensmith::write_float_exr(in, in_img, {"R", "G", "B", "Z", "diffuse.R", "diffuse.G", "diffuse.B", "N.x"});
+  const std::string base = "bokeh --image " + in.string() + " --thin-lens --focal-length 50 --fstop 1.4 --focus 2 --no-spectral -o ";
+  // keep (default): every pass as it was, with a note saying so.
+  const fs::path kept = scratch("passes-keep.exr");
+  const auto kr = run_lensmith(base + kept.string());
+  REQUIRE(kr.exit_code == 0);
+  CHECK(kr.err.find("kept unchanged") != std::string::npos);
+  // OpenEXR stores channels sorted by name: look them up.
+  const std::vector<std::string> names{"diffuse.R", "diffuse.G", "diffuse.B", "N.x"};
+  auto column = [&names](const lensmith::OtherChannels& o, int k) {
+    const auto it = std::find(o.names.begin(), o.names.end(), names[static_cast<std::size_t>(k)]);
+    REQUIRE(it != o.names.end());
+    return static_cast<std::size_t>(it - o.names.begin());
+  };
+  const lensmith::OtherChannels kp = lensmith::read_other_channels(kept);
+  REQUIRE(kp.names.size() == 4);
+  for (int k = 0; k < 4; ++k) {
+    const std::size_t col = column(kp, k);
+    for (int i = 0; i < w * h; ++i) REQUIRE(kp.samples[static_cast<std::size_t>(i) * 4 + col] == in_img.data[static_cast<std::size_t>(i * 8 + 4 + k)]);
+  }
+  // defocus: through the same rays as the picture, so a pass equal to the beauty comes out equal to
+  // the defocused beauty (to float rounding), and a constant pass stays constant where the frame is
+  // covered.
+  const fs::path blurred = scratch("passes-defocus.exr");
+  REQUIRE(run_lensmith(base + blurred.string() + " --other-channels defocus --quiet").exit_code == 0);
+  const lensmith::Image beauty = lensmith::read_radiance_image(blurred);
+  const lensmith::OtherChannels df = lensmith::read_other_channels(blurred);
+  REQUIRE(df.names.size() == 4);
+  double worst = 0.0, n_worst = 0.0;
+  const std::size_t n_col = column(df, 3);
+  for (int i = 0; i < w * h; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      worst = std::max(worst, static_cast<double>(std::abs(df.samples[static_cast<std::size_t>(i) * 4 + column(df, c)] -
+                                                           beauty.data[static_cast<std::size_t>(i * 3 + c)])));
+    }
+    n_worst = std::max(n_worst, static_cast<double>(std::abs(df.samples[static_cast<std::size_t>(i) * 4 + n_col] - 0.3f)));
+  }
+  CHECK(worst < 1e-5);
+  CHECK(n_worst < 1e-3);
+  // The blurred half really is blurred: the pass differs from the input there.
+  CHECK(std::abs(df.samples[static_cast<std::size_t>(24 * w + 50) * 4 + column(df, 0)] - in_img.at(50, 24, 4)) > 1e-3);
+  // drop: RGB (and Z when asked) only.
+  const fs::path dropped = scratch("passes-drop.exr");
+  REQUIRE(run_lensmith(base + dropped.string() + " --other-channels drop --quiet").exit_code == 0);
+  CHECK(lensmith::read_other_channels(dropped).names.empty());
+  // A PNG cannot hold them: RGB with a note. A pass with NaN is refused, naming the pixel (the input's
+  // content, exit 3), unless dropped.
+  const auto png = run_lensmith(base + scratch("passes.png").string());
+  CHECK(png.exit_code == 0);
+  CHECK(png.err.find("only an OpenEXR output") != std::string::npos);
+  in_img.at(5, 7, 7) = std::numeric_limits<float>::quiet_NaN();
+  const fs::path bad = scratch("passes-nan.exr");
+  lensmith::write_float_exr(bad, in_img, {"R", "G", "B", "Z", "diffuse.R", "diffuse.G", "diffuse.B", "N.x"});
+  const auto nan = run_lensmith("bokeh --image " + bad.string() + " --thin-lens --focal-length 50 --fstop 2 --focus 2 --other-channels defocus -o " +
+                                scratch("passes-nan-out.exr").string());
+  CHECK(nan.exit_code == 3);
+  CHECK(nan.err.find("N.x at pixel (5, 7)") != std::string::npos);
+  CHECK(run_lensmith("bokeh --image " + bad.string() + " --thin-lens --focal-length 50 --fstop 2 --focus 2 -o " +
+                     scratch("passes-nan-keep.exr").string()).exit_code == 3);
+  CHECK(run_lensmith("bokeh --image " + bad.string() + " --thin-lens --focal-length 50 --fstop 2 --focus 2 --other-channels drop -o " +
+                     scratch("passes-nan-drop.exr").string() + " --quiet").exit_code == 0);
 }

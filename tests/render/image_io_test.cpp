@@ -463,7 +463,8 @@ TEST_CASE("depth is read from the Z channel of an EXR that also holds RGB", "[re
   CHECK(read_radiance_image(exr).at(2, 1, 0) == 0.5f);
 }
 
-TEST_CASE("the default depth channel is Z, then depth.Z, then the first channel, FILE:CHANNEL overrides", "[render][image_io][depth]") {
+TEST_CASE("the default depth channel is Z, then depth.Z, then a layer's Depth.Z, then a one-channel file's, FILE:CHANNEL overrides",
+          "[render][image_io][depth]") {
   TempDir dir;
   Image three(4, 3, 3);
   for (std::size_t i = 0; i < three.pixel_count(); ++i) {
@@ -481,11 +482,46 @@ TEST_CASE("the default depth channel is Z, then depth.Z, then the first channel,
   write_float_exr(with_depth_z, three, {"a", "b", "depth.Z"});
   CHECK(read_depth(DepthSource{with_depth_z, ""}, {}, frame).at(1, 1) == 3.0f);
 
+  const fs::path layer = dir / "layer.exr";
+  write_float_exr(layer, three, {"ViewLayer.Combined.R", "ViewLayer.Depth.Z", "ViewLayer.Normal.Z"});
+  CHECK(read_depth(DepthSource{layer, ""}, {}, frame).at(1, 1) == 2.0f);
+
+  // With several channels and none of depth, channel 0 would be a colour: an error listing them
+  // (it once read a picture's red as metres).
   const fs::path neither = dir / "first.exr";
   write_float_exr(neither, three, {"first", "second", "third"});
-  CHECK(read_depth(DepthSource{neither, ""}, {}, frame).at(1, 1) == 1.0f);
-
+  CHECK_THROWS_WITH(read_depth(DepthSource{neither, ""}, {}, frame), Contains("no depth channel") && Contains("first, second, third"));
   CHECK(read_depth(DepthSource::parse(neither.string() + ":third"), {}, frame).at(1, 1) == 3.0f);
+
+  const fs::path single = dir / "single.exr";
+  write_float_exr(single, Image(4, 3, 1, 5.0f), {"Y"});
+  CHECK(read_depth(DepthSource{single, ""}, {}, frame).at(1, 1) == 5.0f);
+}
+
+TEST_CASE("a Blender multilayer EXR: the picture, alpha and depth from its layers, the other passes listed by name",
+          "[render][image_io]") {
+  // Blender 3.4's OPEN_EXR_MULTILAYER names channels layer.pass.channel and has no plain R, G, B.
+  TempDir dir;
+  const std::vector<std::string> names{"ViewLayer.Combined.R", "ViewLayer.Combined.G", "ViewLayer.Combined.B", "ViewLayer.Combined.A",
+                                       "ViewLayer.Depth.Z",    "ViewLayer.DiffCol.R",  "ViewLayer.DiffCol.G",  "ViewLayer.DiffCol.B",
+                                       "ViewLayer.Normal.X"};
+  Image img(4, 3, static_cast<int>(names.size()));
+  for (std::size_t i = 0; i < img.pixel_count(); ++i) {
+    for (std::size_t c = 0; c < names.size(); ++c) img.data[i * names.size() + c] = 0.1f * static_cast<float>(c + 1);
+  }
+  const fs::path exr = dir / "multilayer.exr";
+  write_float_exr(exr, img, names);
+  const Image rgb = read_radiance_image(exr);
+  CHECK(rgb.at(2, 1, 0) == Approx(0.1f));
+  CHECK(rgb.at(2, 1, 1) == Approx(0.2f));
+  CHECK(rgb.at(2, 1, 2) == Approx(0.3f));
+  const auto alpha = read_alpha(exr);
+  REQUIRE(alpha.has_value());
+  CHECK(alpha->front() == Approx(0.4f));
+  CHECK(read_depth(DepthSource{exr, ""}, {}, small_frame()).at(0, 0) == Approx(0.5f));
+  OtherChannels other = read_other_channels(exr);
+  std::sort(other.names.begin(), other.names.end());
+  CHECK(other.names == std::vector<std::string>{"ViewLayer.DiffCol.B", "ViewLayer.DiffCol.G", "ViewLayer.DiffCol.R", "ViewLayer.Normal.X"});
 }
 
 TEST_CASE("a missing depth channel is an error listing the file's channels", "[render][image_io][depth]") {

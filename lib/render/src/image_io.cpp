@@ -20,6 +20,41 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// The channels that hold the picture: R, G, B (and A) by those names, else of the first layer that
+// has all three, such as a Blender multilayer EXR's "ViewLayer.Combined.R" (OpenImageIO lists
+// layers in the file's order); -1 where absent.
+struct PictureChannels {
+  int r = -1, g = -1, b = -1, a = -1;
+  bool found() const { return r >= 0 && g >= 0 && b >= 0; }
+};
+PictureChannels picture_channels(const RasterInfo& info) {
+  PictureChannels p{info.channel_index("R"), info.channel_index("G"), info.channel_index("B"), info.channel_index("A")};
+  if (p.found()) return p;
+  for (const RasterChannel& c : info.channels) {
+    const std::string& name = c.name;
+    if (name.size() < 3 || name.compare(name.size() - 2, 2, ".R") != 0) continue;
+    const std::string layer = name.substr(0, name.size() - 1);  // "ViewLayer.Combined."
+    const PictureChannels q{info.channel_index(name), info.channel_index(layer + "G"), info.channel_index(layer + "B"),
+                            info.channel_index(layer + "A")};
+    if (q.found()) return q;
+  }
+  return {info.channel_index("R"), info.channel_index("G"), info.channel_index("B"), info.channel_index("A")};
+}
+
+// The depth channel of a file named without a channel: Z, depth.Z, or the Z of a layer named
+// depth in any case (Blender's "ViewLayer.Depth.Z"); -1 when there is none.
+int depth_channel(const RasterInfo& info) {
+  for (const char* name : {"Z", "depth.Z"}) {
+    if (const int c = info.channel_index(name); c >= 0) return c;
+  }
+  for (std::size_t c = 0; c < info.channels.size(); ++c) {
+    std::string name = info.channels[c].name;
+    for (char& ch : name) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    if (name.size() > 8 && name.compare(name.size() - 8, 8, ".depth.z") == 0) return static_cast<int>(c);
+  }
+  return -1;
+}
+
 std::string lower(std::string text) {
   std::transform(text.begin(), text.end(), text.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
@@ -122,7 +157,7 @@ std::string RadianceReadOptions::to_string() const {
 
 std::optional<std::vector<float>> read_alpha(const fs::path& path) {
   const RasterInfo info = read_raster_info(path);
-  const int index = info.channel_index("A");
+  const int index = picture_channels(info).a;
   if (index < 0) return std::nullopt;
   const int channels[1] = {index};
   Raster alpha = read_raster(path, info, channels);
@@ -138,14 +173,32 @@ std::optional<std::vector<float>> read_alpha(const fs::path& path) {
   return std::move(alpha.samples);
 }
 
+OtherChannels read_other_channels(const fs::path& path) {
+  const RasterInfo info = read_raster_info(path);
+  OtherChannels out;
+  if (info.format != ImageFormat::Exr) return out;
+  const PictureChannels picture = picture_channels(info);
+  const int depth = depth_channel(info);
+  std::vector<int> indices;
+  for (std::size_t c = 0; c < info.channels.size(); ++c) {
+    const int i = static_cast<int>(c);
+    if (i == picture.r || i == picture.g || i == picture.b || i == picture.a || i == depth) continue;
+    out.names.push_back(info.channels[c].name);
+    indices.push_back(i);
+  }
+  if (indices.empty()) return out;
+  out.samples = read_raster(path, info, indices).samples;
+  return out;
+}
+
 Image read_radiance_image(const fs::path& path, const RadianceReadOptions& options) {
   options.validate();
   const RasterInfo info = read_raster_info(path);
 
   std::array<int, 3> source{0, 0, 0};
-  const std::array<int, 3> named{info.channel_index("R"), info.channel_index("G"), info.channel_index("B")};
-  if (named[0] >= 0 && named[1] >= 0 && named[2] >= 0) {
-    source = named;
+  const PictureChannels picture = picture_channels(info);
+  if (picture.found()) {
+    source = {picture.r, picture.g, picture.b};
   } else if (info.channels.size() >= 3) {
     source = {0, 1, 2};
   }  // else gray (+ alpha): channel 0 three times
@@ -272,15 +325,24 @@ DepthMap read_depth(const DepthSource& source, const DepthReadOptions& options, 
   const RasterInfo info = read_raster_info(path);
 
   int channel = -1;
+  bool grey_check = false;
   if (!source.channel.empty()) {
     channel = info.channel_index(source.channel);
     if (channel < 0) {
       throw ImageFileError(path.string() + ": no channel '" + source.channel + "'; the file has " + join(info.channel_names()));
     }
   } else {
-    channel = info.channel_index("Z");
-    if (channel < 0) channel = info.channel_index("depth.Z");
-    if (channel < 0) channel = 0;
+    channel = depth_channel(info);
+    // A one-channel file is its depth, and so is a grey picture of it in another format (R = G = B,
+    // checked below); in a colour picture channel 0 would be its red, and an EXR names its depth.
+    if (channel < 0 && (info.channels.size() == 1 || info.format != ImageFormat::Exr)) {
+      channel = 0;
+      grey_check = info.channels.size() >= 3;
+    }
+    if (channel < 0) {
+      throw ImageFileError(path.string() + ": no depth channel (Z, depth.Z or a layer's Depth.Z); name one as FILE:CHANNEL; the file has " +
+                           join(info.channel_names()));
+    }
   }
   const RasterChannel& stored = info.channels[static_cast<std::size_t>(channel)];
   const std::string where = path.string() + " channel " + stored.name;
@@ -296,6 +358,17 @@ DepthMap read_depth(const DepthSource& source, const DepthReadOptions& options, 
   }
   const int channels[1] = {channel};
   const std::vector<float> values = read_raster(path, info, channels).samples;
+  if (grey_check) {
+    const int rgb[3] = {0, 1, 2};
+    const Raster all = read_raster(path, info, rgb);
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      if (all.samples[3 * i] != all.samples[3 * i + 1] || all.samples[3 * i] != all.samples[3 * i + 2]) {
+        throw ImageFileError(path.string() + ": no depth channel, and its channels " + join(info.channel_names()) + " differ at pixel (" +
+                             std::to_string(i % static_cast<std::size_t>(info.width)) + ", " + std::to_string(i / static_cast<std::size_t>(info.width)) +
+                             "): a colour picture, not a depth map; give the depth as its own file or channel");
+      }
+    }
+  }
 
   constexpr float kFar = std::numeric_limits<float>::infinity();
   DepthMap depth(info.width, info.height, kFar);

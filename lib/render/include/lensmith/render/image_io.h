@@ -54,7 +54,8 @@ struct RadianceReadOptions {
 //   is linear, then taken as stored in [0, 1]: an OpenEXR's integer channels (OpenEXR pixels are
 //   linear), or a PNG with a gAMA chunk of 1.0 and no sRGB chunk. Nothing else is consulted: TIFF,
 //   JPEG and the other formats are taken as sRGB, and no ICC profile is applied.
-// - Channels R, G, B by name when all three exist, else the first three; a 1- or 2-channel
+// - Channels R, G, B by name when all three exist, else those of the first layer that has all
+//   three (a Blender multilayer EXR's ViewLayer.Combined.R, .G, .B), else the first three; a 1- or 2-channel
 //   (gray, gray + alpha) picture is replicated to R = G = B. Alpha is ignored: premultiplied
 //   colours are taken as they are.
 // - The data window must be the display window (no crop or overscan); a deep OpenEXR is refused.
@@ -67,6 +68,17 @@ Image read_radiance_image(const std::filesystem::path& path, const RadianceReadO
 // (integers normalised), or nothing when it has none. Throws ImageFileError naming the first pixel
 // whose alpha is NaN, negative or above 1 by more than rounding, IoError when the file cannot be read.
 std::optional<std::vector<float>> read_alpha(const std::filesystem::path& path);
+
+// The channels of an OpenEXR picture other than its colour, alpha and depth (as read_radiance_image,
+// read_alpha and read_depth choose them): render passes (AOVs) such as diffuse.R or N.x, in the
+// file's order; nothing for other
+// formats. `samples[(y * width + x) * names.size() + c]`, as stored (not validated: a pass may hold
+// any value).
+struct OtherChannels {
+  std::vector<std::string> names;
+  std::vector<float> samples;
+};
+OtherChannels read_other_channels(const std::filesystem::path& path);
 
 // A depth input named on a command line as FILE[:CHANNEL].
 struct DepthSource {
@@ -117,7 +129,9 @@ struct DepthReadOptions {
 // Reads one channel of a depth file as planar depth z in metres (+inf = infinitely far), pixel
 // (x, y) of the map belonging to pixel (x, y) of `frame`; Distance is converted with the frame's
 // tangents at pixel centres (x + 0.5, y + 0.5).
-// The channel is source.channel, or by default "Z", then "depth.Z", then the first channel.
+// The channel is source.channel, or by default "Z", then "depth.Z", then a layer's "Depth.Z" (any
+// case: Blender's "ViewLayer.Depth.Z"), then channel 0 of a one-channel file; otherwise
+// ImageFileError listing the channels.
 // Reads the formats read_radiance_image reads (float channels: OpenEXR, float TIFF, PFM, HDR).
 // Throws IoError when the file cannot be read, and ImageFileError when the channel is missing
 // (listing the file's channels), stored as integers (normalised integers carry no metric depth:
