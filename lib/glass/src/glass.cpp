@@ -16,7 +16,6 @@ namespace lensmith {
 
 namespace {
 
-constexpr double kNotGiven = std::numeric_limits<double>::quiet_NaN();
 // Largest |exponent| of formula 3 evaluated by repeated multiplication; catalogue exponents are
 // even integers from -12 to 4, and anything else falls back to std::pow.
 constexpr double kMaxIntegerExponent = 64.0;
