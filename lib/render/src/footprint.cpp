@@ -259,7 +259,7 @@ bool FootprintScatter::clip_rings(const FootprintPlan& p, FootprintScratch& scra
   return true;
 }
 
-void FootprintScatter::deposit_clipped_rings(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p,
+void FootprintScatter::deposit_clipped_rings(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p, double passing,
                                              const std::array<float, 4>& value, SplatBuffer& buffer, SplatBuffer& fine,
                                              FootprintScratch& scratch, std::size_t& triangles) const {
   const int rings = meshes_.mesh(p.mesh).rings;
@@ -283,7 +283,11 @@ void FootprintScatter::deposit_clipped_rings(const ScenePoint& point, double wav
     for (std::size_t i = begin; i < end; ++i) sum += hits[i].weight;
     scratch.ring_weights.push_back(sum / static_cast<double>(end - begin));
   }
-  const double full_pupil_area = pupil_polygon_area(outline);
+  // The light of the whole aperture in the rings' units, such that what they enclose passes the
+  // dense outline's share: a coarse outline's chords cut a cat's eye's cusps by a few per cent
+  // more than the iris's, and where neighbouring points' outlines switched from 16 to 24 vertices
+  // a uniform defocused sky showed a line.
+  const double full_pupil_area = passing > 0.0 ? scratch.pupil_areas.back() / passing : pupil_polygon_area(outline);
   if (deposit_nested_rings(scratch.ring_spans, scratch.pupil_areas, scratch.ring_weights, full_pupil_area, value,
                            options_.vignetting, buffer, scratch.areas)) {
     return;
@@ -554,7 +558,7 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
     }
     const PupilMesh& mesh = meshes_.mesh(p.mesh);
     if (rings_clipped) {
-      deposit_clipped_rings(point, g.wavelength_nm, p, value, buffer, fine, scratch, triangles);
+      deposit_clipped_rings(point, g.wavelength_nm, p, passing, value, buffer, fine, scratch, triangles);
       return;
     }
     hits.resize(mesh.points.size());
