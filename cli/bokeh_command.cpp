@@ -37,6 +37,39 @@ Aperture make_aperture(const BokehCommandOptions& o) {
   return Aperture::circular();
 }
 
+// `image` with `count` more channels after its own, from `samples` (count per pixel).
+Image with_channels(const Image& image, const std::vector<float>& samples, std::size_t count) {
+  const auto base = static_cast<std::size_t>(image.channels), all = base + count;
+  Image out(image.width, image.height, static_cast<int>(all), 0.0f);
+  for (std::size_t i = 0; i < image.pixel_count(); ++i) {
+    for (std::size_t c = 0; c < base; ++c) out.data[i * all + c] = image.data[i * base + c];
+    for (std::size_t c = 0; c < count; ++c) out.data[i * all + base + c] = samples[i * count + c];
+  }
+  return out;
+}
+
+// `samples` (`count` channels per pixel) defocused like the picture, three channels at a time as a
+// picture without colour fringes (they are not colours of one spectrum).
+std::vector<float> defocus_channels(const std::vector<float>& samples, std::size_t count, const DepthMap& depth, const RayModel& model,
+                                    const Aperture& aperture, BokehOptions options) {
+  options.spectral = false;
+  options.progress = nullptr;
+  const std::size_t pixels = static_cast<std::size_t>(depth.width) * static_cast<std::size_t>(depth.height);
+  std::vector<float> out(samples.size());
+  for (std::size_t first = 0; first < count; first += 3) {
+    const std::size_t n = std::min<std::size_t>(3, count - first);
+    Image group(depth.width, depth.height, 3, 0.0f);
+    for (std::size_t i = 0; i < pixels; ++i) {
+      for (std::size_t c = 0; c < n; ++c) group.data[3 * i + c] = samples[i * count + first + c];
+    }
+    const Image blurred = render_bokeh(group, depth, model, aperture, options);
+    for (std::size_t i = 0; i < pixels; ++i) {
+      for (std::size_t c = 0; c < n; ++c) out[i * count + first + c] = blurred.data[3 * i + c];
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
@@ -198,43 +231,17 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   const auto render_started = std::chrono::steady_clock::now();
   Image out = render_bokeh(image, depth, *model, aperture, options, &stats);
   if (alpha) {
-    // Alpha as a grey picture through the same model: no colour (one wavelength) and no vignetting
-    // (an opaque surface stays opaque however little light the lens takes from it).
-    Image grey(image.width, image.height, 3, 0.0f);
-    for (std::size_t i = 0; i < alpha->size(); ++i) grey.data[3 * i] = grey.data[3 * i + 1] = grey.data[3 * i + 2] = (*alpha)[i];
+    // Alpha through the same model without vignetting (an opaque surface stays opaque however little
+    // light the lens takes from it).
     BokehOptions coverage = options;
-    coverage.spectral = false;
     coverage.vignetting = false;
-    coverage.progress = nullptr;
-    const Image a = render_bokeh(grey, depth, *model, aperture, coverage);
-    Image rgba(image.width, image.height, 4, 0.0f);
-    for (std::size_t i = 0; i < alpha->size(); ++i) {
-      for (int c = 0; c < 3; ++c) rgba.data[4 * i + static_cast<std::size_t>(c)] = out.data[3 * i + static_cast<std::size_t>(c)];
-      rgba.data[4 * i + 3] = std::clamp(a.data[3 * i], 0.0f, 1.0f);
-    }
-    out = std::move(rgba);
+    std::vector<float> a = defocus_channels(*alpha, 1, depth, *model, aperture, coverage);
+    for (float& v : a) v = std::clamp(v, 0.0f, 1.0f);
+    out = with_channels(out, a, 1);
   }
+  // Passes with the lens's vignetting, so that light passes keep adding up to the picture.
   if (o.other_channels == "defocus" && !other.names.empty()) {
-    // Three passes at a time as a picture through the same model and depth, with the lens's
-    // vignetting (light passes keep adding up to the picture) but without colour fringes: a pass's
-    // channels are not colours of one spectrum.
-    BokehOptions passes = options;
-    passes.spectral = false;
-    passes.progress = nullptr;
-    const std::size_t n = other.names.size(), pixels = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
-    for (std::size_t first = 0; first < n; first += 3) {
-      Image group(image.width, image.height, 3, 0.0f);
-      for (std::size_t i = 0; i < pixels; ++i) {
-        for (std::size_t c = 0; c < 3 && first + c < n; ++c) {
-          const float v = other.samples[i * n + first + c];
-          group.data[3 * i + c] = v;
-        }
-      }
-      const Image blurred = render_bokeh(group, depth, *model, aperture, passes);
-      for (std::size_t i = 0; i < pixels; ++i) {
-        for (std::size_t c = 0; c < 3 && first + c < n; ++c) other.samples[i * n + first + c] = blurred.data[3 * i + c];
-      }
-    }
+    other.samples = defocus_channels(other.samples, other.names.size(), depth, *model, aperture, options);
   }
   const double render_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - render_started).count();
   bar.finish();
@@ -250,32 +257,18 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
                 {"vignetting", options.vignetting ? "natural" : "off"},
                 {"spectral", options.spectral ? std::to_string(options.spectral_samples) + " nodes" : "off"}};
   if (kind == RayModelKind::Seidel) meta.extra.emplace_back("seidel_coefficients", o.seidel_coefficients);
-  std::vector<std::string> channels;
+  std::vector<std::string> channels{"R", "G", "B"};
+  if (out.channels == 4) channels.emplace_back("A");
   if (o.keep_depth) {
     // The depth as read (planar metres from the entrance pupil): a compositor's Z for the picture's
     // in-focus geometry; the blurred picture has no single depth per pixel.
-    channels = out.channels == 4 ? std::vector<std::string>{"R", "G", "B", "A", "Z"} : std::vector<std::string>{"R", "G", "B", "Z"};
-    Image with_z(out.width, out.height, out.channels + 1, 0.0f);
-    for (std::size_t i = 0; i < depth.z_m.size(); ++i) {
-      for (int c = 0; c < out.channels; ++c) {
-        with_z.data[i * static_cast<std::size_t>(with_z.channels) + static_cast<std::size_t>(c)] =
-            out.data[i * static_cast<std::size_t>(out.channels) + static_cast<std::size_t>(c)];
-      }
-      with_z.data[i * static_cast<std::size_t>(with_z.channels) + static_cast<std::size_t>(out.channels)] = depth.z_m[i];
-    }
-    out = std::move(with_z);
+    out = with_channels(out, depth.z_m, 1);
+    channels.emplace_back("Z");
   }
   if (!other.names.empty()) {
     // After R, G, B (A, Z): the passes under their own names.
-    if (channels.empty()) channels = out.channels == 4 ? std::vector<std::string>{"R", "G", "B", "A"} : std::vector<std::string>{"R", "G", "B"};
-    const std::size_t n = other.names.size(), base = static_cast<std::size_t>(out.channels);
-    Image all(out.width, out.height, out.channels + static_cast<int>(n), 0.0f);
-    for (std::size_t i = 0; i < static_cast<std::size_t>(out.width) * static_cast<std::size_t>(out.height); ++i) {
-      for (std::size_t c = 0; c < base; ++c) all.data[i * (base + n) + c] = out.data[i * base + c];
-      for (std::size_t c = 0; c < n; ++c) all.data[i * (base + n) + base + c] = other.samples[i * n + c];
-    }
+    out = with_channels(out, other.samples, other.names.size());
     channels.insert(channels.end(), other.names.begin(), other.names.end());
-    out = std::move(all);
     meta.extra.emplace_back("other_channels", o.other_channels);
   }
   write_output_image(output, out, meta, channels);
