@@ -287,7 +287,7 @@ void FootprintScatter::deposit_clipped_rings(const ScenePoint& point, double wav
   // dense outline's share: a coarse outline's chords cut a cat's eye's cusps by a few per cent
   // more than the iris's, and where neighbouring points' outlines switched from 16 to 24 vertices
   // a uniform defocused sky showed a line.
-  const double full_pupil_area = passing > 0.0 ? scratch.pupil_areas.back() / passing : pupil_polygon_area(outline);
+  const double full_pupil_area = scratch.pupil_areas.back() / passing;
   if (deposit_nested_rings(scratch.ring_spans, scratch.pupil_areas, scratch.ring_weights, full_pupil_area, value,
                            options_.vignetting, buffer, scratch.areas)) {
     return;
@@ -429,8 +429,7 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
     if (ok[1][i] && ok[2][i]) spread = std::max(spread, std::hypot(px[1][i].x - px[2][i].x, px[1][i].y - px[2][i].y));
   }
   const double size = std::max(x_max - x_min, y_max - y_min);
-  // Coverage has no colour: one group carries it.
-  // A point whose colour spread just crossed into one
+  // Coverage has no colour: one group carries it. A point whose colour spread just crossed into one
   // more group than its neighbour's is split both ways, its light cross-faded between the two over
   // kGroupBlend of the tolerance: each split places its colours at its groups' wavelengths, and a
   // hard switch moved them by a fraction of a pixel between neighbouring points, which a uniform

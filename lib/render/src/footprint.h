@@ -68,7 +68,7 @@ class FootprintScatter {
   // nested rings, or where they do not nest (a cat's eye mapped to a crescent that turns back in
   // y), as the triangles between them into `fine` (adding them to `triangles`).
   bool clip_rings(const FootprintPlan& p, FootprintScratch& scratch) const;  // into scratch.ring_pupil; false: do not nest
-  // `passing` is the share of the aperture that passes, measured on a dense outline: the rings'
+  // `passing` (> 0) is the share of the aperture that passes, measured on a dense outline: the rings'
   // own outline may be coarse (16 vertices cut a cat's eye's cusps by chords).
   void deposit_clipped_rings(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p, double passing,
                              const std::array<float, 4>& value, SplatBuffer& buffer, SplatBuffer& fine,

@@ -20,6 +20,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
+std::string lower(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return text;
+}
+
 // The channels that hold the picture: R, G, B (and A) by those names, else of the first layer that
 // has all three, such as a Blender multilayer EXR's "ViewLayer.Combined.R" (OpenImageIO lists
 // layers in the file's order); -1 where absent.
@@ -38,7 +44,7 @@ PictureChannels picture_channels(const RasterInfo& info) {
                             info.channel_index(layer + "A")};
     if (q.found()) return q;
   }
-  return {info.channel_index("R"), info.channel_index("G"), info.channel_index("B"), info.channel_index("A")};
+  return p;
 }
 
 // The depth channel of a file named without a channel: Z, depth.Z, or the Z of a layer named
@@ -48,17 +54,10 @@ int depth_channel(const RasterInfo& info) {
     if (const int c = info.channel_index(name); c >= 0) return c;
   }
   for (std::size_t c = 0; c < info.channels.size(); ++c) {
-    std::string name = info.channels[c].name;
-    for (char& ch : name) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    const std::string name = lower(info.channels[c].name);
     if (name.size() > 8 && name.compare(name.size() - 8, 8, ".depth.z") == 0) return static_cast<int>(c);
   }
   return -1;
-}
-
-std::string lower(std::string text) {
-  std::transform(text.begin(), text.end(), text.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return text;
 }
 
 std::string join(const std::vector<std::string>& items) {
