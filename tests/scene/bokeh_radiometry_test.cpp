@@ -44,6 +44,19 @@ double patch_mean(const Image& img, int x, int y, int w, int h) {
 
 Prescription lens_at(const std::string& name) { return LensLibrary::load_path_or_name(name).prescription; }
 
+// The ground truth of `scene` through `camera` at `spp` samples per pixel (one wavelength) and the
+// all-in-focus picture and depth the bokeh renderer starts from.
+struct TruthAndInput {
+  LensRender truth;
+  PinholeRender input;
+};
+TruthAndInput truth_and_input(const Scene& scene, const Camera& camera, int spp) {
+  LensRenderOptions ro;
+  ro.spp = spp;
+  ro.spectral = false;
+  return {render_through_lens(scene, camera, ro), render_pinhole(scene, camera.frame())};
+}
+
 }  // namespace
 
 TEST_CASE("The ground truth through the lens falls off across the field as the relative illumination of lensmith analyze",
@@ -88,12 +101,7 @@ TEST_CASE("Every ray model renders a flat white wall through a vignetting lens a
   co.focus_distance_m = 2.0;
   co.f_number = 2.0;
   const Camera camera = Camera::from_lens(lens, co, w, h);
-  const Scene scene = white_wall(2.0);
-  LensRenderOptions ro;
-  ro.spp = 2048;
-  ro.spectral = false;
-  const LensRender truth = render_through_lens(scene, camera, ro);
-  const PinholeRender input = render_pinhole(scene, camera.frame());
+  const auto [truth, input] = truth_and_input(white_wall(2.0), camera, 2048);
 
   RayModelOptions mo;
   mo.nearest_depth_m = 1.0;
@@ -144,12 +152,7 @@ TEST_CASE("The exact model aims every rim ray of a strongly aberrated pupil: a w
   CameraOptions co;
   co.focus_distance_m = 1.2;
   const Camera camera = Camera::from_lens(lens_at("sasian-triplet"), co, w, h);
-  const Scene scene = white_wall(1.2);
-  LensRenderOptions ro;
-  ro.spp = 512;
-  ro.spectral = false;
-  const LensRender truth = render_through_lens(scene, camera, ro);
-  const PinholeRender input = render_pinhole(scene, camera.frame());
+  const auto [truth, input] = truth_and_input(white_wall(1.2), camera, 512);
   const auto exact = make_ray_model(RayModelKind::Exact, camera);
   BokehOptions bo;
   bo.spectral = false;
@@ -182,11 +185,7 @@ TEST_CASE("The fitted Seidel model darkens a defocused sky across the frame as t
   Scene sky;
   sky.name = "white sky";
   sky.background = Rgb{1.0, 1.0, 1.0};
-  LensRenderOptions ro;
-  ro.spp = 1024;
-  ro.spectral = false;
-  const LensRender truth = render_through_lens(sky, camera, ro);
-  const PinholeRender input = render_pinhole(sky, camera.frame());
+  const auto [truth, input] = truth_and_input(sky, camera, 1024);
   RayModelOptions mo;
   mo.nearest_depth_m = 1.0;
   mo.seidel_coefficients = SeidelCoefficients::Fitted;
