@@ -460,3 +460,53 @@ TEST_CASE("An aperture picture shapes the bokeh: a fully open square mask makes 
   CHECK(ratio == Approx(4.0 / kPi).epsilon(0.03));
   CHECK(total(square, 1) == Approx(1000.0).epsilon(1e-3));
 }
+
+// Level of detail (lib/render/src/source_merging.h): footprints of 40 px and more are deposited on
+// grids of 2 x 2 and 4 x 4 px cells, and the sources of one layer are merged by those cells.
+TEST_CASE("At large blur the sources merged by the coarse grid's cells keep all their light and leave from its centre",
+          "[render]") {
+  const double f = 50.0, n = 1.4, s_m = 2.0;
+  const int w = 320, h = 240;
+  const Camera cam = Camera::thin_lens(f, camera_options(s_m, n), w, h);
+  const auto model = make_ray_model(RayModelKind::Thin, cam);
+  const double pitch_mm = kSensorWidthMm / w, a = f / n, s = mm_from_m(s_m);
+  for (const double blur_px : {60.0, 120.0}) {  // the 2 x 2 and the 4 x 4 px grid
+    INFO("blur " << blur_px << " px");
+    const auto z_m = static_cast<float>(m_from_mm(a * f * s / (a * f + blur_px * pitch_mm * s)));
+    // A textured square of dim light well inside the frame (its discs do not reach the edges), on
+    // black at the focus distance, with one highlight at a corner of a 4 x 4 block: a merge that
+    // put the block's light at the block's centre would move the highlight's disc by 1.5 px.
+    Image img(w, h, 3, 0.0f);
+    DepthMap depth(w, h, static_cast<float>(s_m));
+    const Image texture = test_pattern(w, h);
+    for (int y = 96; y < 144; ++y) {
+      for (int x = 136; x < 184; ++x) {
+        for (int c = 0; c < 3; ++c) img.at(x, y, c) = 0.1f * texture.at(x, y, c);
+        depth.at(x, y) = z_m;
+      }
+    }
+    // Edge pixels stay whole: their split between the square and the black behind it is an
+    // estimate from the texture around them (mixed_pixels.h), not what this test is about.
+    BokehOptions o;
+    o.split_edge_pixels = false;
+    const Image without = render_bokeh(img, depth, *model, Aperture::circular(), o);
+    const int hx = 160, hy = 120;  // multiples of 4: the top-left corner of its block
+    for (int c = 0; c < 3; ++c) img.at(hx, hy, c) = 1000.0f;
+    const Image with = render_bokeh(img, depth, *model, Aperture::circular(), o);
+    double in = 0.0;
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) in += img.at(x, y, 1);
+    }
+    // Energy: everything the square sent lands in the frame (its discs stay inside it).
+    CHECK(total(with, 1) == Approx(in).epsilon(1e-4));
+    // The highlight's own disc: the difference of the two renders, centred on its pixel's centre
+    // (to 0.25 px: the block's other 15 pixels send 1/2000 of its light).
+    Image disc = with;
+    for (std::size_t i = 0; i < disc.data.size(); ++i) disc.data[i] -= without.data[i];
+    const Moments m = moments(disc, 1);
+    CHECK(m.total == Approx(1000.0).epsilon(1e-3));
+    CHECK(m.cx == Approx(hx + 0.5).margin(0.25));
+    CHECK(m.cy == Approx(hy + 0.5).margin(0.25));
+    CHECK(disc_diameter_px(disc) == Approx(blur_px).margin(2.0));
+  }
+}

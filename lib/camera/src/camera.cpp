@@ -174,7 +174,8 @@ GaussianImage Camera::gaussian_image(const ScenePoint& p, const FirstOrderSample
 
 void Camera::finish() {
   focus_mm_ = mm_from_m(options_.focus_distance_m);
-  const FirstOrderSample ref = first_order(reference_nm_);
+  reference_first_order_ = first_order(reference_nm_);
+  const FirstOrderSample& ref = reference_first_order_;
   z_perspective_mm_ = ref.z_entrance_pupil_mm;
   const double w_focus = inverse_per_mm(focus_mm_);
   const double scale = 1.0 / (1.0 + (ref.z_front_principal_mm - z_perspective_mm_) * w_focus);
@@ -190,7 +191,7 @@ void Camera::finish() {
 }
 
 double Camera::signed_coc_px(double inverse_depth_per_mm) const {
-  const FirstOrderSample ref = first_order(reference_nm_);
+  const FirstOrderSample& ref = reference_first_order_;
   const GaussianImage g = gaussian_image({0.0, 0.0, inverse_depth_per_mm}, ref);
   const double to_pupil = g.z_mm - ref.z_exit_pupil_mm;
   if (to_pupil == 0.0) return 0.0;

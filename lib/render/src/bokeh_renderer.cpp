@@ -26,6 +26,7 @@
 #include "lensmith/core/units.h"
 #include "pupil_mesh_table.h"
 #include "scatter_source.h"
+#include "source_merging.h"
 #include "spectral_groups.h"
 
 namespace lensmith {
@@ -37,6 +38,7 @@ using render_detail::FootprintPlan;
 using render_detail::FootprintScatter;
 using render_detail::FootprintScratch;
 using render_detail::ScatterSource;
+using render_detail::ScatterSources;
 
 // Footprint heights (px, with margins) from which half and a quarter of the sub-rows are used: only
 // a tall footprint's top and bottom rows see the y sampling.
@@ -74,39 +76,45 @@ Image render(const Image& image, const DepthMap& depth, const RayModel& model, c
   const render_detail::PupilMeshTable meshes(aperture);
   const FootprintScatter scatter(model, aperture, groups, meshes, options);
 
-  std::vector<ScatterSource> sources = render_detail::make_scatter_sources(image, depth, camera, options, threads, stats);
+  ScatterSources sources = render_detail::make_scatter_sources(image, depth, camera, options, threads, stats);
   if (options.split_edge_pixels) render_detail::split_mixed_pixels(sources, w, h, camera, threads, stats);
   const DepthLayers layers = render_detail::make_depth_layers(sources, w, options.layer_spacing_px, options.max_layers);
   stats.layer_spacing_px = layers.spacing_px;
 
   const bool stretch = options.hidden == HiddenSurfaces::Stretch;
-  std::vector<float> layer_rgba(static_cast<std::size_t>(w) * h * 4);
-  std::vector<float> hole_rgba(stretch ? layer_rgba.size() : 0);  // Stretch: coverage of the hidden sources
-  std::vector<double> result(static_cast<std::size_t>(w) * h * 4, 0.0);  // premultiplied RGB + coverage
+  LargeVector<float> layer_rgba(static_cast<std::size_t>(w) * h * 4);
+  LargeVector<float> hole_rgba(stretch ? layer_rgba.size() : 0);  // Stretch: coverage of the hidden sources
+  LargeVector<double> result(static_cast<std::size_t>(w) * h * 4, 0.0);  // premultiplied RGB + coverage
   const int bands = std::max(1, std::min(h, threads * kBandsPerThread));
   std::size_t done = 0;
   std::atomic<std::size_t> footprints{0}, triangles{0};
   // Per thread, its splat buffers, kept from band to band and layer to layer.
   std::vector<BandBuffers> pools(static_cast<std::size_t>(threads));
+  // A layer's sources and their plans, kept from layer to layer (their memory is faulted in once).
+  ScatterSources layer;
+  LargeVector<FootprintPlan> plans;
+  render_detail::MergeScratch merge_scratch;
 
   for (int l = 0; l < layers.count; ++l) {
     const auto u = static_cast<std::size_t>(l);
-    std::vector<ScatterSource> layer;
+    layer.clear();
     layer.reserve(layers.members[u].size());
     for (int i : layers.members[u]) layer.push_back(sources[static_cast<std::size_t>(i)]);
     const double hidden_blur = layers.max_blur_px[u] + layers.nearer_blur_px[u];
     if (!layer.empty() && l + 1 < layers.count && hidden_blur >= kMinHiddenBlurPx) {
       const double reach = std::min(0.5 * hidden_blur + kHiddenMarginPx, 0.5 * (w + h));
-      std::vector<ScatterSource> extra =
+      ScatterSources extra =
           render_detail::hidden_sources(sources, layers, l, w, h, reach, options.hidden, camera, threads);
       stats.hidden_sources += extra.size();
       layer.insert(layer.end(), extra.begin(), extra.end());
     }
     if (layer.empty()) continue;
     ++stats.layers;
+    // Level of detail: sources whose footprints go to a coarse grid, merged by its cells.
+    render_detail::merge_coarse_sources(layer, w, h, merge_scratch);
 
     // Footprint extents and sample counts.
-    std::vector<FootprintPlan> plans(layer.size());
+    plans.resize(layer.size());
 #pragma omp parallel num_threads(threads)
     {
       FootprintScratch scratch;
@@ -159,7 +167,7 @@ Image render(const Image& image, const DepthMap& depth, const RayModel& model, c
         }
         bool any = false;
         for (int set = 0; set < (stretch ? 2 : 1); ++set) {
-          std::vector<float>& target = set == 0 ? layer_rgba : hole_rgba;
+          LargeVector<float>& target = set == 0 ? layer_rgba : hole_rgba;
           float* rows = target.data() + static_cast<std::size_t>(row_begin) * w * 4;
           std::fill(rows, rows + static_cast<std::size_t>(row_end - row_begin) * w * 4, 0.0f);
           for (std::size_t lv = 0; lv < static_cast<std::size_t>(kLevels); ++lv) {

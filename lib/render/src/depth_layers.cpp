@@ -11,7 +11,7 @@ int DepthLayers::layer_at(double coc_px) const {
   return std::clamp(static_cast<int>(std::floor((coc_px - coc_min_px) / spacing_px)), 0, count - 1);
 }
 
-DepthLayers make_depth_layers(const std::vector<ScatterSource>& sources, int width, double spacing_px, int max_layers) {
+DepthLayers make_depth_layers(const ScatterSources& sources, int width, double spacing_px, int max_layers) {
   DepthLayers l;
   double coc_min = kInfinity, coc_max = -kInfinity;
   for (const ScatterSource& s : sources) {

@@ -29,8 +29,8 @@ struct DepthLayers {
   double coc_min_px = 0.0;  // signed blur of layer 0's lower edge (the farthest sources)
   double spacing_px = 0.0;  // signed-blur step between layers
   int count = 0;            // layer 0 is the farthest, count - 1 the nearest
-  std::vector<PixelLayers> pixels;           // per pixel (row-major)
-  std::vector<std::vector<int>> members;     // per layer: indices of its sources
+  LargeVector<PixelLayers> pixels;         // per pixel (row-major)
+  std::vector<LargeVector<int>> members;   // per layer: indices of its sources
   std::vector<double> max_blur_px;           // per layer: largest |signed blur| of its sources
   std::vector<double> nearer_blur_px;        // per layer: largest |signed blur| of every nearer layer
 
@@ -39,6 +39,6 @@ struct DepthLayers {
 
 // Layers `spacing_px` apart (widened so there are at most `max_layers`), farthest first. `sources`
 // are the parts of the pixels of an image `width` wide.
-DepthLayers make_depth_layers(const std::vector<ScatterSource>& sources, int width, double spacing_px, int max_layers);
+DepthLayers make_depth_layers(const ScatterSources& sources, int width, double spacing_px, int max_layers);
 
 }  // namespace lensmith::render_detail

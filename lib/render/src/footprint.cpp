@@ -79,6 +79,30 @@ void reach_clip(const std::vector<PupilPoint>& outline, double scale, const std:
   }
 }
 
+}  // namespace
+
+int grid_level(double footprint_px) {
+  return footprint_px >= kQuarterResolutionPx ? 2 : footprint_px >= kHalfResolutionPx ? 1 : 0;
+}
+
+double FootprintScatter::disc_passing_share(const std::vector<PupilDisc>& discs, int own_step, FootprintScratch& scratch) const {
+  // Measured on an outline of at least kShareSectorStep's vertices: a coarse one would misjudge how
+  // much of the circle a disc cuts off (an octagon by up to 10 %). With the chief ray inside every
+  // disc the cut is radial (cheap); otherwise the polygon is clipped disc by disc.
+  const int share_step = std::max(own_step, PupilMeshTable::kShareSectorStep);
+  const std::vector<PupilPoint>& share_outline = meshes_.dense_outline(share_step);
+  if (centre_passes(discs)) {
+    disc_reach(meshes_.dense_directions(share_step), discs, scratch.reach);
+    reach_clip(share_outline, 1.0, scratch.reach, scratch.clipped);
+  } else {
+    clip_pupil_polygon(share_outline, discs, scratch.clipped, scratch.clip_work);
+  }
+  scratch.reach_of = nullptr;
+  return scratch.clipped.size() < 3 ? 0.0 : pupil_polygon_area(scratch.clipped) / pupil_polygon_area(share_outline);
+}
+
+namespace {
+
 // Whether a ring that rises and falls once in y (two chains from its topmost to its bottommost
 // vertex) is simple: its two chains must not cross. One that does is a figure eight (a near-focus
 // beam with coma and astigmatism maps a pupil ring so), whose signed area, the difference of its
@@ -346,7 +370,7 @@ FootprintScatter::FootprintScatter(const RayModel& model, const Aperture& apertu
 FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& scratch) const {
   std::vector<PupilPoint>& pupil = scratch.pupil;
   std::vector<SensorHit>& hits = scratch.hits;
-  const PixelPoint centre{s.x + 0.5, s.y + 0.5};
+  const PixelPoint centre = source_centre(s);
   const Tangents t = camera_.frame().tangents_at(centre);
   const ScenePoint point{t.x, t.y, s.inverse_depth_per_mm};
   FootprintPlan p;
@@ -383,7 +407,18 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
     }
   }
   for (std::size_t l = 0; l < wavelengths; ++l) {
-    if (scratch.discs.empty()) {
+    if (affine) {
+      // An affine model (which clips by discs only) maps the probe through three rays.
+      static constexpr std::array<PupilPoint, 3> kBasis{{{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}}};
+      std::array<SensorHit, 3> basis;
+      model_.map_passing(point, lambdas[l], kBasis, basis);
+      for (std::size_t i = 0; i < 9; ++i) {
+        SensorHit& h = hits[i];
+        h = basis[0];
+        h.x_mm += (basis[1].x_mm - basis[0].x_mm) * pupil[i].x + (basis[2].x_mm - basis[0].x_mm) * pupil[i].y;
+        h.y_mm += (basis[1].y_mm - basis[0].y_mm) * pupil[i].x + (basis[2].y_mm - basis[0].y_mm) * pupil[i].y;
+      }
+    } else if (scratch.discs.empty()) {
       model_.map(point, lambdas[l], pupil, hits);
     } else {
       model_.map_passing(point, lambdas[l], pupil, hits);
@@ -439,7 +474,7 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
   if (p.groups > 1 && groups_needed < p.groups) {
     p.blend = static_cast<float>(std::min(1.0, (groups_needed - (p.groups - 1)) / kGroupBlend));
   }
-  p.level = size >= kQuarterResolutionPx ? 2 : size >= kHalfResolutionPx ? 1 : 0;
+  p.level = grid_level(size);
   const double cell_px = 1 << p.level;
   const double margin = kTentMarginPx * cell_px + (near_affine ? 0.0 : kMeshMarginFraction * size);
   p.y_min = static_cast<float>(y_min - margin);
@@ -464,6 +499,11 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
     const double rings = clips ? std::max(kMinClippingRings, size / kPxPerClippingRing) : size / (kPxPerRing * std::max(1.0, 0.5 * cell_px));
     p.mesh = PupilMeshTable::polar_mesh(rings, sector_step);
   }
+  p.discs = !scratch.discs.empty();
+  if (p.discs && aperture_.is_uniform_convex()) {
+    const int own_step = p.mesh >= 0 ? PupilMeshTable::sector_step_of_mesh(p.mesh) : p.outline;
+    p.passing = static_cast<float>(disc_passing_share(scratch.discs, own_step, scratch));
+  }
   return p;
 }
 
@@ -471,42 +511,32 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
                                FootprintScratch& scratch, std::size_t& triangles) const {
   std::vector<SensorHit>& hits = scratch.hits;
   std::vector<Point2f>& points = scratch.points;
-  const Tangents t = camera_.frame().tangents_at({s.x + 0.5, s.y + 0.5});
+  const Tangents t = camera_.frame().tangents_at(source_centre(s));
   const ScenePoint point{t.x, t.y, s.inverse_depth_per_mm};
   // First-order vignetting (the model's pupil discs, the same at every wavelength): for the single
   // polygon, the outline less what they cut off, and the share of the aperture that passes.
-  model_.clip_discs(point, scratch.discs);
+  // The point path needs only the passing share, planned already.
+  const double passing = p.passing;
+  if (!(passing > 0.0)) return;  // the whole beam is stopped
   scratch.reach_of = nullptr;
-  double passing = 1.0;
+  if (p.discs && p.outline != FootprintPlan::kPoint) {
+    model_.clip_discs(point, scratch.discs);
+  } else {
+    scratch.discs.clear();
+  }
   const std::vector<PupilPoint>* outline = p.outline >= 0 ? &meshes_.outline(p.outline) : nullptr;
-  if (!scratch.discs.empty() && aperture_.is_uniform_convex()) {
-    // Measured on an outline of at least kShareSectorStep's vertices: a coarse one would misjudge
-    // how much of the circle a disc cuts off (an octagon by up to 10 %). With the chief ray inside
-    // every disc the cut is radial (cheap); otherwise the polygon is clipped disc by disc.
-    const bool radial = centre_passes(scratch.discs);
-    const int own_step = p.mesh >= 0 ? PupilMeshTable::sector_step_of_mesh(p.mesh) : p.outline;
-    const int share_step = std::max(own_step, PupilMeshTable::kShareSectorStep);
-    const std::vector<PupilPoint>& share_outline = meshes_.dense_outline(share_step);
-    if (radial) {
-      disc_reach(meshes_.dense_directions(share_step), scratch.discs, scratch.reach);
-      scratch.reach_of = &share_outline;
-      reach_clip(share_outline, 1.0, scratch.reach, scratch.clipped);
+  if (!scratch.discs.empty() && aperture_.is_uniform_convex() && p.mesh < 0 && p.outline >= 0) {
+    // The outline less what the discs cut off: with the chief ray inside every disc the cut is
+    // radial (cheap); otherwise the polygon is clipped disc by disc.
+    const std::vector<PupilPoint>& own = meshes_.dense_outline(p.outline);
+    if (centre_passes(scratch.discs)) {
+      disc_reach(meshes_.dense_directions(p.outline), scratch.discs, scratch.reach);
+      scratch.reach_of = &own;
+      reach_clip(own, 1.0, scratch.reach, scratch.clipped);
     } else {
-      clip_pupil_polygon(share_outline, scratch.discs, scratch.clipped, scratch.clip_work);
+      clip_pupil_polygon(own, scratch.discs, scratch.clipped, scratch.clip_work);
     }
-    passing = scratch.clipped.size() < 3 ? 0.0 : pupil_polygon_area(scratch.clipped) / pupil_polygon_area(share_outline);
-    if (!(passing > 0.0)) return;  // the whole beam is stopped
-    if (p.mesh < 0 && p.outline >= 0) {
-      const std::vector<PupilPoint>& own = meshes_.dense_outline(p.outline);
-      if (radial) {
-        if (scratch.reach_of != &own) disc_reach(meshes_.dense_directions(p.outline), scratch.discs, scratch.reach);
-        scratch.reach_of = &own;
-        reach_clip(own, 1.0, scratch.reach, scratch.clipped);
-      } else {
-        clip_pupil_polygon(own, scratch.discs, scratch.clipped, scratch.clip_work);
-      }
-      if (scratch.clipped.size() < 3) return;
-    }
+    if (scratch.clipped.size() < 3) return;
     outline = &scratch.clipped;
   }
   // A polar mesh of a model that clips by discs: its rings clipped once for every wavelength.
@@ -521,7 +551,7 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
       static constexpr std::array<PupilPoint, 1> kCentre{{{0.0, 0.0}}};
       hits.resize(1);
       // With discs the passing share is known (a cat's eye may leave the chief ray out).
-      if (scratch.discs.empty()) {
+      if (!p.discs) {
         model_.map(point, g.wavelength_nm, kCentre, std::span<SensorHit>(hits.data(), 1));
       } else {
         model_.map_passing(point, g.wavelength_nm, kCentre, std::span<SensorHit>(hits.data(), 1));

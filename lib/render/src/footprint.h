@@ -21,6 +21,10 @@
 
 namespace lensmith::render_detail {
 
+// The splat grid for a footprint this large (px): 0 (full resolution), 1 (cells of 2 x 2 px) or 2
+// (4 x 4 px).
+int grid_level(double footprint_px);
+
 // What the planner decided for one source.
 struct FootprintPlan {
   static constexpr int kPoint = -2;  // `outline` value of the point path
@@ -31,6 +35,10 @@ struct FootprintPlan {
   int mesh = -1;       // PupilMeshTable mesh index, or -1 for the single-polygon and point paths
   int outline = 0;     // PupilMeshTable sector step (single polygon), or kPoint
   int level = 0;       // the splat grid: 2^level output px per cell side (large footprints are coarse)
+  bool discs = false;  // the model clips this point's beam by pupil discs (RayModel::clip_discs)
+  // Share of a uniform convex aperture that passes those discs, measured on an outline of at least
+  // PupilMeshTable::kShareSectorStep's vertices (1 without discs; 0: the whole beam is stopped).
+  float passing = 1.0f;
 };
 
 // Per-thread scratch space, so planning and deposits allocate nothing once warm.
@@ -73,6 +81,8 @@ class FootprintScatter {
   void deposit_clipped_rings(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p, double passing,
                              const std::array<float, 4>& value, SplatBuffer& buffer, SplatBuffer& fine,
                              FootprintScratch& scratch, std::size_t& triangles) const;
+  // FootprintPlan::passing for `discs` and a footprint drawn with `own_step`'s sector count.
+  double disc_passing_share(const std::vector<PupilDisc>& discs, int own_step, FootprintScratch& scratch) const;
   // `value` with its light (not its coverage) scaled by a ray's radiometric weight (SensorHit), when
   // BokehOptions::vignetting is on.
   std::array<float, 4> lit(const std::array<float, 4>& value, double weight) const;

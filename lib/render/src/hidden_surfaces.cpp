@@ -16,16 +16,16 @@ double tone(float v) { return static_cast<double>(v) / (1.0 + static_cast<double
 float untone(double t) { return static_cast<float>(std::min(t, kMaxTone) / (1.0 - std::min(t, kMaxTone))); }
 }  // namespace
 
-std::vector<ScatterSource> hidden_sources(const std::vector<ScatterSource>& sources, const DepthLayers& layers, int layer,
+ScatterSources hidden_sources(const ScatterSources& sources, const DepthLayers& layers, int layer,
                                           int width, int height, double reach_px, HiddenSurfaces mode, const Camera& camera,
                                           int threads) {
   const int w = width, h = height;
-  const std::vector<PixelLayers>& pixels = layers.pixels;
+  const LargeVector<PixelLayers>& pixels = layers.pixels;
   // Nearer pixels within a (2 reach + 1)-pixel square of a pixel of the layer: a separable
   // dilation, rows then columns, each line independent (threads).
   const int reach = static_cast<int>(reach_px);
   const int far = std::numeric_limits<int>::max() / 4;
-  std::vector<int> row_distance(static_cast<std::size_t>(w) * h);
+  LargeVector<int> row_distance(static_cast<std::size_t>(w) * h);
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (int y = 0; y < h; ++y) {
     int* d = row_distance.data() + static_cast<std::size_t>(y) * w;
@@ -35,7 +35,7 @@ std::vector<ScatterSource> hidden_sources(const std::vector<ScatterSource>& sour
     last = far;
     for (int x = w - 1; x >= 0; --x) d[x] = std::min(d[x], l[x].in(layer) ? (last = 0) : (last = std::min(far, last + 1)));
   }
-  std::vector<std::uint8_t> within(static_cast<std::size_t>(w) * h, 0);
+  LargeVector<std::uint8_t> within(static_cast<std::size_t>(w) * h, 0);
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (int x = 0; x < w; ++x) {
     int last = far;
@@ -71,7 +71,7 @@ std::vector<ScatterSource> hidden_sources(const std::vector<ScatterSource>& sour
   x1 = std::min(w - 1, x1 + reach);
   y1 = std::min(h - 1, y1 + reach);
   const int ww = x1 - x0 + 1, wh = y1 - y0 + 1;
-  std::vector<std::array<double, 5>> cells(static_cast<std::size_t>(ww) * wh, std::array<double, 5>{});
+  LargeVector<std::array<double, 5>> cells(static_cast<std::size_t>(ww) * wh, std::array<double, 5>{});
   // The layer's own whole pixels (the parts of split edge pixels are uncertain estimates).
   for (int i : layers.members[static_cast<std::size_t>(layer)]) {
     const ScatterSource& p = sources[static_cast<std::size_t>(i)];
@@ -85,7 +85,7 @@ std::vector<ScatterSource> hidden_sources(const std::vector<ScatterSource>& sour
     cell[4] += c;
   }
   push_pull(ww, wh, cells);
-  std::vector<ScatterSource> out;
+  ScatterSources out;
   out.reserve(targets.size());
   for (std::size_t i : targets) {
     const std::size_t wx = i % static_cast<std::size_t>(w) - static_cast<std::size_t>(x0);

@@ -20,7 +20,7 @@ namespace lensmith::render_detail {
 
 // Hidden sources of `layer`, under the nearer pixels within `reach_px` (a square) of its own pixels
 // of an image `width` x `height`; coverage-only for HiddenSurfaces::Stretch.
-std::vector<ScatterSource> hidden_sources(const std::vector<ScatterSource>& sources, const DepthLayers& layers, int layer,
+ScatterSources hidden_sources(const ScatterSources& sources, const DepthLayers& layers, int layer,
                                           int width, int height, double reach_px, HiddenSurfaces mode, const Camera& camera,
                                           int threads);
 

@@ -20,7 +20,7 @@ constexpr double kKnownCoverage = 0.9;
 constexpr double kGapTolerance = 1e-9;
 }  // namespace
 
-void composite_layer_over(const std::vector<float>& layer_rgba, const std::vector<float>* holes, std::vector<double>& result,
+void composite_layer_over(const LargeVector<float>& layer_rgba, const LargeVector<float>* holes, LargeVector<double>& result,
                           int width, int row_begin, int row_end) {
   for (std::size_t k = static_cast<std::size_t>(row_begin) * width; k < static_cast<std::size_t>(row_end) * width; ++k) {
     double c[4] = {layer_rgba[4 * k], layer_rgba[4 * k + 1], layer_rgba[4 * k + 2], layer_rgba[4 * k + 3]};
@@ -42,12 +42,12 @@ void composite_layer_over(const std::vector<float>& layer_rgba, const std::vecto
   }
 }
 
-Image finish_composite(const std::vector<double>& result, int width, int height) {
+Image finish_composite(const LargeVector<double>& result, int width, int height) {
   const std::size_t count = static_cast<std::size_t>(width) * height;
   bool any_gap = false;
   for (std::size_t k = 0; k < count && !any_gap; ++k) any_gap = result[4 * k + 3] < kRenormaliseCoverage;
   // The push-pull fill (5 doubles a pixel) only where some gap is too empty to renormalise.
-  std::vector<std::array<double, 5>> fill;
+  LargeVector<std::array<double, 5>> fill;
   if (any_gap) {
     fill.assign(count, std::array<double, 5>{});
     for (std::size_t k = 0; k < count; ++k) {

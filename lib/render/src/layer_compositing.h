@@ -9,6 +9,8 @@
 
 #include <vector>
 
+#include "lensmith/core/huge_page_allocator.h"
+
 #include "lensmith/render/image.h"
 
 namespace lensmith::render_detail {
@@ -16,10 +18,10 @@ namespace lensmith::render_detail {
 // result (premultiplied RGB + coverage, double, w x h x 4) = layer rows [row_begin, row_end) over
 // result. `holes` (HiddenSurfaces::Stretch, else null): the coverage of the layer's hidden sources in
 // channel 3; the layer's colour is renormalised over it.
-void composite_layer_over(const std::vector<float>& layer_rgba, const std::vector<float>* holes, std::vector<double>& result,
+void composite_layer_over(const LargeVector<float>& layer_rgba, const LargeVector<float>* holes, LargeVector<double>& result,
                           int width, int row_begin, int row_end);
 
 // The output picture: the result with its uncovered remainder filled.
-Image finish_composite(const std::vector<double>& result, int width, int height);
+Image finish_composite(const LargeVector<double>& result, int width, int height);
 
 }  // namespace lensmith::render_detail

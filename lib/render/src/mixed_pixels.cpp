@@ -61,8 +61,8 @@ struct Decision {
 };
 
 // Per pixel: 1 where a 4-neighbour's blur differs by kMinBlurDifferencePx or more.
-std::vector<std::uint8_t> next_to_step_map(const std::vector<ScatterSource>& sources, int width, int height) {
-  std::vector<std::uint8_t> m(static_cast<std::size_t>(width) * height, 0);
+LargeVector<std::uint8_t> next_to_step_map(const ScatterSources& sources, int width, int height) {
+  LargeVector<std::uint8_t> m(static_cast<std::size_t>(width) * height, 0);
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * width + x;
@@ -73,7 +73,7 @@ std::vector<std::uint8_t> next_to_step_map(const std::vector<ScatterSource>& sou
   return m;
 }
 
-Decision decide(const std::vector<ScatterSource>& sources, const std::vector<std::uint8_t>& next_to_step, int width, int height,
+Decision decide(const ScatterSources& sources, const LargeVector<std::uint8_t>& next_to_step, int width, int height,
                 int x, int y) {
   const ScatterSource& p = sources[static_cast<std::size_t>(y) * width + x];
   Decision d;
@@ -157,7 +157,7 @@ void place_on(ScatterSource& part, const ScatterSource& p, const Group& g, const
   part.coc_px = camera.signed_coc_px(g.inverse_depth_per_mm);
 }
 
-void apply(std::vector<ScatterSource>& sources, std::size_t i, const Decision& d, const Camera& camera, BokehStatistics& stats) {
+void apply(ScatterSources& sources, std::size_t i, const Decision& d, const Camera& camera, BokehStatistics& stats) {
   const ScatterSource p = sources[i];
   if (d.kind == Decision::Kind::Move) {
     place_on(sources[i], p, d.alpha == 1.0 ? d.near : d.far, camera);
@@ -182,7 +182,7 @@ void apply(std::vector<ScatterSource>& sources, std::size_t i, const Decision& d
 
 }  // namespace
 
-void split_mixed_pixels(std::vector<ScatterSource>& sources, int width, int height, const Camera& camera, int threads,
+void split_mixed_pixels(ScatterSources& sources, int width, int height, const Camera& camera, int threads,
                         BokehStatistics& stats) {
   // Each pass decides from the sources as they were at its start, so decisions do not depend on
   // the order of the pixels; each row keeps those that change something, applied in row order.
@@ -190,7 +190,7 @@ void split_mixed_pixels(std::vector<ScatterSource>& sources, int width, int heig
   for (int pass = 0; pass <= kMovePasses; ++pass) {
     const bool last = pass == kMovePasses;
     std::size_t changes = 0;
-    const std::vector<std::uint8_t> next_to_step = next_to_step_map(sources, width, height);
+    const LargeVector<std::uint8_t> next_to_step = next_to_step_map(sources, width, height);
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 16) reduction(+ : changes)
     for (int y = 0; y < height; ++y) {
       auto& row = rows[static_cast<std::size_t>(y)];

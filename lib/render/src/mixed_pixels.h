@@ -24,7 +24,7 @@ namespace lensmith::render_detail {
 // `sources` holds one source per pixel (row-major, width x height); split pixels keep their near
 // part at their index and get their far part appended. Statistics: split_edge_pixels,
 // redepthed_edge_pixels.
-void split_mixed_pixels(std::vector<ScatterSource>& sources, int width, int height, const Camera& camera, int threads,
+void split_mixed_pixels(ScatterSources& sources, int width, int height, const Camera& camera, int threads,
                         BokehStatistics& stats);
 
 }  // namespace lensmith::render_detail

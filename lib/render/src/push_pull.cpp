@@ -22,15 +22,15 @@ Cell normalised(const Cell& v) {
 
 }  // namespace
 
-void push_pull(int w, int h, std::vector<Cell>& cells) {
+void push_pull(int w, int h, LargeVector<Cell>& cells) {
   // Pull: each level sums 2 x 2 blocks of the one below, down to a single cell.
-  std::vector<std::vector<Cell>> levels;
+  std::vector<LargeVector<Cell>> levels;
   std::vector<std::pair<int, int>> sizes{{w, h}};
   while (sizes.back().first > 1 || sizes.back().second > 1) {
     const auto [fw, fh] = sizes.back();
-    const std::vector<Cell>& f = levels.empty() ? cells : levels.back();
+    const LargeVector<Cell>& f = levels.empty() ? cells : levels.back();
     const int cw = (fw + 1) / 2, ch = (fh + 1) / 2;
-    std::vector<Cell> c(static_cast<std::size_t>(cw) * ch, Cell{});
+    LargeVector<Cell> c(static_cast<std::size_t>(cw) * ch, Cell{});
     for (int y = 0; y < fh; ++y) {
       for (int x = 0; x < fw; ++x) {
         Cell& dst = c[static_cast<std::size_t>(y / 2) * cw + x / 2];
@@ -53,8 +53,8 @@ void push_pull(int w, int h, std::vector<Cell>& cells) {
   top = normalised(top);
   if (top[4] > 0.0) top[4] = 1.0;
   for (std::size_t l = levels.size(); l-- > 0;) {
-    std::vector<Cell>& f = l == 0 ? cells : levels[l - 1];
-    const std::vector<Cell>& c = levels[l];
+    LargeVector<Cell>& f = l == 0 ? cells : levels[l - 1];
+    const LargeVector<Cell>& c = levels[l];
     const auto [fw, fh] = sizes[l];
     const auto [cw, ch] = sizes[l + 1];
     for (int y = 0; y < fh; ++y) {

@@ -6,11 +6,13 @@
 #include <array>
 #include <vector>
 
+#include "lensmith/core/huge_page_allocator.h"
+
 namespace lensmith::render_detail {
 
 // `cells` holds, per pixel of a w x h grid, four weighted sums and their weight (0 = unknown). Pull
 // sums 2 x 2 blocks down to one cell; push gives every unknown cell its parent's normalised value.
 // On return every cell holds normalised values and weight 1 (all zero if no cell was known).
-void push_pull(int w, int h, std::vector<std::array<double, 5>>& cells);
+void push_pull(int w, int h, LargeVector<std::array<double, 5>>& cells);
 
 }  // namespace lensmith::render_detail

@@ -31,10 +31,10 @@ double clamp_inverse_depth(const Camera& camera, double w, double max_blur_px, s
   return in;
 }
 
-std::vector<ScatterSource> make_scatter_sources(const Image& image, const DepthMap& depth, const Camera& camera,
+ScatterSources make_scatter_sources(const Image& image, const DepthMap& depth, const Camera& camera,
                                                 const BokehOptions& options, int threads, BokehStatistics& stats) {
   const int w = image.width, h = image.height;
-  std::vector<ScatterSource> sources(static_cast<std::size_t>(w) * h);
+  ScatterSources sources(static_cast<std::size_t>(w) * h);
   std::size_t clamped = 0;
   double coc_min = kInfinity, coc_max = -kInfinity;
 #pragma omp parallel for num_threads(threads) schedule(static) reduction(+ : clamped) reduction(min : coc_min) reduction(max : coc_max)

@@ -378,7 +378,7 @@ void SplatBuffer::resolve_into(float* rgba_full_image) const {
   // Grid cells integrated, then each output pixel bilinearly between the four cells around its
   // centre, divided by k^2: the weights of a cell over the output pixels sum to k^2 (k samples per
   // unit of a tent with unit integral, per axis), so the energy is kept.
-  std::vector<double>& cells = cells_;
+  LargeVector<double>& cells = cells_;
   cells.resize(diff_.size());
   for (std::size_t r = 0; r < diff_.size(); r += grid_row_size) {
     double sum[kChannels] = {0.0, 0.0, 0.0, 0.0};

@@ -128,6 +128,7 @@ class Camera {
   double z_perspective_mm_ = 0.0;
   double pupil_orientation_ = 1.0;
   double px_per_sensor_mm_ = 0.0;
+  FirstOrderSample reference_first_order_{};  // first_order(reference_nm_), for signed_coc_px per pixel
 };
 
 }  // namespace lensmith

@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "lensmith/core/huge_page_allocator.h"
+
 namespace lensmith {
 
 struct Image;
@@ -130,10 +132,10 @@ class SplatBuffer {
   double scale_ = 1.0;
   double x_offset_ = 0.0;
   std::vector<Point2f> scaled_;  // scratch: a polygon's vertices in cells
-  mutable std::vector<double> cells_;  // scratch of resolve_into: the grid's integrated cells
+  mutable LargeVector<double> cells_;  // scratch of resolve_into: the grid's integrated cells
   // First differences along x, double: width_ x (row_end_ - row_begin_) x 4 channels, row-major.
   // double keeps a bright highlight's rounding from streaking along its row through the prefix sum.
-  std::vector<double> diff_;
+  LargeVector<double> diff_;
   // Per sub-row class m in [0, subrows): the upper of its two rows relative to the pixel row it
   // lies in (-1 or 0), and the tent weight of the lower row (the upper row gets 1 - weight).
   std::vector<int> subrow_row_offset_;
