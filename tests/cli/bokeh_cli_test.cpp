@@ -18,10 +18,10 @@ namespace {
 
 const std::string kScene = std::string(LENSMITH_SOURCE_DIR) + "/examples/bokeh-scene.exr";
 
+// A file in this test process's scratch folder (removed when the process ends).
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("lensmith_bokeh_cli_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return dir / name;
+  static const lensmith::testing::ScratchFolder folder("lensmith_bokeh_cli_");
+  return folder.dir / name;
 }
 
 std::string value_of(const std::vector<std::pair<std::string, std::string>>& meta, const std::string& key) {

@@ -15,16 +15,8 @@ namespace {
 
 const std::string kScene = std::string(LENSMITH_SOURCE_DIR) + "/examples/bokeh-scene.exr";
 
-// A scratch folder removed at the end of the test.
-struct Scratch {
-  fs::path dir = fs::temp_directory_path() / ("lensmith_exit_codes_" + std::to_string(::getpid()));
-  Scratch() { fs::create_directories(dir); }
-  ~Scratch() { fs::remove_all(dir); }
-  std::string file(const std::string& name, const std::string& text = "") const {
-    const fs::path p = dir / name;
-    if (!text.empty()) std::ofstream(p) << text;
-    return p.string();
-  }
+struct Scratch : lensmith::testing::ScratchFolder {
+  Scratch() : ScratchFolder("lensmith_exit_codes_") {}
 };
 
 }  // namespace

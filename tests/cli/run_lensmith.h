@@ -14,6 +14,32 @@
 
 namespace lensmith::testing {
 
+// A folder for a test's files under the system's temporary folder, named after the test process,
+// emptied when made and removed with what is in it when the test ends (ctest runs every test case
+// as a process of its own: folders left behind piled up by the hundred).
+class ScratchFolder {
+ public:
+  explicit ScratchFolder(const std::string& prefix)
+      : dir(std::filesystem::temp_directory_path() / (prefix + std::to_string(::getpid()))) {
+    std::error_code ignored;
+    std::filesystem::remove_all(dir, ignored);
+    std::filesystem::create_directories(dir);
+  }
+  ~ScratchFolder() {
+    std::error_code ignored;
+    std::filesystem::remove_all(dir, ignored);
+  }
+  ScratchFolder(const ScratchFolder&) = delete;
+  ScratchFolder& operator=(const ScratchFolder&) = delete;
+  // A file in the folder, written with `text` unless that is empty.
+  std::string file(const std::string& name, const std::string& text = "") const {
+    const std::filesystem::path p = dir / name;
+    if (!text.empty()) std::ofstream(p) << text;
+    return p.string();
+  }
+  const std::filesystem::path dir;
+};
+
 struct CommandResult {
   int exit_code = -1;
   std::string out;  // stdout

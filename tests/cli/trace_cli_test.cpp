@@ -17,15 +17,8 @@ using lensmith::testing::run_lensmith;
 
 namespace {
 
-// A scratch folder for output files, removed when the test ends.
-struct ScratchFolder {
-  std::filesystem::path path;
-  ScratchFolder() {
-    path = std::filesystem::temp_directory_path() / ("lensmith_trace_cli_test_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(path);
-  }
-  ~ScratchFolder() { std::filesystem::remove_all(path); }
-  std::string file(const std::string& name) const { return (path / name).string(); }
+struct ScratchFolder : lensmith::testing::ScratchFolder {
+  ScratchFolder() : lensmith::testing::ScratchFolder("lensmith_trace_cli_test_") {}
 };
 
 struct PngHeader {

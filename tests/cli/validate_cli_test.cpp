@@ -13,8 +13,8 @@ namespace fs = std::filesystem;
 
 TEST_CASE("lensmith validate writes a Markdown report and a PSF picture, and fails only on a missed threshold",
           "[cli][validate]") {
-  const fs::path dir = fs::temp_directory_path() / ("lensmith_validate_cli_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
+  const lensmith::testing::ScratchFolder scratch("lensmith_validate_cli_");
+  const fs::path dir = scratch.dir / "out";
   const std::string common = "validate sasian-triplet --fstop 8 --focus 3 --pupil-samples 24 --width 640 --height 360 --out " +
                              dir.string() + " --quiet";
   const auto ok = run_lensmith(common);
