@@ -180,8 +180,12 @@ std::string Aperture::to_string() const {
 }
 
 double pupil_polygon_area(const std::vector<PupilPoint>& v) {
+  const std::size_t n = v.size();
+  if (n == 0) return 0.0;
   double twice = 0.0;
-  for (std::size_t i = 0, n = v.size(); i < n; ++i) twice += v[i].x * v[(i + 1) % n].y - v[(i + 1) % n].x * v[i].y;
+  // Edge (i - 1, i) for every i, the closing edge first: no modulo in the loop (the renderer
+  // measures every vignetted footprint's passing share with it).
+  for (std::size_t i = 0, j = n - 1; i < n; j = i++) twice += v[j].x * v[i].y - v[i].x * v[j].y;
   return 0.5 * std::abs(twice);
 }
 

@@ -76,10 +76,13 @@ void ReferenceSphereModel::clip_discs(const ScenePoint& point, std::vector<Pupil
   // s = a (a_k + b_k w / d), c = (b_k / d) tan / s and rho = R_k / |s|.
   const double w = point.inverse_depth_per_mm;
   const double d = 1.0 + (z_entrance_pupil_mm_ - camera_.z_perspective_mm()) * w;
+  const double inverse_d = 1.0 / d;  // one division per point, one per aperture (the renderer asks per pixel)
   for (const ParaxialAperture& k : apertures_) {
-    const double scale = entrance_pupil_radius_mm_ * (k.a + k.b * w / d);
+    const double scale = entrance_pupil_radius_mm_ * (k.a + k.b * w * inverse_d);
     if (!(std::abs(scale) > 0.0)) continue;
-    const PupilDisc disc{k.b / d * point.tan_x / scale, k.b / d * point.tan_y / scale, k.radius_mm / std::abs(scale)};
+    const double inverse_scale = 1.0 / scale;
+    const double shift = k.b * inverse_d * inverse_scale;
+    const PupilDisc disc{shift * point.tan_x, shift * point.tan_y, k.radius_mm * std::abs(inverse_scale)};
     // Only discs that cut the unit pupil matter: |c| + 1 > rho.
     const double inner = disc.radius - 1.0;
     if (inner < 0.0 || disc.x * disc.x + disc.y * disc.y > inner * inner) discs.push_back(disc);

@@ -95,6 +95,7 @@ class FootprintScatter {
   const BokehOptions& options_;
   // The probe: the pupil centre and 8 points on the aperture's edge, from the top anticlockwise.
   std::array<PupilPoint, 9> probe_{};
+  std::array<double, 9> probe_length_{};  // their distances from the centre
 };
 
 }  // namespace lensmith::render_detail

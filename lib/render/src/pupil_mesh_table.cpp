@@ -37,11 +37,16 @@ PupilMeshTable::PupilMeshTable(const Aperture& aperture) {
     outlines_.push_back(aperture.outline(aperture.kind() == Aperture::Kind::Blades ? aperture.blade_count() : sectors));
     dense_outlines_.push_back(aperture.outline(sectors));
     Directions d;
-    for (const PupilPoint& q : dense_outlines_.back()) {
+    const std::vector<PupilPoint>& outline = dense_outlines_.back();
+    for (std::size_t j = 0; j < outline.size(); ++j) {
+      const PupilPoint& q = outline[j];
+      const PupilPoint& next = outline[(j + 1) % outline.size()];
       const double len = std::hypot(q.x, q.y);
       d.ux.push_back(q.x / len);
       d.uy.push_back(q.y / len);
       d.inverse_length.push_back(1.0 / len);
+      d.half_cross.push_back(0.5 * (q.x * next.y - next.x * q.y));
+      d.area += d.half_cross.back();
     }
     dense_directions_.push_back(std::move(d));
   }

@@ -35,6 +35,11 @@ class PupilMeshTable {
   // distance (struct of arrays, for vectorised cuts along them).
   struct Directions {
     std::vector<double> ux, uy, inverse_length;
+    // Half the cross product of vertex j and vertex j + 1 (the area of their triangle with the
+    // centre), and the outline's area: an outline scaled by f_j along each direction has the area
+    // sum of f_j f_(j+1) half_cross_j.
+    std::vector<double> half_cross;
+    double area = 0.0;
   };
   const Directions& dense_directions(int sector_step) const { return dense_directions_[static_cast<std::size_t>(sector_step)]; }
 
