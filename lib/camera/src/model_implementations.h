@@ -163,6 +163,9 @@ struct SeidelRayGeometry {
   // right-handed pair; y0 the field in units of the coefficients' maximum field.
   double ex_x = 0.0, ex_y = 0.0, ey_x = 0.0, ey_y = 1.0;
   double y0 = 0.0;
+  // The ray's parameter at the sensor is this times the distance from the exit-pupil point to G
+  // (the same for every pupil point, so sensor_point needs no division).
+  double sensor_per_length = 0.0;
 
   SeidelRayGeometry(const Camera& camera, const FirstOrderSample& fo, const ScenePoint& point, double max_field_tangent)
       : g(camera.gaussian_image(point, fo)),
@@ -178,6 +181,7 @@ struct SeidelRayGeometry {
     ex_x = ey_y;
     ex_y = -ey_x;
     y0 = max_field_tangent > 0.0 ? t_len / max_field_tangent : 0.0;
+    sensor_per_length = -(z_sensor - g.z_mm) / ((z_exit - g.z_mm) * radius_sphere);
   }
 
   // Where the ray through normalised pupil point q meets the sensor (mm) with aberration terms t.
@@ -191,12 +195,13 @@ struct SeidelRayGeometry {
     const double dy = b * t.spherical * rho2 - t.coma * (rho2 + 2.0 * b * b) + (2.0 * t.astigmatism + t.curvature) * b - t.distortion;
     const double p1x = g.x_mm + dx * ex_x + dy * ey_x;
     const double p1y = g.y_mm + dx * ex_y + dy * ey_y;
+    // The sphere point Q = G + u R / L (u from G to the exit-pupil point, L its length) and the line
+    // from Q through P1 meets the sensor at P1 + (P1 - Q) s, s = (z_sensor - G_z) / (G_z - Q_z)
+    // = L sensor_per_length: so x = P1_x + sensor_per_length (L (P1_x - G_x) - R u_x).
     const double ux = r_exit * q.x - g.x_mm, uy = r_exit * q.y - g.y_mm, uz = z_exit - g.z_mm;
-    const double scale = radius_sphere / std::sqrt(ux * ux + uy * uy + uz * uz);
-    const double qx = g.x_mm + ux * scale, qy = g.y_mm + uy * scale, qz = g.z_mm + uz * scale;
-    const double s = (z_sensor - g.z_mm) / (g.z_mm - qz);
-    x_mm = p1x + (p1x - qx) * s;
-    y_mm = p1y + (p1y - qy) * s;
+    const double length = std::sqrt(ux * ux + uy * uy + uz * uz);
+    x_mm = p1x + sensor_per_length * (length * (p1x - g.x_mm) - radius_sphere * ux);
+    y_mm = p1y + sensor_per_length * (length * (p1y - g.y_mm) - radius_sphere * uy);
   }
 };
 
