@@ -97,7 +97,6 @@ double FootprintScatter::disc_passing_share(const std::vector<PupilDisc>& discs,
   const int share_step = std::max(own_step, PupilMeshTable::kShareSectorStep);
   const std::vector<PupilPoint>& share_outline = meshes_.dense_outline(share_step);
   const PupilMeshTable::Directions& u = meshes_.dense_directions(share_step);
-  scratch.reach_of = nullptr;
   if (centre_passes(discs)) {
     // The outline cut radially: its area from the scale factors along each direction.
     disc_reach(u, discs, scratch.reach);
@@ -277,8 +276,7 @@ bool FootprintScatter::clip_rings(const FootprintPlan& p, FootprintScratch& scra
   // leaves it to the triangles. Otherwise ring k reaches the smaller of k / R and the discs' reach
   // along each vertex direction.
   if (!centre_passes(scratch.discs)) return false;
-  if (scratch.reach_of != &outline) disc_reach(meshes_.dense_directions(PupilMeshTable::sector_step_of_mesh(p.mesh)), scratch.discs, scratch.reach);
-  scratch.reach_of = &outline;
+  disc_reach(meshes_.dense_directions(PupilMeshTable::sector_step_of_mesh(p.mesh)), scratch.discs, scratch.reach);
   // The rings span what passes: where the discs cut every direction short of the rim (a lens opened
   // beyond its clear apertures), ring R is the passing region's outline and the others scale to
   // its largest reach, so that no two rings clip to the same polygon (which would read as a fold).
@@ -375,7 +373,9 @@ FootprintScatter::FootprintScatter(const RayModel& model, const Aperture& apertu
     const double a = kPi / 2.0 + 2.0 * kPi * k / 8.0;
     const double r = aperture_.kind() == Aperture::Kind::Mask ? 1.0 : aperture_.edge_radius(a);
     probe_[static_cast<std::size_t>(k) + 1] = {r * std::cos(a), r * std::sin(a)};
-    probe_length_[static_cast<std::size_t>(k) + 1] = r;
+    probe_directions_.ux.push_back(std::cos(a));
+    probe_directions_.uy.push_back(std::sin(a));
+    probe_directions_.inverse_length.push_back(1.0 / r);
   }
 }
 
@@ -405,16 +405,9 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
   // beam's, not the iris's (a lens opened beyond its clear apertures would otherwise plan meshes and
   // spectral groups for light that never gets through).
   if (any_clipped && centre_passes(scratch.discs)) {
+    disc_reach(probe_directions_, scratch.discs, scratch.reach);
     for (std::size_t i = 1; i < pupil.size(); ++i) {
-      const double length = probe_length_[i];
-      if (!(length > 0.0)) continue;
-      const double ux = pupil[i].x / length, uy = pupil[i].y / length;
-      double reach = kInfinity;
-      for (const PupilDisc& d : scratch.discs) {
-        const double b = ux * d.x + uy * d.y;
-        reach = std::min(reach, b + std::sqrt(b * b - (d.x * d.x + d.y * d.y - d.radius * d.radius)));
-      }
-      const double f = std::min(1.0, reach / length);
+      const double f = std::min(1.0, scratch.reach[i - 1]);
       pupil[i] = {pupil[i].x * f, pupil[i].y * f};
     }
   }
@@ -527,12 +520,11 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
   std::vector<Point2f>& points = scratch.points;
   const Tangents t = camera_.frame().tangents_at(source_centre(s));
   const ScenePoint point{t.x, t.y, s.inverse_depth_per_mm};
-  // First-order vignetting (the model's pupil discs, the same at every wavelength): for the single
-  // polygon, the outline less what they cut off, and the share of the aperture that passes.
-  // The point path needs only the passing share, planned already.
+  // First-order vignetting (the model's pupil discs, the same at every wavelength): the share of the
+  // aperture that passes was planned; the point path needs nothing more, the single polygon the
+  // outline less what the discs cut off.
   const double passing = p.passing;
   if (!(passing > 0.0)) return;  // the whole beam is stopped
-  scratch.reach_of = nullptr;
   if (p.discs && p.outline != FootprintPlan::kPoint) {
     model_.clip_discs(point, scratch.discs);
   } else {
@@ -545,7 +537,6 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
     const std::vector<PupilPoint>& own = meshes_.dense_outline(p.outline);
     if (centre_passes(scratch.discs)) {
       disc_reach(meshes_.dense_directions(p.outline), scratch.discs, scratch.reach);
-      scratch.reach_of = &own;
       reach_clip(own, 1.0, scratch.reach, scratch.clipped);
     } else {
       clip_pupil_polygon(own, scratch.discs, scratch.clipped, scratch.clip_work);

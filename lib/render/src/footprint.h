@@ -51,7 +51,6 @@ struct FootprintScratch {
   std::vector<PupilPoint> clipped;  // the aperture's outline less what they cut off
   std::vector<PupilPoint> clip_work;
   std::vector<double> reach;  // the discs' reach along an outline's vertex directions
-  const std::vector<PupilPoint>* reach_of = nullptr;  // the outline `reach` is for (this source's discs)
   std::vector<PupilPoint> ring_pupil;     // clipped rings' vertices, the centre first
   std::vector<std::size_t> ring_offsets;  // clipped rings: where each ring's vertices end in `pupil`
   std::vector<double> pupil_areas;
@@ -95,7 +94,7 @@ class FootprintScatter {
   const BokehOptions& options_;
   // The probe: the pupil centre and 8 points on the aperture's edge, from the top anticlockwise.
   std::array<PupilPoint, 9> probe_{};
-  std::array<double, 9> probe_length_{};  // their distances from the centre
+  PupilMeshTable::Directions probe_directions_;  // of the 8 edge points, for the discs' reach
 };
 
 }  // namespace lensmith::render_detail

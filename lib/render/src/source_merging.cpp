@@ -28,7 +28,7 @@ void merge_coarse_sources(ScatterSources& layer, int width, int height, MergeScr
   blocks.clear();
   block_of.assign(layer.size(), -1);
   for (std::size_t i = 0; i < layer.size(); ++i) {
-    const int level = std::min(level_of(layer[i]), 2);
+    const int level = level_of(layer[i]);
     if (level < 1) continue;
     const ScatterSource& s = layer[i];
     std::int32_t& slot = slot_of(s, level);
@@ -36,8 +36,6 @@ void merge_coarse_sources(ScatterSources& layer, int width, int height, MergeScr
       slot = static_cast<std::int32_t>(blocks.size());
       BlockSum b;
       b.first = i;
-      b.level = level;
-      b.coverage_only = s.coverage_only;
       blocks.push_back(b);
     }
     BlockSum& b = blocks[static_cast<std::size_t>(slot)];

@@ -22,8 +22,6 @@ namespace lensmith::render_detail {
 struct BlockSum {
   std::size_t first = 0;  // index of the first member in the layer
   int members = 0;
-  int level = 0;
-  bool coverage_only = false;
   double rgb[3] = {0.0, 0.0, 0.0};
   double coverage = 0.0;
   double inverse_depth = 0.0;  // coverage-weighted sums
