@@ -14,6 +14,7 @@
 #include "lensmith/core/errors.h"
 #include "lensmith/core/number_parsing.h"
 #include "lensmith/core/units.h"
+#include "lensmith/imageio/image_file.h"
 #include "lensmith/paraxial/paraxial_system.h"
 #include "lensmith/render/bokeh_renderer.h"
 #include "lensmith/render/image_io.h"
@@ -88,6 +89,9 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   read.highlight_gain = o.highlight_gain;
   read.highlight_threshold = o.highlight_threshold;
   read.validate();
+  if (o.threads > 0) set_image_codec_threads(o.threads);
+  // The picture, its alpha, passes and depth are often one file: decoded once, until the depth is read.
+  std::optional<ImageReadCache> read_cache(std::in_place);
   const Image image = read_radiance_image(o.image, read);
   // A transparent element (a CG layer over nothing) keeps its alpha: defocused with the same rays as
   // its (premultiplied) colour, into an RGBA OpenEXR.
@@ -177,6 +181,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   // build the same one).
   const PinholeFrame frame = PinholeFrame::from_options(image.width, image.height, camera.framing, default_focal_mm);
   const DepthMap depth = read_depth(depth_source, depth_options, frame);
+  read_cache.reset();
   if (!o.focus_pixel.empty()) {
     // X,Y: integers inside the image.
     const std::size_t comma = o.focus_pixel.find(',');

@@ -21,6 +21,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -32,6 +33,7 @@
 #include <string>
 
 #include "lensmith/core/errors.h"
+#include "lensmith/imageio/image_file.h"
 
 using Catch::Matchers::Contains;
 using Catch::Matchers::WithinAbs;
@@ -522,6 +524,47 @@ TEST_CASE("a Blender multilayer EXR: the picture, alpha and depth from its layer
   OtherChannels other = read_other_channels(exr);
   std::sort(other.names.begin(), other.names.end());
   CHECK(other.names == std::vector<std::string>{"ViewLayer.DiffCol.B", "ViewLayer.DiffCol.G", "ViewLayer.DiffCol.R", "ViewLayer.Normal.X"});
+}
+
+TEST_CASE("within an ImageReadCache a file read for picture, alpha, passes and depth gives what separate reads give",
+          "[render][image_io]") {
+  TempDir dir;
+  const std::vector<std::string> names{"R", "G", "B", "A", "Z", "N.X"};
+  Image img(4, 3, static_cast<int>(names.size()));
+  for (std::size_t i = 0; i < img.data.size(); ++i) img.data[i] = 0.25f + static_cast<float>(i);
+  for (std::size_t p = 0; p < img.pixel_count(); ++p) img.data[p * names.size() + 3] = 0.05f * static_cast<float>(p);  // alpha in [0, 1]
+  const fs::path exr = dir / "all.exr";
+  write_float_exr(exr, img, names);
+  const Image rgb = read_radiance_image(exr);
+  const auto alpha = read_alpha(exr);
+  const DepthMap depth = read_depth(DepthSource{exr, ""}, {}, small_frame());
+  const OtherChannels other = read_other_channels(exr);
+  ImageReadCache cache;
+  CHECK(read_radiance_image(exr).data == rgb.data);
+  CHECK(read_alpha(exr) == alpha);
+  CHECK(read_depth(DepthSource{exr, ""}, {}, small_frame()).z_m == depth.z_m);
+  CHECK(read_other_channels(exr).samples == other.samples);
+}
+
+TEST_CASE("an ImageReadCache decodes a file anew once it has changed, and reads nothing stale after its scope",
+          "[render][image_io]") {
+  TempDir dir;
+  const fs::path exr = dir / "changing.exr";
+  Image first(4, 3, 3);
+  std::fill(first.data.begin(), first.data.end(), 1.0f);
+  write_float_exr(exr, first, {"R", "G", "B"});
+  Image second(4, 3, 3);
+  std::fill(second.data.begin(), second.data.end(), 2.0f);
+  {
+    ImageReadCache cache;
+    CHECK(read_radiance_image(exr).at(1, 1, 0) == 1.0f);
+    // Rewritten with other contents and another modification time: the stamp differs.
+    write_float_exr(exr, second, {"R", "G", "B"});
+    fs::last_write_time(exr, fs::last_write_time(exr) + std::chrono::seconds(2));
+    CHECK(read_radiance_image(exr).at(1, 1, 0) == 2.0f);
+  }
+  write_float_exr(exr, first, {"R", "G", "B"});
+  CHECK(read_radiance_image(exr).at(1, 1, 0) == 1.0f);
 }
 
 TEST_CASE("a missing depth channel is an error listing the file's channels", "[render][image_io][depth]") {

@@ -14,14 +14,17 @@
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfPartType.h>
 #include <OpenEXR/ImfStringAttribute.h>
+#include <OpenEXR/ImfThreading.h>
 #include <OpenEXR/ImfVecAttribute.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cctype>
 #include <memory>
 #include <set>
 #include <string_view>
+#include <thread>
 
 #include "codecs.h"
 #include "lensmith/core/number_parsing.h"
@@ -153,6 +156,18 @@ std::vector<std::string> canonical_order(const Imf::ChannelList& list) {
   return out;
 }
 
+// Threads for OpenEXR's block (de)compression: -1 until set_image_codec_threads, then its count.
+std::atomic<int> codec_threads{-1};
+
+// OpenEXR's global pool sized as asked (by default, the machine's hardware threads): zlib is the
+// cost of reading and writing float images, and blocks of scanlines compress independently.
+void size_codec_pool() {
+  int wanted = codec_threads.load();
+  if (wanted < 0) wanted = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  if (wanted == 1) wanted = 0;  // the caller alone
+  if (Imf::globalThreadCount() != wanted) Imf::setGlobalThreadCount(wanted);
+}
+
 std::unique_ptr<Imf::MultiPartInputFile> open_exr(const fs::path& path) {
   try {
     return std::make_unique<Imf::MultiPartInputFile>(path.c_str());
@@ -210,6 +225,7 @@ Raster read_exr(const fs::path& path, const RasterInfo& info, std::span<const in
   const auto file = open_exr(path);
   const Imf::Header& header = file->header(0);
   if (is_deep(header)) throw ImageFileError(path.string() + ": a deep image; lensmith reads flat images only");
+  size_codec_pool();
   Raster raster;
   raster.width = info.width;
   raster.height = info.height;
@@ -289,6 +305,7 @@ void write_exr_file(const fs::path& path, const std::string& file, const PixelsV
       throw OptionsError(path.string() + ": channel name '" + name + "' is empty or repeated: each channel needs its own name");
     }
   }
+  size_codec_pool();
   try {
     Imf::Header header(pixels.width, pixels.height);
     header.compression() = Imf::ZIP_COMPRESSION;
@@ -318,3 +335,9 @@ void write_exr_file(const fs::path& path, const std::string& file, const PixelsV
 }
 
 }  // namespace lensmith::codecs
+
+namespace lensmith {
+
+void set_image_codec_threads(int threads) { codecs::codec_threads.store(std::max(0, threads)); }
+
+}  // namespace lensmith

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string_view>
 
 #include "codecs.h"
@@ -121,15 +122,21 @@ RasterInfo read_raster_info(const fs::path& path) {
   throw IoError(path.string() + ": unknown image format");
 }
 
-Raster read_raster(const fs::path& path, const RasterInfo& info, std::span<const int> channels) {
-  for (const int c : channels) {
-    if (c < 0 || static_cast<std::size_t>(c) >= info.channels.size()) {
-      throw OptionsError(path.string() + ": channel index " + std::to_string(c) + " outside the file's " +
-                         std::to_string(info.channels.size()) + " channels");
-    }
-  }
-  if (info.format == ImageFormat::Exr) return codecs::read_exr(path, info, channels);
+namespace {
+
+// The cache read_raster uses on this thread, if any (innermost ImageReadCache).
+thread_local ImageReadCache* current_read_cache = nullptr;
+
+// Every channel of the file, decoded.
+codecs::Decoded decode_all(const fs::path& path, const RasterInfo& info) {
   codecs::Decoded decoded;
+  if (info.format == ImageFormat::Exr) {
+    std::vector<int> all(info.channels.size());
+    for (std::size_t c = 0; c < all.size(); ++c) all[c] = static_cast<int>(c);
+    decoded.info = info;
+    decoded.samples = codecs::read_exr(path, info, all).samples;
+    return decoded;
+  }
   switch (info.format) {
     case ImageFormat::Tiff: decoded = codecs::read_tiff(path); break;
     case ImageFormat::Pfm: decoded = codecs::read_pfm(path); break;
@@ -140,7 +147,62 @@ Raster read_raster(const fs::path& path, const RasterInfo& info, std::span<const
     throw IoError(path.string() + ": the file changed while it was read (" + info.to_string() + ", then " +
                   decoded.info.to_string() + ")");
   }
-  return codecs::select_channels(decoded, channels);
+  return decoded;
+}
+
+// What identifies a file's contents for the cache: its path, size and modification time.
+struct FileStamp {
+  std::string path;
+  std::uintmax_t bytes = 0;
+  fs::file_time_type modified{};
+  bool operator==(const FileStamp&) const = default;
+};
+
+std::optional<FileStamp> stamp_of(const fs::path& path) {
+  std::error_code ec;
+  FileStamp stamp;
+  stamp.path = fs::absolute(path, ec).lexically_normal().string();
+  if (ec) return std::nullopt;
+  stamp.bytes = fs::file_size(path, ec);
+  if (ec) return std::nullopt;
+  stamp.modified = fs::last_write_time(path, ec);
+  if (ec) return std::nullopt;
+  return stamp;
+}
+
+}  // namespace
+
+struct ImageReadCache::Entry {
+  FileStamp stamp;
+  codecs::Decoded decoded;
+};
+
+ImageReadCache::ImageReadCache() : previous_(current_read_cache) { current_read_cache = this; }
+
+ImageReadCache::~ImageReadCache() { current_read_cache = previous_; }
+
+Raster read_raster(const fs::path& path, const RasterInfo& info, std::span<const int> channels) {
+  for (const int c : channels) {
+    if (c < 0 || static_cast<std::size_t>(c) >= info.channels.size()) {
+      throw OptionsError(path.string() + ": channel index " + std::to_string(c) + " outside the file's " +
+                         std::to_string(info.channels.size()) + " channels");
+    }
+  }
+  ImageReadCache* cache = current_read_cache;
+  const std::optional<FileStamp> stamp = cache ? stamp_of(path) : std::nullopt;
+  if (!stamp) {
+    // Without a cache only the channels asked for are converted (OpenEXR decompresses them all anyway).
+    if (info.format == ImageFormat::Exr) return codecs::read_exr(path, info, channels);
+    return codecs::select_channels(decode_all(path, info), channels);
+  }
+  for (const ImageReadCache::Entry& entry : cache->entries_) {
+    if (entry.stamp == *stamp && entry.decoded.info.width == info.width && entry.decoded.info.height == info.height &&
+        entry.decoded.info.channels.size() == info.channels.size()) {
+      return codecs::select_channels(entry.decoded, channels);
+    }
+  }
+  cache->entries_.push_back({*stamp, decode_all(path, info)});
+  return codecs::select_channels(cache->entries_.back().decoded, channels);
 }
 
 std::vector<std::pair<std::string, std::string>> read_image_metadata_pairs(const fs::path& path) {

@@ -91,14 +91,17 @@ Image render(const Image& image, const DepthMap& depth, const RayModel& model, c
   // Per thread, its splat buffers, kept from band to band and layer to layer.
   std::vector<BandBuffers> pools(static_cast<std::size_t>(threads));
   // A layer's sources and their plans, kept from layer to layer (their memory is faulted in once).
+  // Address space for the largest a layer can be (all sources and as many hidden ones), reserved
+  // once: only what a layer touches is faulted in, and no layer copies it to grow.
   ScatterSources layer;
+  layer.reserve(sources.size() + static_cast<std::size_t>(w) * h);
   LargeVector<FootprintPlan> plans;
+  plans.reserve(layer.capacity());
   render_detail::MergeScratch merge_scratch;
 
   for (int l = 0; l < layers.count; ++l) {
     const auto u = static_cast<std::size_t>(l);
     layer.clear();
-    layer.reserve(layers.members[u].size());
     for (int i : layers.members[u]) layer.push_back(sources[static_cast<std::size_t>(i)]);
     const double hidden_blur = layers.max_blur_px[u] + layers.nearer_blur_px[u];
     if (!layer.empty() && l + 1 < layers.count && hidden_blur >= kMinHiddenBlurPx) {
@@ -113,7 +116,6 @@ Image render(const Image& image, const DepthMap& depth, const RayModel& model, c
     // Level of detail: sources whose footprints go to a coarse grid, merged by its cells.
     render_detail::merge_coarse_sources(layer, w, h, merge_scratch);
 
-    // Footprint extents and sample counts.
     plans.resize(layer.size());
 #pragma omp parallel num_threads(threads)
     {

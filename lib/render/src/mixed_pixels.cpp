@@ -202,6 +202,8 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
         ++changes;
       }
     }
+    // One growth for all the split pixels' second parts (none while the reserve lasts).
+    if (sources.capacity() < sources.size() + changes) sources.reserve(sources.size() + changes);
     for (const auto& row : rows) {
       for (const auto& [i, d] : row) apply(sources, i, d, camera, stats);
     }

@@ -34,7 +34,13 @@ double clamp_inverse_depth(const Camera& camera, double w, double max_blur_px, s
 ScatterSources make_scatter_sources(const Image& image, const DepthMap& depth, const Camera& camera,
                                                 const BokehOptions& options, int threads, BokehStatistics& stats) {
   const int w = image.width, h = image.height;
-  ScatterSources sources(static_cast<std::size_t>(w) * h);
+  // Room for the second parts of split edge pixels (mixed_pixels), so that they are appended
+  // without a copy of the frame's sources: reserved address space costs nothing until touched, and
+  // on a virtual machine touching fresh memory is what costs (docs/performance.md).
+  const std::size_t pixels = static_cast<std::size_t>(w) * h;
+  ScatterSources sources;
+  sources.reserve(pixels + pixels / 4);
+  sources.resize(pixels);
   std::size_t clamped = 0;
   double coc_min = kInfinity, coc_max = -kInfinity;
 #pragma omp parallel for num_threads(threads) schedule(static) reduction(+ : clamped) reduction(min : coc_min) reduction(max : coc_max)

@@ -39,6 +39,31 @@ RasterInfo read_raster_info(const std::filesystem::path& path);
 // when decoding fails, OptionsError for an index out of range.
 Raster read_raster(const std::filesystem::path& path, const RasterInfo& info, std::span<const int> channels);
 
+// While one lives on a thread, read_raster on that thread decodes each file once and serves later
+// reads of it (other channels of the same file) from the decoded samples. A render's inputs are
+// often one OpenEXR file read for its colour, alpha, passes and depth, and every read decompresses
+// all of a file's channels: on bench/blender's 600 x 400 scenes four reads took about 0.08 s, one
+// takes 0.02 s. A file is known by its path, size and modification time. Scoped, so that the
+// decoded samples do not outlive the reading of the inputs.
+class ImageReadCache {
+ public:
+  ImageReadCache();
+  ~ImageReadCache();
+  ImageReadCache(const ImageReadCache&) = delete;
+  ImageReadCache& operator=(const ImageReadCache&) = delete;
+
+  struct Entry;
+
+ private:
+  ImageReadCache* previous_;
+  std::vector<Entry> entries_;
+  friend Raster read_raster(const std::filesystem::path& path, const RasterInfo& info, std::span<const int> channels);
+};
+
+// Threads the OpenEXR codec may use to decompress and compress blocks of scanlines (0: none besides
+// the caller; the default is the machine's hardware threads). Process-wide, as OpenEXR's pool is.
+void set_image_codec_threads(int threads);
+
 // The metadata of a picture file as (name, value) text, under the names OpenImageIO used:
 // OpenEXR attributes (comments as ImageDescription, capDate as DateTime, owner as Copyright, the
 // compression as "compression"; strings as stored, floats and doubles in the shortest text that
@@ -67,7 +92,7 @@ struct PixelsView {
 
 // Writers. Each takes the final path, writes atomically, and throws IoError naming `path` when the
 // file cannot be written, OptionsError when the view's sizes do not match its samples.
-// OpenEXR, 32-bit float, ZIP compression, one channel per name; every attribute (ImageDescription
+// OpenEXR, 32-bit float, ZIP compression (16 scanlines a block), one channel per name; every attribute (ImageDescription
 // stored as the standard "comments", DateTime as "capDate").
 void write_exr(const std::filesystem::path& path, const PixelsView<float>& pixels, const std::vector<std::string>& channel_names,
                const std::vector<ImageAttribute>& attributes);
