@@ -14,9 +14,11 @@
 #include "lensmith/core/errors.h"
 #include "lensmith/core/number_parsing.h"
 #include "lensmith/core/units.h"
+#include "lensmith/imageio/deep_raster.h"
 #include "lensmith/imageio/image_file.h"
 #include "lensmith/paraxial/paraxial_system.h"
 #include "lensmith/render/bokeh_renderer.h"
+#include "lensmith/render/deep_image.h"
 #include "lensmith/render/image_io.h"
 
 namespace lensmith::cli {
@@ -92,10 +94,33 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   if (o.threads > 0) set_image_codec_threads(o.threads);
   // The picture, its alpha, passes and depth are often one file: decoded once, until the depth is read.
   std::optional<ImageReadCache> read_cache(std::in_place);
-  const Image image = read_radiance_image(o.image, read);
+  // A deep OpenEXR is layered input: its samples carry colour, alpha and depth together.
+  const bool layered = is_deep_picture(o.image);
+  if (layered && !o.depth.empty()) {
+    throw UsageError(o.image + " is a deep image, whose samples carry their own Z: --depth is for flat pictures");
+  }
+  std::optional<Image> flat;
+  int width = 0, height = 0;
+  if (layered) {
+    const DeepRaster header = read_deep_header(o.image);
+    width = header.width;
+    height = header.height;
+    std::vector<std::string> unused;
+    for (const std::string& name : header.channels) {
+      if (name != "R" && name != "G" && name != "B" && name != "A" && name != "Z" && name != "ZBack") unused.push_back(name);
+    }
+    if (!unused.empty() && !global.quiet) {
+      std::cerr << "note: " << o.image << " is deep; its channels besides R, G, B, A, Z and ZBack (" << unused.size()
+                << ", e.g. " << unused.front() << ") are not read\n";
+    }
+  } else {
+    flat = read_radiance_image(o.image, read);
+    width = flat->width;
+    height = flat->height;
+  }
   // A transparent element (a CG layer over nothing) keeps its alpha: defocused with the same rays as
   // its (premultiplied) colour, into an RGBA OpenEXR.
-  std::optional<std::vector<float>> alpha = read_alpha(o.image);
+  std::optional<std::vector<float>> alpha = layered ? std::nullopt : read_alpha(o.image);
   if (alpha && !output_keeps_alpha(output)) {
     if (!global.quiet) std::cerr << "note: " << o.image << " has alpha; only an OpenEXR output (.exr) keeps it, " << output.string() << " gets RGB\n";
     alpha.reset();
@@ -103,7 +128,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
 
   // Render passes (AOVs) of an EXR input: kept in focus as Nuke's defocus nodes leave the channels
   // they do not process, defocused with the picture's rays, or dropped.
-  OtherChannels other = o.other_channels == "drop" ? OtherChannels{} : read_other_channels(o.image);
+  OtherChannels other = o.other_channels == "drop" || layered ? OtherChannels{} : read_other_channels(o.image);
   if (!other.names.empty() && !output_keeps_alpha(output)) {
     if (!global.quiet) {
       std::cerr << "note: " << o.image << " has " << other.names.size() << " other channels; only an OpenEXR output (.exr) keeps them\n";
@@ -114,7 +139,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   // input's, and said as such.
   for (std::size_t i = 0; i < other.samples.size(); ++i) {
     if (std::isfinite(other.samples[i])) continue;
-    const std::size_t pixel = i / other.names.size(), w = static_cast<std::size_t>(image.width);
+    const std::size_t pixel = i / other.names.size(), w = static_cast<std::size_t>(width);
     throw ImageFileError(o.image + ": channel " + other.names[i % other.names.size()] + " at pixel (" + std::to_string(pixel % w) + ", " +
                          std::to_string(pixel / w) + ") is " + format_number(other.samples[i]) +
                          ": the passes written beside the picture must be finite (--other-channels drop leaves them out)");
@@ -179,17 +204,20 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   depth_options.invalid = parse_invalid_depth(o.invalid_depth);
   // The camera's framing is the pinhole frame the depth is read in (Camera::from_lens and thin_lens
   // build the same one).
-  const PinholeFrame frame = PinholeFrame::from_options(image.width, image.height, camera.framing, default_focal_mm);
-  const DepthMap depth = read_depth(depth_source, depth_options, frame);
+  const PinholeFrame frame = PinholeFrame::from_options(width, height, camera.framing, default_focal_mm);
+  std::optional<DeepImage> deep;
+  if (layered) deep = read_deep_image(o.image, depth_options, frame);
+  // A layered input's depth per pixel is its front sample's (for --focus-pixel and --keep-depth).
+  const DepthMap depth = layered ? deep->front_depth() : read_depth(depth_source, depth_options, frame);
   read_cache.reset();
   if (!o.focus_pixel.empty()) {
     // X,Y: integers inside the image.
     const std::size_t comma = o.focus_pixel.find(',');
     const std::optional<double> x = comma == std::string::npos ? std::nullopt : parse_finite_number(o.focus_pixel.substr(0, comma));
     const std::optional<double> y = comma == std::string::npos ? std::nullopt : parse_finite_number(o.focus_pixel.substr(comma + 1));
-    if (!x || !y || *x != std::floor(*x) || *y != std::floor(*y) || *x < 0 || *y < 0 || *x >= image.width || *y >= image.height) {
-      throw UsageError("--focus-pixel " + o.focus_pixel + ": expected X,Y, whole pixels inside the " + std::to_string(image.width) +
-                       " x " + std::to_string(image.height) + " image (0,0 = top left)");
+    if (!x || !y || *x != std::floor(*x) || *y != std::floor(*y) || *x < 0 || *y < 0 || *x >= width || *y >= height) {
+      throw UsageError("--focus-pixel " + o.focus_pixel + ": expected X,Y, whole pixels inside the " + std::to_string(width) +
+                       " x " + std::to_string(height) + " image (0,0 = top left)");
     }
     const float z = depth.at(static_cast<int>(*x), static_cast<int>(*y));
     camera.focus_distance_m = z;
@@ -199,18 +227,21 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   }
   std::optional<Camera> cam;
   if (o.thin_lens) {
-    cam = Camera::thin_lens(*o.focal_length_mm, camera, image.width, image.height);
+    cam = Camera::thin_lens(*o.focal_length_mm, camera, width, height);
   } else if (kind == RayModelKind::Thin) {
     // The ideal thin lens with this lens's focal length and f-number.
     const ParaxialSystem p(*lens);
     if (!camera.f_number) camera.f_number = p.f_number();
-    cam = Camera::thin_lens(p.efl_mm(), camera, image.width, image.height);
+    cam = Camera::thin_lens(p.efl_mm(), camera, width, height);
   } else {
-    cam = Camera::from_lens(*lens, camera, image.width, image.height);
+    cam = Camera::from_lens(*lens, camera, width, height);
     warn_about_aperture(*cam, global);
   }
   float nearest_m = std::numeric_limits<float>::infinity();
   for (float z : depth.z_m) nearest_m = std::min(nearest_m, z);
+  if (layered) {
+    for (const DeepSample& sample : deep->samples) nearest_m = std::min(nearest_m, sample.z_m);
+  }
   RayModelOptions model_options;
   model_options.nearest_depth_m = std::isfinite(nearest_m) ? std::max(0.01, static_cast<double>(nearest_m)) : 1.0;
   model_options.seidel_coefficients = parse_seidel_coefficients(o.seidel_coefficients);
@@ -234,8 +265,21 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   options.progress = [&bar](double f) { bar.update(f); };
   BokehStatistics stats;
   const auto render_started = std::chrono::steady_clock::now();
-  Image out = render_bokeh(image, depth, *model, aperture, options, &stats);
-  if (alpha) {
+  Image out = layered ? render_bokeh(*deep, *model, aperture, options, &stats) : render_bokeh(*flat, depth, *model, aperture, options, &stats);
+  if (layered && output_keeps_alpha(output) && deep->max_transparency() > 1e-4) {
+    // Alpha through the same rays: the samples' alphas as their colour (premultiplied: alpha times
+    // one), without vignetting, as for a flat picture's alpha below.
+    DeepImage coverage_image = *deep;
+    for (DeepSample& sample : coverage_image.samples) sample.rgb = {sample.alpha, sample.alpha, sample.alpha};
+    BokehOptions coverage = options;
+    coverage.vignetting = false;
+    coverage.spectral = false;
+    coverage.progress = nullptr;
+    const Image a = render_bokeh(coverage_image, *model, aperture, coverage);
+    std::vector<float> channel(a.pixel_count());
+    for (std::size_t i = 0; i < channel.size(); ++i) channel[i] = std::clamp(a.data[i * 3], 0.0f, 1.0f);
+    out = with_channels(out, channel, 1);
+  } else if (alpha) {
     // Alpha through the same model without vignetting (an opaque surface stays opaque however little
     // light the lens takes from it).
     BokehOptions coverage = options;
@@ -285,8 +329,14 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
        << " aperture\n  " << stats.layers << " depth layers " << format_rounded(stats.layer_spacing_px, 3) << " px apart, largest blur "
        << format_rounded(stats.max_abs_coc_px, 3) << " px; " << stats.footprints << " footprints";
   if (stats.triangles > 0) what << " (" << stats.triangles << " triangles)";
-  what << "; " << stats.hidden_sources << " hidden background pixels filled in, " << stats.split_edge_pixels
-       << " edge pixels split between two surfaces";
+  if (layered) {
+    what << "; layered input: " << stats.deep_samples << " deep samples";
+    if (stats.volume_slabs > 0) what << " (volumes cut into " << stats.volume_slabs << " slabs)";
+    what << ", " << stats.hidden_sources << " hidden background pixels filled in where the file has none";
+  } else {
+    what << "; " << stats.hidden_sources << " hidden background pixels filled in, " << stats.split_edge_pixels
+         << " edge pixels split between two surfaces";
+  }
   if (stats.clamped_depths > 0) what << "; " << stats.clamped_depths << " pixels nearer than the lens serves (or beyond --max-blur) clamped";
   report_written(what.str(), global);
   return kExitOk;

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "deep_exr_writer.h"
 #include "lensmith/render/image_io.h"
 #include "run_lensmith.h"
 
@@ -162,6 +163,40 @@ TEST_CASE("lensmith bokeh keeps an RGBA input's alpha, defocused with its colour
                                 scratch("element.png").string());
   CHECK(png.exit_code == 0);
   CHECK(png.err.find("only an OpenEXR output") != std::string::npos);
+}
+
+TEST_CASE("lensmith bokeh reads a deep OpenEXR as layered input: a CG element over nothing keeps its alpha, empty pixels stay empty",
+          "[cli][bokeh][deep]") {
+  // The element of the test above as a deep image: one opaque sample per pixel of the square, no
+  // samples elsewhere (as renderers write an element over nothing).
+  const int w = 64, h = 48;
+  std::vector<std::vector<std::vector<float>>> pixels(static_cast<std::size_t>(w * h));
+  for (int y = 16; y < 32; ++y) {
+    for (int x = 24; x < 40; ++x) pixels[static_cast<std::size_t>(y * w + x)] = {{1.0f, 0.5f, 0.5f, 0.5f, 2.0f}};  // A, B, G, R, Z
+  }
+  const fs::path in = scratch("element-deep.exr");
+  lensmith::testing::write_deep_exr(in, w, h, {"A", "B", "G", "R", "Z"}, pixels);
+  const fs::path out = scratch("element-deep-out.exr");
+  const auto r = run_lensmith("bokeh --image " + in.string() + " --thin-lens --focal-length 50 --fstop 1.4 --focus 0.5 -o " + out.string());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.err.find("layered input: 256 deep samples") != std::string::npos);
+  const auto alpha = lensmith::read_alpha(out);
+  REQUIRE(alpha.has_value());
+  double total = 0.0;
+  for (float a : *alpha) total += a;
+  CHECK(total == Approx(256.0).epsilon(0.02));  // the scatter keeps the coverage; nothing reaches the frame's edge
+  CHECK((*alpha)[0] == Approx(0.0).margin(1e-4));
+  CHECK((*alpha)[static_cast<std::size_t>(24 * w + 22)] > 0.05);  // spread 2 px beyond the square's edge
+  // The colour is the flat element's, premultiplied over black: 0.5 inside, alpha times 0.5 at the rim.
+  const lensmith::Image rgb = lensmith::read_radiance_image(out);
+  CHECK(rgb.at(32, 24, 0) == Approx(0.5).margin(0.01));
+  CHECK(rgb.at(22, 24, 0) == Approx(0.5 * (*alpha)[static_cast<std::size_t>(24 * w + 22)]).margin(0.01));
+  // A deep image carries its own depth.
+  const auto with_depth = run_lensmith("bokeh --image " + in.string() + " --depth " + in.string() +
+                                       " --thin-lens --focal-length 50 --focus 2 -o " + scratch("x.exr").string());
+  CHECK(with_depth.exit_code == 2);
+  CHECK(with_depth.err.find("is a deep image, whose samples carry their own Z") != std::string::npos);
 }
 
 TEST_CASE("lensmith bokeh passes an EXR's other channels through: kept in focus, defocused with the picture, or dropped",

@@ -3,6 +3,9 @@
 // branch in read_exr that opens Imf::DeepScanLineInputPart / DeepTiledInputPart on the same file.
 // Attribute names follow OpenImageIO's mapping (comments <-> ImageDescription, ...).
 #include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfDeepFrameBuffer.h>
+#include <OpenEXR/ImfDeepScanLineInputPart.h>
+#include <OpenEXR/ImfDeepTiledInputPart.h>
 #include <OpenEXR/ImfCompressionAttribute.h>
 #include <OpenEXR/ImfDoubleAttribute.h>
 #include <OpenEXR/ImfFloatAttribute.h>
@@ -22,11 +25,13 @@
 #include <atomic>
 #include <cctype>
 #include <memory>
+#include <fstream>
 #include <set>
 #include <string_view>
 #include <thread>
 
 #include "codecs.h"
+#include "lensmith/imageio/deep_raster.h"
 #include "lensmith/core/number_parsing.h"
 
 namespace lensmith::codecs {
@@ -168,7 +173,92 @@ void size_codec_pool() {
   if (Imf::globalThreadCount() != wanted) Imf::setGlobalThreadCount(wanted);
 }
 
+// The bytes OpenEXR 3.1 reads for the value of an attribute of a fixed-size type whatever its size
+// field says (TypedAttribute::readValueFrom reads the type), 0 for the types it reads by size.
+std::size_t fixed_value_bytes(std::string_view type) {
+  static constexpr std::array<std::pair<std::string_view, std::size_t>, 24> kFixed{{
+      {"box2i", 16}, {"box2f", 16}, {"compression", 1}, {"lineOrder", 1}, {"envmap", 1}, {"deepImageState", 1},
+      {"float", 4}, {"double", 8}, {"int", 4}, {"rational", 8}, {"timecode", 8}, {"keycode", 28},
+      {"tiledesc", 9}, {"v2i", 8}, {"v2f", 8}, {"v2d", 16}, {"v3i", 12}, {"v3f", 12},
+      {"v3d", 24}, {"m33f", 36}, {"m33d", 72}, {"m44f", 64}, {"m44d", 128}, {"chromaticities", 32},
+  }};
+  for (const auto& [name, bytes] : kFixed) {
+    if (name == type) return bytes;
+  }
+  return 0;
+}
+
+// The headers' attribute sizes against the file's length, walked as OpenEXR 3.1's Header::readFrom
+// walks them, before OpenEXR reads them: it allocates what a string, opaque or preview attribute
+// claims before reading it, so a damaged header claiming 2 GB took 2 GB (found by tests/fuzz's
+// exr_image target). Layout from the OpenEXR file layout document: magic and version (8 bytes),
+// then per part a header of attributes (name, type, 32-bit little-endian size, value) ended by an
+// empty name; a multi-part file ends its headers with one more empty name. Where the walk cannot
+// follow, OpenEXR's own checks decide.
+void check_header_sizes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::error_code ec;
+  const std::uintmax_t length = fs::file_size(path, ec);
+  if (!in || ec) return;
+  char start[8];
+  if (!in.read(start, 8)) return;
+  const bool multipart = (static_cast<unsigned char>(start[5]) & 0x10) != 0;
+  auto read_name = [&](std::string& name) {
+    name.clear();
+    for (char c; in.get(c);) {
+      if (c == '\0') return true;
+      if (name.size() >= 255) return false;
+      name += c;
+    }
+    return false;
+  };
+  auto read_u32 = [&](std::uint32_t& v) {
+    unsigned char b[4];
+    if (!in.read(reinterpret_cast<char*>(b), 4)) return false;
+    v = b[0] | (b[1] << 8) | (b[2] << 16) | (static_cast<std::uint32_t>(b[3]) << 24);
+    return true;
+  };
+  auto remaining = [&]() {
+    const auto at = static_cast<std::uintmax_t>(in.tellg());
+    return at <= length ? length - at : 0;
+  };
+  auto too_big = [&](const std::string& name, std::uintmax_t claim) {
+    throw IoError(path.string() + ": cannot read the OpenEXR image: header attribute '" + name + "' claims " + std::to_string(claim) +
+                  " bytes, more than the " + std::to_string(remaining()) + " left in the file (a damaged file)");
+  };
+  for (int part = 0; part < 1 << 16; ++part) {
+    std::string name, type;
+    int attributes = 0;
+    while (true) {
+      if (!read_name(name)) return;
+      if (name.empty()) break;
+      std::uint32_t size = 0;
+      if (!read_name(type) || !read_u32(size) || size > 0x7fffffffu) return;
+      if (const std::size_t fixed = fixed_value_bytes(type); fixed > 0) {
+        in.seekg(static_cast<std::streamoff>(fixed), std::ios::cur);
+      } else if (type == "chlist") {
+        // Channels until an empty name, each a name and 16 bytes.
+        std::string channel;
+        while (read_name(channel) && !channel.empty()) in.seekg(16, std::ios::cur);
+      } else if (type == "preview") {
+        std::uint32_t w = 0, h = 0;
+        if (!read_u32(w) || !read_u32(h)) return;
+        const std::uintmax_t bytes = std::uintmax_t{4} * w * h;
+        if (bytes > remaining()) too_big(name, bytes);
+        in.seekg(static_cast<std::streamoff>(bytes), std::ios::cur);
+      } else {
+        if (size > remaining()) too_big(name, size);
+        in.seekg(static_cast<std::streamoff>(size), std::ios::cur);
+      }
+      if (!in) return;
+      ++attributes;
+    }
+    if (!multipart || attributes == 0) return;
+  }
+}
+
 std::unique_ptr<Imf::MultiPartInputFile> open_exr(const fs::path& path) {
+  check_header_sizes(path);
   try {
     return std::make_unique<Imf::MultiPartInputFile>(path.c_str());
   } catch (const std::exception& e) {
@@ -178,10 +268,38 @@ std::unique_ptr<Imf::MultiPartInputFile> open_exr(const fs::path& path) {
 
 bool is_deep(const Imf::Header& header) { return header.hasType() && Imf::isDeepData(header.type()); }
 
-RasterInfo info_from_header(const fs::path& path, const Imf::Header& header) {
-  if (is_deep(header)) throw ImageFileError(path.string() + ": a deep image; lensmith reads flat images only");
+// The data window, which must be the display window: a crop or overscan would shift the picture
+// against the pinhole frame, centred on the pixels read.
+void check_windows(const fs::path& path, const Imf::Header& header) {
   const Imath::Box2i data = header.dataWindow();
   const Imath::Box2i display = header.displayWindow();
+  if (data == display) return;
+  const int width = data.max.x - data.min.x + 1, height = data.max.y - data.min.y + 1;
+  const int full_width = display.max.x - display.min.x + 1;
+  const int full_height = display.max.y - display.min.y + 1;
+  throw ImageFileError(path.string() + ": data window " + std::to_string(width) + " x " + std::to_string(height) +
+                       " at (" + std::to_string(data.min.x) + ", " + std::to_string(data.min.y) +
+                       ") differs from the display window " + std::to_string(full_width) + " x " +
+                       std::to_string(full_height) + " at (" + std::to_string(display.min.x) + ", " +
+                       std::to_string(display.min.y) + "): render or save the image without a crop or overscan");
+}
+
+// Pictures of more than kMaxImagePixels: a header's claim that no picture needs (and that would
+// take all memory to decode) is refused before anything is allocated.
+constexpr long long kMaxImagePixels = 1LL << 28;  // 16384 x 16384
+void check_size(const fs::path& path, int width, int height) {
+  if (static_cast<long long>(width) * height > kMaxImagePixels) {
+    throw ImageFileError(path.string() + ": " + std::to_string(width) + " x " + std::to_string(height) +
+                         " pixels, more than lensmith reads (" + std::to_string(kMaxImagePixels) + " pixels)");
+  }
+}
+
+RasterInfo info_from_header(const fs::path& path, const Imf::Header& header) {
+  if (is_deep(header)) {
+    throw ImageFileError(path.string() + ": a deep image; lensmith bokeh reads it as layered input (--image), "
+                         "elsewhere lensmith reads flat images only (flatten it first, e.g. oiiotool --flatten)");
+  }
+  const Imath::Box2i data = header.dataWindow();
   RasterInfo info;
   info.format = ImageFormat::Exr;
   info.width = data.max.x - data.min.x + 1;
@@ -192,16 +310,8 @@ RasterInfo info_from_header(const fs::path& path, const Imf::Header& header) {
     throw ImageFileError(path.string() + ": image of " + std::to_string(info.width) + " x " + std::to_string(info.height) +
                          " pixels and no channels: not a 2-D picture");
   }
-  // A crop or overscan would shift the picture against the pinhole frame, centred on the pixels read.
-  if (data != display) {
-    const int full_width = display.max.x - display.min.x + 1;
-    const int full_height = display.max.y - display.min.y + 1;
-    throw ImageFileError(path.string() + ": data window " + std::to_string(info.width) + " x " + std::to_string(info.height) +
-                         " at (" + std::to_string(data.min.x) + ", " + std::to_string(data.min.y) +
-                         ") differs from the display window " + std::to_string(full_width) + " x " +
-                         std::to_string(full_height) + " at (" + std::to_string(display.min.x) + ", " +
-                         std::to_string(display.min.y) + "): render or save the image without a crop or overscan");
-  }
+  check_windows(path, header);
+  check_size(path, info.width, info.height);
   for (const std::string& name : canonical_order(header.channels())) {
     const Imf::Channel& channel = header.channels()[name];
     if (channel.xSampling != 1 || channel.ySampling != 1) {
@@ -339,5 +449,113 @@ void write_exr_file(const fs::path& path, const std::string& file, const PixelsV
 namespace lensmith {
 
 void set_image_codec_threads(int threads) { codecs::codec_threads.store(std::max(0, threads)); }
+
+int DeepRaster::channel_index(std::string_view name) const {
+  for (std::size_t i = 0; i < channels.size(); ++i) {
+    if (channels[i] == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+std::string DeepRaster::to_string() const {
+  std::string names;
+  for (std::size_t i = 0; i < channels.size(); ++i) names += (i ? ", " : "") + channels[i];
+  return "deep " + std::to_string(width) + " x " + std::to_string(height) + ", channels " + names + ", " +
+         std::to_string(sample_count()) + " samples";
+}
+
+bool is_deep_image(const std::filesystem::path& path) {
+  if (detect_image_format(path) != ImageFormat::Exr) return false;
+  const auto file = codecs::open_exr(path);
+  return codecs::is_deep(file->header(0));
+}
+
+namespace {
+
+DeepRaster deep_header(const std::filesystem::path& path, const Imf::Header& header) {
+  if (!codecs::is_deep(header)) throw ImageFileError(path.string() + ": not a deep image (its samples are flat)");
+  codecs::check_windows(path, header);
+  const Imath::Box2i window = header.dataWindow();
+  DeepRaster raster;
+  raster.width = window.max.x - window.min.x + 1;
+  raster.height = window.max.y - window.min.y + 1;
+  raster.channels = codecs::canonical_order(header.channels());
+  codecs::check_size(path, raster.width, raster.height);
+  if (raster.width < 1 || raster.height < 1 || raster.channels.empty()) {
+    throw ImageFileError(path.string() + ": deep image of " + std::to_string(raster.width) + " x " + std::to_string(raster.height) +
+                         " pixels and no channels: not a 2-D picture");
+  }
+  for (const std::string& name : raster.channels) {
+    const Imf::Channel& channel = header.channels()[name];
+    if (channel.xSampling != 1 || channel.ySampling != 1) {
+      throw ImageFileError(path.string() + ": channel " + name + " is subsampled; lensmith reads channels with a sample in every pixel");
+    }
+  }
+  return raster;
+}
+
+}  // namespace
+
+DeepRaster read_deep_header(const std::filesystem::path& path) {
+  const auto file = codecs::open_exr(path);
+  return deep_header(path, file->header(0));
+}
+
+DeepRaster read_deep_raster(const std::filesystem::path& path, std::uint64_t max_samples) {
+  const auto file = codecs::open_exr(path);
+  const Imf::Header& header = file->header(0);
+  DeepRaster raster = deep_header(path, header);
+  codecs::size_codec_pool();
+  const Imath::Box2i window = header.dataWindow();
+  const auto w = static_cast<std::size_t>(raster.width), h = static_cast<std::size_t>(raster.height);
+  const std::size_t nc = raster.channels.size();
+  // OpenEXR addresses the frame buffer from the data window's origin: base pointers are offset back
+  // to pixel (0, 0) of the window's coordinates.
+  const std::ptrdiff_t origin = static_cast<std::ptrdiff_t>(window.min.y) * static_cast<std::ptrdiff_t>(w) + window.min.x;
+  std::vector<unsigned int> counts(w * h, 0);
+  std::vector<float*> pointers(w * h * nc, nullptr);
+  Imf::DeepFrameBuffer frame;
+  frame.insertSampleCountSlice(Imf::Slice(Imf::UINT, reinterpret_cast<char*>(counts.data() - origin), sizeof(unsigned int),
+                                          w * sizeof(unsigned int)));
+  for (std::size_t c = 0; c < nc; ++c) {
+    // Pointer per pixel in pointers[(p * nc) + c]; a sample's channels are adjacent in `samples`.
+    frame.insert(raster.channels[c], Imf::DeepSlice(Imf::FLOAT, reinterpret_cast<char*>(pointers.data() + c - origin * static_cast<std::ptrdiff_t>(nc)),
+                                                    nc * sizeof(float*), w * nc * sizeof(float*), nc * sizeof(float)));
+  }
+  auto allocate = [&]() {
+    raster.first_sample.assign(w * h + 1, 0);
+    for (std::size_t p = 0; p < w * h; ++p) raster.first_sample[p + 1] = raster.first_sample[p] + counts[p];
+    if (raster.sample_count() > max_samples) {
+      throw ImageFileError(path.string() + ": " + std::to_string(raster.sample_count()) + " deep samples, more than lensmith reads (" +
+                           std::to_string(max_samples) + ")");
+    }
+    raster.samples.assign(raster.sample_count() * nc, 0.0f);
+    for (std::size_t p = 0; p < w * h; ++p) {
+      for (std::size_t c = 0; c < nc; ++c) {
+        pointers[p * nc + c] = counts[p] ? raster.samples.data() + raster.first_sample[p] * nc + c : nullptr;
+      }
+    }
+  };
+  try {
+    if (header.type() == Imf::DEEPTILE) {
+      Imf::DeepTiledInputPart part(*file, 0);
+      part.setFrameBuffer(frame);
+      part.readPixelSampleCounts(0, part.numXTiles(0) - 1, 0, part.numYTiles(0) - 1);
+      allocate();
+      part.readTiles(0, part.numXTiles(0) - 1, 0, part.numYTiles(0) - 1);
+    } else {
+      Imf::DeepScanLineInputPart part(*file, 0);
+      part.setFrameBuffer(frame);
+      part.readPixelSampleCounts(window.min.y, window.max.y);
+      allocate();
+      part.readPixels(window.min.y, window.max.y);
+    }
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw IoError(path.string() + ": cannot read the deep OpenEXR pixels: " + e.what());
+  }
+  return raster;
+}
 
 }  // namespace lensmith

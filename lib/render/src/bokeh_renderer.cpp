@@ -24,6 +24,7 @@
 #include "lensmith/core/errors.h"
 #include "lensmith/core/number_parsing.h"
 #include "lensmith/core/units.h"
+#include "lensmith/render/deep_image.h"
 #include "pupil_mesh_table.h"
 #include "scatter_source.h"
 #include "source_merging.h"
@@ -67,18 +68,17 @@ SplatOptions subrow_options(const SplatOptions& splat, int divisor) {
   return o;
 }
 
-Image render(const Image& image, const DepthMap& depth, const RayModel& model, const Aperture& aperture,
-             const BokehOptions& options, BokehStatistics& stats) {
+int thread_count(const BokehOptions& options) { return options.threads > 0 ? options.threads : omp_get_max_threads(); }
+
+// The stages after the sources: layers, and per layer hidden surfaces, planning, deposit and
+// compositing. `sources` are the parts of the pixels of a w x h picture.
+Image render_sources(const ScatterSources& sources, const DepthLayers& layers, int w, int h, const RayModel& model,
+                     const Aperture& aperture, const BokehOptions& options, BokehStatistics& stats) {
   const Camera& camera = model.camera();
-  const int w = image.width, h = image.height;
-  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  const int threads = thread_count(options);
   const render_detail::SpectralGroups groups(camera, options.spectral, options.spectral_samples);
   const render_detail::PupilMeshTable meshes(aperture);
   const FootprintScatter scatter(model, aperture, groups, meshes, options);
-
-  ScatterSources sources = render_detail::make_scatter_sources(image, depth, camera, options, threads, stats);
-  if (options.split_edge_pixels) render_detail::split_mixed_pixels(sources, w, h, camera, threads, stats);
-  const DepthLayers layers = render_detail::make_depth_layers(sources, w, options.layer_spacing_px, options.max_layers);
   stats.layer_spacing_px = layers.spacing_px;
 
   const bool stretch = options.hidden == HiddenSurfaces::Stretch;
@@ -201,6 +201,15 @@ Image render(const Image& image, const DepthMap& depth, const RayModel& model, c
   return render_detail::finish_composite(result, w, h);
 }
 
+// Checks that the picture has the camera's framing.
+void check_framing(const RayModel& model, int width, int height, const std::string& what) {
+  const PinholeFrame& frame = model.camera().frame();
+  if (width != frame.width_px() || height != frame.height_px()) {
+    throw OptionsError("the camera was framed for " + std::to_string(frame.width_px()) + " x " + std::to_string(frame.height_px()) +
+                       " but the " + what + " is " + std::to_string(width) + " x " + std::to_string(height));
+  }
+}
+
 }  // namespace
 
 std::string_view to_string(HiddenSurfaces h) { return h == HiddenSurfaces::Extend ? "extend" : "stretch"; }
@@ -243,7 +252,9 @@ std::string BokehStatistics::to_string() const {
   os << "BokehStatistics(" << layers << " layers at " << layer_spacing_px << " px, " << source_pixels << " pixels, "
      << hidden_sources << " hidden sources, " << split_edge_pixels << " edge pixels split, " << redepthed_edge_pixels
      << " moved, " << footprints << " footprints, " << triangles << " triangles, "
-     << clamped_depths << " clamped depths, max |CoC| " << max_abs_coc_px << " px)";
+     << clamped_depths << " clamped depths, max |CoC| " << max_abs_coc_px << " px";
+  if (deep_samples > 0) os << ", " << deep_samples << " deep samples, " << volume_slabs << " volume slabs";
+  os << ")";
   return os.str();
 }
 
@@ -251,16 +262,11 @@ Image render_bokeh(const Image& image, const DepthMap& depth, const RayModel& mo
                    const BokehOptions& options, BokehStatistics* statistics) {
   options.validate();
   if (image.channels != 3) throw OptionsError("the bokeh renderer takes a 3-channel linear RGB image, got " + image.to_string());
-  const PinholeFrame& frame = model.camera().frame();
   if (image.width != depth.width || image.height != depth.height) {
     throw OptionsError("image is " + std::to_string(image.width) + " x " + std::to_string(image.height) +
                        " but depth is " + std::to_string(depth.width) + " x " + std::to_string(depth.height));
   }
-  if (image.width != frame.width_px() || image.height != frame.height_px()) {
-    throw OptionsError("the camera was framed for " + std::to_string(frame.width_px()) + " x " +
-                       std::to_string(frame.height_px()) + " but the image is " + std::to_string(image.width) + " x " +
-                       std::to_string(image.height));
-  }
+  check_framing(model, image.width, image.height, "image");
   for (std::size_t i = 0; i < depth.z_m.size(); ++i) {
     if (!(depth.z_m[i] > 0.0f)) {
       throw OptionsError("depth at pixel (" + std::to_string(i % static_cast<std::size_t>(depth.width)) + ", " +
@@ -269,7 +275,31 @@ Image render_bokeh(const Image& image, const DepthMap& depth, const RayModel& mo
     }
   }
   BokehStatistics local;
-  return render(image, depth, model, aperture, options, statistics ? *statistics : local);
+  BokehStatistics& stats = statistics ? *statistics : local;
+  const Camera& camera = model.camera();
+  const int w = image.width, h = image.height, threads = thread_count(options);
+  ScatterSources sources = render_detail::make_scatter_sources(image, depth, camera, options, threads, stats);
+  if (options.split_edge_pixels) render_detail::split_mixed_pixels(sources, w, h, camera, threads, stats);
+  const DepthLayers layers = render_detail::make_depth_layers(sources, w, h, options.layer_spacing_px, options.max_layers);
+  return render_sources(sources, layers, w, h, model, aperture, options, stats);
+}
+
+Image render_bokeh(const DeepImage& deep, const RayModel& model, const Aperture& aperture, const BokehOptions& options,
+                   BokehStatistics* statistics) {
+  options.validate();
+  check_framing(model, deep.width, deep.height, "deep image");
+  if (deep.first_sample.size() != static_cast<std::size_t>(deep.width) * static_cast<std::size_t>(deep.height) + 1) {
+    throw OptionsError("the deep image has samples for " + std::to_string(deep.first_sample.size() - 1) + " pixels of its " +
+                       std::to_string(deep.width) + " x " + std::to_string(deep.height));
+  }
+  BokehStatistics local;
+  BokehStatistics& stats = statistics ? *statistics : local;
+  // Edge pixels need no split: a layered input has each surface of a pixel as its own sample.
+  const render_detail::DeepSources deep_sources = render_detail::make_deep_sources(deep, model.camera(), options, stats);
+  stats.deep_samples = deep_sources.samples;
+  stats.volume_slabs = deep_sources.volume_slabs;
+  const DepthLayers layers = render_detail::make_depth_layers(deep_sources.sources, deep.width, deep.height, deep_sources.spacing);
+  return render_sources(deep_sources.sources, layers, deep.width, deep.height, model, aperture, options, stats);
 }
 
 }  // namespace lensmith

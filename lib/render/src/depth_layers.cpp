@@ -7,33 +7,40 @@
 
 namespace lensmith::render_detail {
 
-int DepthLayers::layer_at(double coc_px) const {
+LayerSpacing LayerSpacing::over(double coc_min_px, double coc_max_px, double spacing_px, int max_layers) {
+  LayerSpacing l;
+  l.coc_min_px = coc_min_px;
+  l.spacing_px = std::max(spacing_px, (coc_max_px - coc_min_px) / max_layers);
+  l.count = std::max(1, static_cast<int>(std::floor((coc_max_px - coc_min_px) / l.spacing_px)) + 1);
+  return l;
+}
+
+int LayerSpacing::layer_at(double coc_px) const {
   return std::clamp(static_cast<int>(std::floor((coc_px - coc_min_px) / spacing_px)), 0, count - 1);
 }
 
-DepthLayers make_depth_layers(const ScatterSources& sources, int width, double spacing_px, int max_layers) {
+DepthLayers make_depth_layers(const ScatterSources& sources, int width, int height, const LayerSpacing& spacing) {
   DepthLayers l;
-  double coc_min = kInfinity, coc_max = -kInfinity;
-  for (const ScatterSource& s : sources) {
-    coc_min = std::min(coc_min, s.coc_px);
-    coc_max = std::max(coc_max, s.coc_px);
-  }
-  l.coc_min_px = coc_min;
-  l.spacing_px = std::max(spacing_px, (coc_max - coc_min) / max_layers);
-  l.count = std::max(1, static_cast<int>(std::floor((coc_max - coc_min) / l.spacing_px)) + 1);
+  static_cast<LayerSpacing&>(l) = spacing;
   l.members.assign(static_cast<std::size_t>(l.count), {});
   l.max_blur_px.assign(static_cast<std::size_t>(l.count), 0.0);
-  std::size_t pixel_count = 0;
-  for (const ScatterSource& s : sources) pixel_count = std::max(pixel_count, static_cast<std::size_t>(s.y) * width + s.x + 1);
-  l.pixels.assign(pixel_count, {});
+  const std::size_t pixel_count = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  // Parts grouped by pixel: counted, then placed (a split pixel's second part comes at the end of
+  // the sources).
+  l.part_begin.assign(pixel_count + 1, 0);
+  for (const ScatterSource& s : sources) ++l.part_begin[static_cast<std::size_t>(s.y) * width + s.x + 1];
+  for (std::size_t p = 0; p < pixel_count; ++p) l.part_begin[p + 1] += l.part_begin[p];
+  l.parts.resize(sources.size());
+  LargeVector<std::uint32_t> next(l.part_begin.begin(), l.part_begin.end() - 1);
   for (std::size_t i = 0; i < sources.size(); ++i) {
-    const int k = std::min(l.count - 1, static_cast<int>(std::floor((sources[i].coc_px - coc_min) / l.spacing_px)));
-    PixelLayers& p = l.pixels[static_cast<std::size_t>(sources[i].y) * width + sources[i].x];
-    const std::size_t part = p.layer[0] < 0 ? 0 : 1;
-    p.layer[part] = k;
-    p.coverage[part] = sources[i].coverage;
+    const ScatterSource& s = sources[i];
+    const int k = spacing.layer_at(s.coc_px);
+    PixelPart& part = l.parts[next[static_cast<std::size_t>(s.y) * width + s.x]++];
+    part.layer = k;
+    part.visible = s.coverage - s.hidden;
+    part.hidden = s.hidden;
     l.members[static_cast<std::size_t>(k)].push_back(static_cast<int>(i));
-    l.max_blur_px[static_cast<std::size_t>(k)] = std::max(l.max_blur_px[static_cast<std::size_t>(k)], std::abs(sources[i].coc_px));
+    l.max_blur_px[static_cast<std::size_t>(k)] = std::max(l.max_blur_px[static_cast<std::size_t>(k)], std::abs(s.coc_px));
   }
   l.nearer_blur_px.assign(static_cast<std::size_t>(l.count), 0.0);
   for (int k = l.count - 2; k >= 0; --k) {
@@ -41,6 +48,16 @@ DepthLayers make_depth_layers(const ScatterSources& sources, int width, double s
     l.nearer_blur_px[u] = std::max(l.nearer_blur_px[u + 1], l.max_blur_px[u + 1]);
   }
   return l;
+}
+
+DepthLayers make_depth_layers(const ScatterSources& sources, int width, int height, double spacing_px, int max_layers) {
+  double coc_min = kInfinity, coc_max = -kInfinity;
+  for (const ScatterSource& s : sources) {
+    coc_min = std::min(coc_min, s.coc_px);
+    coc_max = std::max(coc_max, s.coc_px);
+  }
+  if (sources.empty()) coc_min = coc_max = 0.0;
+  return make_depth_layers(sources, width, height, LayerSpacing::over(coc_min, coc_max, spacing_px, max_layers));
 }
 
 }  // namespace lensmith::render_detail

@@ -5,40 +5,56 @@
 #pragma once
 
 #include <algorithm>
-#include <array>
+#include <cstdint>
 #include <vector>
 
+#include "layer_spacing.h"
 #include "scatter_source.h"
 
 namespace lensmith::render_detail {
 
-// The layers of a pixel's parts (one, or two for a split edge pixel) and their coverage.
-struct PixelLayers {
-  std::array<int, 2> layer{-1, -1};
-  std::array<float, 2> coverage{0.0f, 0.0f};
-  bool in(int l) const { return layer[0] == l || layer[1] == l; }
-  // Fraction of the pixel that parts nearer than layer l cover (hidden from l), at most 1.
-  float nearer_than(int l) const {
-    return std::min(1.0f, (layer[0] > l ? coverage[0] : 0.0f) + (layer[1] > l ? coverage[1] : 0.0f));
-  }
-  // Fraction of the pixel on layer l.
-  float on(int l) const { return (layer[0] == l ? coverage[0] : 0.0f) + (layer[1] == l ? coverage[1] : 0.0f); }
+// One part of a pixel: a surface of one layer (a flat picture's pixel has one part, or two where an
+// edge pixel is split; a layered input's pixel one per layer its samples fall in).
+struct PixelPart {
+  int layer = -1;
+  float visible = 0.0f;  // share of the pixel this part covers as the pinhole sees it
+  float hidden = 0.0f;   // share it covers behind nearer parts of the pixel (known only from layered input)
 };
 
-struct DepthLayers {
-  double coc_min_px = 0.0;  // signed blur of layer 0's lower edge (the farthest sources)
-  double spacing_px = 0.0;  // signed-blur step between layers
-  int count = 0;            // layer 0 is the farthest, count - 1 the nearest
-  LargeVector<PixelLayers> pixels;         // per pixel (row-major)
+// The layers (LayerSpacing: layer 0 is the farthest, count - 1 the nearest) and their sources.
+struct DepthLayers : LayerSpacing {
+  // Per pixel (row-major) its parts: parts[part_begin[p] .. part_begin[p + 1]).
+  LargeVector<std::uint32_t> part_begin;
+  LargeVector<PixelPart> parts;
   std::vector<LargeVector<int>> members;   // per layer: indices of its sources
   std::vector<double> max_blur_px;           // per layer: largest |signed blur| of its sources
   std::vector<double> nearer_blur_px;        // per layer: largest |signed blur| of every nearer layer
 
-  int layer_at(double coc_px) const;
+  // Whether pixel p has a part on layer l.
+  bool in(std::size_t p, int l) const {
+    for (std::uint32_t i = part_begin[p]; i < part_begin[p + 1]; ++i) {
+      if (parts[i].layer == l) return true;
+    }
+    return false;
+  }
+  // The share of pixel p that parts nearer than layer l cover and whose background is not known:
+  // what they cover (at most 1) less what the pixel's parts at layer l or farther are known to cover
+  // behind them (layered input). The hidden-surface extension of layer l fills this share.
+  float unknown_behind(std::size_t p, int l) const {
+    float nearer = 0.0f, known = 0.0f;
+    for (std::uint32_t i = part_begin[p]; i < part_begin[p + 1]; ++i) {
+      if (parts[i].layer > l) nearer += parts[i].visible;
+      else known += parts[i].hidden;
+    }
+    return std::max(0.0f, std::min(1.0f, nearer) - known);
+  }
 };
 
-// Layers `spacing_px` apart (widened so there are at most `max_layers`), farthest first. `sources`
-// are the parts of the pixels of an image `width` wide.
-DepthLayers make_depth_layers(const ScatterSources& sources, int width, double spacing_px, int max_layers);
+// The layers of `sources` (the parts of the pixels of an image `width` x `height`), farthest first,
+// at `spacing`.
+DepthLayers make_depth_layers(const ScatterSources& sources, int width, int height, const LayerSpacing& spacing);
+// The same, `spacing_px` apart over the sources' own range of blur (widened so there are at most
+// `max_layers`).
+DepthLayers make_depth_layers(const ScatterSources& sources, int width, int height, double spacing_px, int max_layers);
 
 }  // namespace lensmith::render_detail

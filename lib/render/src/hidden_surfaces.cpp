@@ -20,7 +20,6 @@ ScatterSources hidden_sources(const ScatterSources& sources, const DepthLayers& 
                                           int width, int height, double reach_px, HiddenSurfaces mode, const Camera& camera,
                                           int threads) {
   const int w = width, h = height;
-  const LargeVector<PixelLayers>& pixels = layers.pixels;
   // Nearer pixels within a (2 reach + 1)-pixel square of a pixel of the layer: a separable
   // dilation, rows then columns, each line independent (threads).
   const int reach = static_cast<int>(reach_px);
@@ -29,11 +28,11 @@ ScatterSources hidden_sources(const ScatterSources& sources, const DepthLayers& 
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (int y = 0; y < h; ++y) {
     int* d = row_distance.data() + static_cast<std::size_t>(y) * w;
-    const PixelLayers* l = pixels.data() + static_cast<std::size_t>(y) * w;
+    const std::size_t row = static_cast<std::size_t>(y) * w;
     int last = far;
-    for (int x = 0; x < w; ++x) d[x] = l[x].in(layer) ? (last = 0) : (last = std::min(far, last + 1));
+    for (int x = 0; x < w; ++x) d[x] = layers.in(row + x, layer) ? (last = 0) : (last = std::min(far, last + 1));
     last = far;
-    for (int x = w - 1; x >= 0; --x) d[x] = std::min(d[x], l[x].in(layer) ? (last = 0) : (last = std::min(far, last + 1)));
+    for (int x = w - 1; x >= 0; --x) d[x] = std::min(d[x], layers.in(row + x, layer) ? (last = 0) : (last = std::min(far, last + 1)));
   }
   LargeVector<std::uint8_t> within(static_cast<std::size_t>(w) * h, 0);
 #pragma omp parallel for num_threads(threads) schedule(static)
@@ -54,7 +53,7 @@ ScatterSources hidden_sources(const ScatterSources& sources, const DepthLayers& 
   std::vector<std::size_t> targets;
   int x0 = w, x1 = -1, y0 = h, y1 = -1;
   for (std::size_t i = 0; i < within.size(); ++i) {
-    if (within[i] && pixels[i].nearer_than(layer) > 0.0f) {
+    if (within[i] && layers.unknown_behind(i, layer) > 0.0f) {
       targets.push_back(i);
       const int x = static_cast<int>(i % static_cast<std::size_t>(w)), y = static_cast<int>(i / static_cast<std::size_t>(w));
       x0 = std::min(x0, x);
@@ -94,7 +93,7 @@ ScatterSources hidden_sources(const ScatterSources& sources, const DepthLayers& 
     ScatterSource s;
     s.x = static_cast<int>(i % static_cast<std::size_t>(w));
     s.y = static_cast<int>(i / static_cast<std::size_t>(w));
-    s.coverage = pixels[i].nearer_than(layer);
+    s.coverage = layers.unknown_behind(i, layer);
     s.coverage_only = mode == HiddenSurfaces::Stretch;
     if (!s.coverage_only) s.rgb = {s.coverage * untone(v[0]), s.coverage * untone(v[1]), s.coverage * untone(v[2])};
     s.inverse_depth_per_mm = v[3];

@@ -3,7 +3,8 @@
 // and around a sharp one too, because a blurred background point spreads its light past the sharp
 // silhouette in front of it. So each layer gets hidden sources under the nearer pixels within
 // reach of its own pixels: half the blur of the layer itself and of every nearer layer, plus the
-// 2 px tent. Their coverage is the part of the pixel the nearer layers take; their inverse depth is
+// 2 px tent. Their coverage is the part of the pixel the nearer layers take and no sample of a
+// layered input is known to fill (DepthLayers::unknown_behind); their inverse depth is
 // interpolated from the layer's own pixels by push-pull (Gortler et al., "The Lumigraph", 1996).
 //
 // HiddenSurfaces::Extend also interpolates their colour (in x / (1 + x), so that a few HDR

@@ -319,6 +319,22 @@ std::string DepthReadOptions::to_string() const {
          lensmith::to_string(invalid) + ")";
 }
 
+double planar_depth_m(double v, const DepthReadOptions& options, const PinholeFrame& frame, int x, int y) {
+  switch (options.kind) {
+    case DepthKind::Z: return metres_from(v, options.unit);
+    case DepthKind::Distance: {
+      const Tangents t = frame.tangents_at({x + 0.5, y + 0.5});
+      return metres_from(v, options.unit) / std::sqrt(1.0 + t.x * t.x + t.y * t.y);
+    }
+    case DepthKind::Inverse:
+      // 0 is infinitely far; +inf would be a point at the pinhole, as invalid as z = 0.
+      if (v == 0.0) return kInfinity;
+      if (v > 0.0 && std::isfinite(v)) return metres_from(1.0 / v, options.unit);
+      break;
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
 DepthMap read_depth(const DepthSource& source, const DepthReadOptions& options, const PinholeFrame& frame) {
   const fs::path& path = source.file;
   const RasterInfo info = read_raster_info(path);
@@ -378,27 +394,7 @@ DepthMap read_depth(const DepthSource& source, const DepthReadOptions& options, 
   for (int y = 0; y < info.height; ++y) {
     for (int x = 0; x < info.width; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(info.width) + static_cast<std::size_t>(x);
-      const double v = values[i];
-      double z_m = std::numeric_limits<double>::quiet_NaN();
-      switch (options.kind) {
-        case DepthKind::Z:
-          z_m = metres_from(v, options.unit);
-          break;
-        case DepthKind::Distance: {
-          const Tangents t = frame.tangents_at({x + 0.5, y + 0.5});
-          z_m = metres_from(v, options.unit) / std::sqrt(1.0 + t.x * t.x + t.y * t.y);
-          break;
-        }
-        case DepthKind::Inverse:
-          // 0 is infinitely far; +inf would be a point at the pinhole, as invalid as z = 0.
-          if (v == 0.0) {
-            z_m = kInfinity;
-          } else if (v > 0.0 && std::isfinite(v)) {
-            z_m = metres_from(1.0 / v, options.unit);
-          }
-          break;
-      }
-      const float z = static_cast<float>(z_m);
+      const float z = static_cast<float>(planar_depth_m(values[i], options, frame, x, y));
       // z = 0 (also a depth too small for a float) is a point at the pinhole, not in front of it.
       if (z > 0.0f) {
         depth.z_m[i] = z;

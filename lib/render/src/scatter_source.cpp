@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 
 #include "lensmith/core/units.h"
 
@@ -60,6 +61,151 @@ ScatterSources make_scatter_sources(const Image& image, const DepthMap& depth, c
   stats.clamped_depths = clamped;
   stats.max_abs_coc_px = std::max(std::abs(coc_min), std::abs(coc_max));
   return sources;
+}
+
+}  // namespace lensmith::render_detail
+
+namespace lensmith::render_detail {
+
+namespace {
+
+// A surface or a volume's slab of one pixel before merging: premultiplied colour, alpha, inverse depth.
+struct Piece {
+  std::array<double, 3> rgb{};
+  double alpha = 0.0;
+  double inverse_depth_per_mm = 0.0;
+  double coc_px = 0.0;
+};
+
+// The pieces of one pixel, front to back: surfaces as they are, volumes cut into slabs.
+void pixel_pieces(std::span<const DeepSample> samples, const Camera& camera, double max_blur_px, std::size_t& clamped,
+                  std::size_t& slabs, std::vector<Piece>& out) {
+  out.clear();
+  for (const DeepSample& s : samples) {
+    const double w_front = clamp_inverse_depth(camera, inverse_depth_per_mm(s.z_m), max_blur_px, clamped);
+    if (!s.is_volume()) {
+      out.push_back({{s.rgb[0], s.rgb[1], s.rgb[2]}, s.alpha, w_front, camera.signed_coc_px(w_front)});
+      continue;
+    }
+    std::size_t unused = 0;
+    const double w_back = clamp_inverse_depth(camera, inverse_depth_per_mm(s.z_back_m), max_blur_px, unused);
+    const double blur_span = std::abs(camera.signed_coc_px(w_front) - camera.signed_coc_px(w_back));
+    const int n = std::clamp(static_cast<int>(std::ceil(blur_span / kVolumeSlabPx)), 1, kMaxVolumeSlabs);
+    slabs += static_cast<std::size_t>(n);
+    // Slab edges evenly in inverse depth (blur is linear in it); each slab's share of the volume by
+    // its thickness in z, as OpenEXR's rule assumes a uniform volume (in inverse depth where the
+    // back is infinitely far).
+    const bool finite = std::isfinite(s.z_back_m);
+    auto edge_z_mm = [&](int k) { return 1.0 / (w_front + (w_back - w_front) * k / n); };
+    const double thickness = finite ? edge_z_mm(n) - edge_z_mm(0) : w_front - w_back;  // mm, or 1/mm
+    const double transmit = 1.0 - static_cast<double>(s.alpha);
+    for (int k = 0; k < n; ++k) {
+      double f = 1.0 / n;
+      if (finite && thickness > 0.0) f = (edge_z_mm(k + 1) - edge_z_mm(k)) / thickness;
+      const double a = s.alpha >= 1.0f ? 1.0 : 1.0 - std::pow(transmit, f);
+      // alpha' / alpha; for a volume that absorbs nothing (alpha 0) the colour goes by f.
+      const double share = s.alpha > 0.0f ? a / s.alpha : f;
+      const double w_mid = w_front + (w_back - w_front) * (k + 0.5) / n;
+      out.push_back({{s.rgb[0] * share, s.rgb[1] * share, s.rgb[2] * share}, a, w_mid, camera.signed_coc_px(w_mid)});
+    }
+  }
+}
+
+}  // namespace
+
+DeepSources make_deep_sources(const DeepImage& deep, const Camera& camera, const BokehOptions& options, BokehStatistics& stats) {
+  DeepSources result;
+  const int w = deep.width, h = deep.height;
+  std::size_t clamped = 0, slabs = 0;
+  std::vector<Piece> pieces;
+  // Pass 1: the range of blur, for the layers the pieces are merged into; an uncovered remainder is
+  // infinitely far.
+  double coc_min = kInfinity, coc_max = -kInfinity;
+  bool backdrop = false;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      std::size_t unused_clamped = 0, unused_slabs = 0;
+      pixel_pieces(deep.pixel(x, y), camera, options.max_blur_px, unused_clamped, unused_slabs, pieces);
+      double transmitted = 1.0;
+      for (const Piece& p : pieces) {
+        coc_min = std::min(coc_min, p.coc_px);
+        coc_max = std::max(coc_max, p.coc_px);
+        transmitted *= 1.0 - p.alpha;
+      }
+      backdrop = backdrop || transmitted > kOpaqueRemainder;
+    }
+  }
+  const double backdrop_w = clamp_inverse_depth(camera, 0.0, options.max_blur_px, clamped);
+  if (!(coc_min <= coc_max)) coc_min = coc_max = camera.signed_coc_px(backdrop_w);
+  result.spacing = LayerSpacing::over(coc_min, coc_max, options.layer_spacing_px, options.max_layers);
+  // The uncovered remainder is nothing: a layer of its own behind every sample, so that it never
+  // shares a layer's coverage with a surface (within a layer coverage averages, and a black
+  // backdrop of another blur would thin an element's rim).
+  double backdrop_coc = 0.0;
+  if (backdrop) {
+    result.spacing.coc_min_px -= result.spacing.spacing_px;
+    ++result.spacing.count;
+    backdrop_coc = result.spacing.coc_min_px + 0.5 * result.spacing.spacing_px;
+  }
+
+  // Pass 2: per pixel, pieces of one layer composited into one source.
+  ScatterSources& sources = result.sources;
+  sources.reserve(deep.sample_count() + static_cast<std::size_t>(w) * h);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      pixel_pieces(deep.pixel(x, y), camera, options.max_blur_px, clamped, slabs, pieces);
+      double transmitted = 1.0;  // through the sources of this pixel made so far
+      std::size_t i = 0;
+      while (i < pieces.size()) {
+        const int layer = result.spacing.layer_at(pieces[i].coc_px);
+        std::array<double, 3> rgb{};
+        double alpha = 0.0, weight = 0.0, weighted_w = 0.0, plain_w = 0.0;
+        std::size_t count = 0;
+        for (; i < pieces.size() && result.spacing.layer_at(pieces[i].coc_px) == layer; ++i, ++count) {
+          const Piece& p = pieces[i];
+          const double through = 1.0 - alpha;  // what the group's nearer pieces let through
+          for (std::size_t c = 0; c < 3; ++c) rgb[c] += through * p.rgb[c];
+          const double adds = through * p.alpha;
+          weighted_w += adds * p.inverse_depth_per_mm;
+          plain_w += p.inverse_depth_per_mm;
+          weight += adds;
+          alpha += adds;
+        }
+        // Light without coverage (an emissive sample of alpha 0: a glow) is kept, at its mean depth.
+        if (!(alpha > 0.0) && rgb[0] + rgb[1] + rgb[2] <= 0.0) continue;
+        ScatterSource s;
+        s.x = x;
+        s.y = y;
+        s.coverage = static_cast<float>(std::min(1.0, alpha));
+        s.hidden = static_cast<float>(std::min(1.0, alpha) * (1.0 - transmitted));
+        s.rgb = {static_cast<float>(rgb[0]), static_cast<float>(rgb[1]), static_cast<float>(rgb[2])};
+        s.inverse_depth_per_mm = weight > 0.0 ? weighted_w / weight : plain_w / static_cast<double>(count);
+        s.coc_px = camera.signed_coc_px(s.inverse_depth_per_mm);
+        sources.push_back(s);
+        transmitted *= 1.0 - std::min(1.0, alpha);
+      }
+      if (transmitted > kOpaqueRemainder) {
+        // The rest of the pixel: nothing, infinitely far (black, as a transparent pixel's
+        // premultiplied colour is; the alpha channel says how much is there).
+        ScatterSource s;
+        s.x = x;
+        s.y = y;
+        s.coverage = 1.0f;
+        s.hidden = static_cast<float>(1.0 - transmitted);
+        s.inverse_depth_per_mm = backdrop_w;
+        s.coc_px = backdrop_coc;  // its layer's; the footprint is mapped from its depth
+        sources.push_back(s);
+      }
+    }
+  }
+  result.samples = deep.sample_count();
+  result.volume_slabs = slabs;
+  stats.source_pixels = static_cast<std::size_t>(w) * h;
+  stats.clamped_depths = clamped;
+  double most = 0.0;
+  for (const ScatterSource& s : sources) most = std::max(most, std::abs(s.coc_px));
+  stats.max_abs_coc_px = most;
+  return result;
 }
 
 }  // namespace lensmith::render_detail

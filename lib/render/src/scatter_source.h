@@ -10,7 +10,9 @@
 
 #include "lensmith/camera/camera.h"
 #include "lensmith/core/huge_page_allocator.h"
+#include "layer_spacing.h"
 #include "lensmith/render/bokeh_renderer.h"
+#include "lensmith/render/deep_image.h"
 #include "lensmith/render/image.h"
 
 namespace lensmith::render_detail {
@@ -25,6 +27,7 @@ struct ScatterSource {
   std::array<float, 3> rgb{};       // linear radiance it sends (premultiplied by coverage)
   float coverage = 1.0f;            // fraction of the pixel's area this part stands for (0..1]
   bool coverage_only = false;       // a hidden source of HiddenSurfaces::Stretch: coverage, no light
+  float hidden = 0.0f;              // the part of `coverage` that nearer parts of its pixel hide (layered input)
   double inverse_depth_per_mm = 0.0;
   double coc_px = 0.0;              // signed blur diameter at the reference wavelength (Camera::signed_coc_px)
 };
@@ -40,6 +43,27 @@ inline PixelPoint source_centre(const ScatterSource& s) {
 // Inverse depth (1/mm) clamped to 1 mm in front of the lens and to `max_blur_px`; `clamped` counts
 // the changed ones.
 double clamp_inverse_depth(const Camera& camera, double inverse_depth_per_mm, double max_blur_px, std::size_t& clamped);
+
+// Sources of a layered picture and the layers they were merged for. Per pixel, front to back: a
+// volume is cut into slabs of at most kVolumeSlabPx of blur each (alpha and colour by the OpenEXR
+// rule for part of a uniform volume: alpha' = 1 - (1 - alpha)^f, colour scaled by alpha' / alpha,
+// f the slab's share of the thickness in z); consecutive samples of one layer are composited into
+// one source (front over back; inverse depth weighted by what each adds); a pixel the samples do
+// not cover fully gets a black source infinitely far for the rest, in a layer of its own behind all
+// others. Each source covers its own alpha (`hidden`: the part nearer sources of its pixel hide), so
+// behind an edge or a peeled foreground the renderer scatters what the file knows is there.
+struct DeepSources {
+  ScatterSources sources;
+  LayerSpacing spacing;
+  std::size_t samples = 0;      // samples read
+  std::size_t volume_slabs = 0;  // slabs cut from volumetric samples
+};
+inline constexpr double kVolumeSlabPx = 1.0;
+// A pixel whose samples leave less than this uncovered is opaque (float alphas of 1 - 2^-24 and
+// products of many of them).
+inline constexpr double kOpaqueRemainder = 1e-4;
+inline constexpr int kMaxVolumeSlabs = 64;
+DeepSources make_deep_sources(const DeepImage& deep, const Camera& camera, const BokehOptions& options, BokehStatistics& stats);
 
 // One source per pixel, row-major, with its signed blur; statistics: source_pixels,
 // clamped_depths, max_abs_coc_px.

@@ -76,6 +76,8 @@ struct BokehStatistics {
   std::size_t triangles = 0;        // mesh triangles deposited (seidel, exact, masks)
   std::size_t clamped_depths = 0;   // pixels brought back to max_blur_px or in front of the lens
   double max_abs_coc_px = 0.0;      // largest |signed CoC| among the source pixels
+  std::size_t deep_samples = 0;     // samples of a layered (deep) input
+  std::size_t volume_slabs = 0;     // slabs its volumetric samples were cut into
   std::string to_string() const;
 };
 
@@ -84,5 +86,15 @@ struct BokehStatistics {
 // Throws OptionsError for mismatched sizes or options.
 Image render_bokeh(const Image& image, const DepthMap& depth, const RayModel& model, const Aperture& aperture,
                    const BokehOptions& options = {}, BokehStatistics* statistics = nullptr);
+
+struct DeepImage;  // lensmith/render/deep_image.h
+
+// The picture `model` takes of a layered scene (deep_image.h): every sample of a pixel scattered in
+// its own depth layer, so what lies behind an edge or behind a whole foreground comes from the file
+// where it has it; the hidden-surface extension fills only what it does not know. Output: linear
+// RGB premultiplied over black where the samples leave a pixel uncovered (render the alpha with a
+// DeepImage whose colours are its alphas). Throws OptionsError for another framing or bad options.
+Image render_bokeh(const DeepImage& deep, const RayModel& model, const Aperture& aperture, const BokehOptions& options = {},
+                   BokehStatistics* statistics = nullptr);
 
 }  // namespace lensmith

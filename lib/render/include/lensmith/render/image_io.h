@@ -126,6 +126,11 @@ struct DepthReadOptions {
   friend std::ostream& operator<<(std::ostream& os, const DepthReadOptions& o) { return os << o.to_string(); }
 };
 
+// One depth value of pixel (x, y) of `frame` as planar depth z in metres (+inf = infinitely far):
+// what read_depth does per pixel. NaN where the value names no point in front of the camera (z <= 0
+// comes back as it is; the caller decides).
+double planar_depth_m(double value, const DepthReadOptions& options, const PinholeFrame& frame, int x, int y);
+
 // Reads one channel of a depth file as planar depth z in metres (+inf = infinitely far), pixel
 // (x, y) of the map belonging to pixel (x, y) of `frame`; Distance is converted with the frame's
 // tangents at pixel centres (x + 0.5, y + 0.5).
