@@ -220,6 +220,7 @@ struct SceneRenderOptions {
   std::string output;                             // -o: .exr (float + metadata) or .png/.jpg/.tif (sRGB)
   std::string depth;                              // --depth: planar depth EXR (channel Z, metres); --pinhole only
   bool pinhole = false;                           // --pinhole: the all-in-focus picture
+  int layers = 0;                                 // --layers N: --pinhole as a deep EXR of N peeled layers (0 = flat)
   std::string lens;                               // --lens: file or shipped name; exact tracing
   bool thin_lens = false;                         // --thin-lens: an ideal thin lens
   std::optional<double> focal_length_mm;          // --focal-length (thin lens), mm

@@ -369,8 +369,15 @@ int main(int argc, char** argv) {
   CLI::Option* scene_thin = scene_render_cmd->add_flag("--thin-lens", scene_render.thin_lens, "Render through an ideal thin lens (needs --focal-length, --fstop)");
   scene_pinhole->excludes(scene_lens)->excludes(scene_thin);
   scene_lens->excludes(scene_thin);
-  scene_render_cmd->add_option("--depth", scene_render.depth, "With --pinhole: also write the planar depth, float EXR channel Z, metres")
-      ->needs(scene_pinhole);
+  CLI::Option* scene_depth =
+      scene_render_cmd->add_option("--depth", scene_render.depth, "With --pinhole: also write the planar depth, float EXR channel Z, metres")
+          ->needs(scene_pinhole);
+  scene_render_cmd
+      ->add_option("--layers", scene_render.layers,
+                   "With --pinhole: a deep OpenEXR (-o .exr) of the N nearest surfaces along every ray, depth-peeled (1-16)")
+      ->check(CLI::Range(1, 16))
+      ->needs(scene_pinhole)
+      ->excludes(scene_depth);
   scene_render_cmd->add_option("--focal-length", scene_render.focal_length_mm, "Thin-lens focal length, mm (> 0)")
       ->check(positive())->needs(scene_thin);
   // Options of renders through a lens: meaningless for a pinhole.

@@ -18,6 +18,7 @@
 #include "lensmith/paraxial/paraxial_system.h"
 #include "lensmith/render/image_io.h"
 #include "lensmith/scene/lens_render.h"
+#include "lensmith/render/deep_image.h"
 #include "lensmith/scene/pinhole_render.h"
 #include "lensmith/scene/scene_json.h"
 
@@ -52,6 +53,9 @@ int run_scene_render(const SceneRenderOptions& o, const GlobalOptions& global) {
       throw UsageError("--depth " + o.depth + " is the output image: give the depth another file");
     }
   }
+  if (o.layers > 0 && !output_keeps_alpha(output)) {
+    throw UsageError("--layers writes a deep OpenEXR: give -o a .exr file, not " + output.string());
+  }
   const Scene scene = load_scene(o.scene);
 
   OutputMetadata meta;
@@ -66,9 +70,25 @@ int run_scene_render(const SceneRenderOptions& o, const GlobalOptions& global) {
         PinholeFrame::from_options(o.width_px, o.height_px, framing, o.pinhole_focal_length_mm.value_or(kDefaultPinholeFocalMm));
     PinholeRenderOptions options;
     options.threads = o.threads;
-    PinholeRender out = render_pinhole(scene, frame, options);
     meta.model = "pinhole";
     meta.extra.push_back({"frame", frame.to_string()});
+    // The framing, which lensmith bokeh reads back (unless its flags say otherwise).
+    meta.extra.push_back({"focal_length_mm", format_number(o.pinhole_focal_length_mm.value_or(kDefaultPinholeFocalMm))});
+    meta.extra.push_back({"sensor_width_mm", format_number(o.sensor_width_mm)});
+    if (o.layers > 0) {
+      const DeepImage deep = render_pinhole_layers(scene, frame, o.layers, options);
+      meta.model = "pinhole, " + std::to_string(o.layers) + " peeled layers";
+      meta.extra.push_back({"layers", std::to_string(o.layers)});
+      write_deep_image(output, deep, meta);
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+      std::ostringstream what;
+      what << output.string() << " (" << deep.width << " x " << deep.height << ", deep) in " << std::fixed << std::setprecision(2)
+           << seconds << " s\n  pinhole, focal length " << format_rounded(frame.focal_length_px(), 5) << " px, up to " << o.layers
+           << " surfaces per ray: " << deep.to_string();
+      report_written(what.str(), global);
+      return kExitOk;
+    }
+    PinholeRender out = render_pinhole(scene, frame, options);
     rgb = std::move(out.rgb);
     if (!o.depth.empty()) write_depth(o.depth, out.depth);
     summary = "pinhole, focal length " + format_rounded(frame.focal_length_px(), 5) + " px, horizontal field of view " +

@@ -858,6 +858,30 @@ TEST_CASE("a deep tiled OpenEXR reads sample for sample like the deep scanline f
   }
 }
 
+TEST_CASE("deep OpenEXR files written by OpenImageIO (oiiotool --deepen, scanline and tiled) read back as the flat picture they came from",
+          "[render][image_io][deep]") {
+  // tests/fuzz/corpus/exr_image: flat-none.exr (oiiotool 2.4.7 --pattern fill, R G B A Z) and its
+  // deep scanline and deep tiled (2 x 2) versions written by oiiotool --deepen.
+  const fs::path corpus = fs::path(LENSMITH_SOURCE_DIR) / "tests/fuzz/corpus/exr_image";
+  const RasterInfo info = read_raster_info(corpus / "flat-none.exr");
+  const std::vector<int> rgbaz{info.channel_index("R"), info.channel_index("G"), info.channel_index("B"), info.channel_index("A"),
+                               info.channel_index("Z")};
+  const Raster flat = read_raster(corpus / "flat-none.exr", info, rgbaz);
+  for (const char* name : {"deep-scanline.exr", "deep-tiled.exr"}) {
+    INFO(name);
+    REQUIRE(is_deep_picture(corpus / name));
+    const DeepImage deep = read_deep_image(corpus / name, {}, PinholeFrame(info.width, info.height, 10.0));
+    const Image composite = deep.flatten();
+    for (int y = 0; y < info.height; ++y) {
+      for (int x = 0; x < info.width; ++x) {
+        REQUIRE(deep.pixel(x, y).size() == 1);
+        for (int c = 0; c < 4; ++c) CHECK(composite.at(x, y, c) == flat.at(x, y, c));
+        CHECK(deep.pixel(x, y)[0].z_m == flat.at(x, y, 4));
+      }
+    }
+  }
+}
+
 TEST_CASE("a deep sample with a bad depth, alpha or colour is refused naming the pixel and the sample", "[render][image_io][deep]") {
   TempDir dir;
   const std::vector<std::string> names{"A", "B", "G", "R", "Z", "ZBack"};

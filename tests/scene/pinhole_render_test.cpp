@@ -260,3 +260,53 @@ TEST_CASE("an invalid scene built in code is refused with the object and field n
   CHECK_THROWS_AS(render_pinhole(scene, PinholeFrame(4, 4, 4.0)), SceneError);
   CHECK_THROWS_WITH(render_pinhole(scene, PinholeFrame(4, 4, 4.0)), Contains("objects[1] (sphere \"lamp\"): radius_m = -1"));
 }
+
+// ---- depth peeling (render_pinhole_layers) ---------------------------------------------------------
+
+TEST_CASE("depth peeling keeps the wall behind a rectangle, at the wall's depth and in its colour", "[scene][pinhole][layers]") {
+  Scene scene;
+  const Rgb wall{0.2, 0.5, 0.3}, card{0.9, 0.1, 0.1};
+  scene.objects.push_back(object(box_at(4.0, -9.0, 9.0, -9.0, 9.0), wall));
+  scene.objects.push_back(object(box_at(1.0, -0.2, 0.2, -0.2, 0.2), card));  // f = 40 px at 1 m: pixels 12..28
+  const PinholeFrame frame(40, 24, 40.0);
+  const DeepImage one = render_pinhole_layers(scene, frame, 1, {4, 0});
+  const DeepImage two = render_pinhole_layers(scene, frame, 2, {4, 0});
+  // The card's middle: one layer sees the card only, two see the wall behind it, whole.
+  REQUIRE(one.pixel(20, 12).size() == 1);
+  REQUIRE(two.pixel(20, 12).size() == 2);
+  const DeepSample& behind = two.pixel(20, 12)[1];
+  CHECK_THAT(behind.z_m, WithinRel(4.0, kFloatDepth));
+  CHECK(behind.alpha == 1.0f);
+  for (int c = 0; c < 3; ++c) CHECK_THAT(behind.rgb[static_cast<std::size_t>(c)], WithinAbs(wall[c], kFloatColour));
+  CHECK_THAT(two.pixel(20, 12)[0].z_m, WithinRel(1.0, kFloatDepth));
+  // Beyond the card: the wall alone; no sky behind it (it covers the frame).
+  CHECK(two.pixel(2, 2).size() == 1);
+}
+
+TEST_CASE("depth-peeled layers composite front to back into the pinhole picture where the surfaces are plain", "[scene][pinhole][layers]") {
+  // A card whose edges cut pixels at sub-pixel positions over a plain wall, sky in a corner: every
+  // pixel, edges included, must flatten to render_pinhole's colour, for any number of layers.
+  Scene scene;
+  scene.background = {0.05, 0.1, 0.4};
+  scene.objects.push_back(object(box_at(4.0, -9.0, 0.8, -9.0, 0.5), Rgb{0.2, 0.5, 0.3}));
+  scene.objects.push_back(object(box_at(1.0, -0.213, 0.187, -0.171, 0.229), Rgb{0.9, 0.1, 0.1}));
+  const PinholeFrame frame(40, 24, 40.0);
+  const PinholeRender flat = render_pinhole(scene, frame, {4, 0});
+  for (int layers : {1, 2, 3}) {
+    const Image composite = render_pinhole_layers(scene, frame, layers, {4, 0}).flatten();
+    for (int y = 0; y < frame.height_px(); ++y) {
+      for (int x = 0; x < frame.width_px(); ++x) {
+        INFO(layers << " layers, pixel (" << x << ", " << y << ")");
+        for (int c = 0; c < 3; ++c) REQUIRE_THAT(composite.at(x, y, c), WithinAbs(flat.rgb.at(x, y, c), 1e-6));
+        REQUIRE_THAT(composite.at(x, y, 3), WithinAbs(1.0, 1e-6));
+      }
+    }
+  }
+}
+
+TEST_CASE("depth peeling refuses a layer count outside 1..16", "[scene][pinhole][layers]") {
+  Scene scene;
+  scene.objects.push_back(object(box_at(4.0, -9.0, 9.0, -9.0, 9.0), grey(0.5)));
+  CHECK_THROWS_WITH(render_pinhole_layers(scene, PinholeFrame(4, 4, 4.0), 0), Contains("layers = 0: must be in 1..16"));
+  CHECK_THROWS_WITH(render_pinhole_layers(scene, PinholeFrame(4, 4, 4.0), 17), Contains("layers = 17"));
+}

@@ -5,6 +5,7 @@
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfDeepFrameBuffer.h>
 #include <OpenEXR/ImfDeepScanLineInputPart.h>
+#include <OpenEXR/ImfDeepScanLineOutputFile.h>
 #include <OpenEXR/ImfDeepTiledInputPart.h>
 #include <OpenEXR/ImfCompressionAttribute.h>
 #include <OpenEXR/ImfDoubleAttribute.h>
@@ -33,6 +34,7 @@
 #include "codecs.h"
 #include "lensmith/imageio/deep_raster.h"
 #include "lensmith/core/number_parsing.h"
+#include "lensmith/core/text_file.h"
 
 namespace lensmith::codecs {
 
@@ -68,6 +70,16 @@ bool is_structural(std::string_view name) {
     if (name == s) return true;
   }
   return false;
+}
+
+void insert_attributes(Imf::Header& header, const std::vector<ImageAttribute>& attributes) {
+  for (const ImageAttribute& attribute : attributes) {
+    if (const auto* text = std::get_if<std::string>(&attribute.value)) {
+      header.insert(exr_name(attribute.name), Imf::StringAttribute(*text));
+    } else {
+      header.insert(exr_name(attribute.name), Imf::DoubleAttribute(std::get<double>(attribute.value)));
+    }
+  }
 }
 
 std::string compression_name(Imf::Compression c) {
@@ -419,13 +431,7 @@ void write_exr_file(const fs::path& path, const std::string& file, const PixelsV
   try {
     Imf::Header header(pixels.width, pixels.height);
     header.compression() = Imf::ZIP_COMPRESSION;
-    for (const ImageAttribute& attribute : attributes) {
-      if (const auto* text = std::get_if<std::string>(&attribute.value)) {
-        header.insert(exr_name(attribute.name), Imf::StringAttribute(*text));
-      } else {
-        header.insert(exr_name(attribute.name), Imf::DoubleAttribute(std::get<double>(attribute.value)));
-      }
-    }
+    insert_attributes(header, attributes);
     Imf::FrameBuffer frame;
     const auto stride = static_cast<std::size_t>(pixels.channels);
     for (std::size_t c = 0; c < channel_names.size(); ++c) {
@@ -556,6 +562,52 @@ DeepRaster read_deep_raster(const std::filesystem::path& path, std::uint64_t max
     throw IoError(path.string() + ": cannot read the deep OpenEXR pixels: " + e.what());
   }
   return raster;
+}
+
+void write_deep_exr(const std::filesystem::path& path, const DeepRaster& raster, const std::vector<ImageAttribute>& attributes) {
+  const auto w = static_cast<std::size_t>(raster.width), h = static_cast<std::size_t>(raster.height);
+  const std::size_t nc = raster.channels.size();
+  if (raster.width < 1 || raster.height < 1 || nc == 0 || raster.first_sample.size() != w * h + 1 || raster.first_sample.front() != 0 ||
+      raster.samples.size() != raster.sample_count() * nc) {
+    throw OptionsError(path.string() + ": cannot write " + raster.to_string() + ": first_sample needs width x height + 1 entries from 0 "
+                       "and samples one value per channel per sample");
+  }
+  std::set<std::string> seen;
+  for (const std::string& name : raster.channels) {
+    if (name.empty() || !seen.insert(name).second) {
+      throw OptionsError(path.string() + ": channel name '" + name + "' is empty or repeated: each channel needs its own name");
+    }
+  }
+  std::vector<unsigned int> counts(w * h);
+  std::vector<const float*> pointers(w * h * nc, nullptr);
+  for (std::size_t p = 0; p < w * h; ++p) {
+    counts[p] = static_cast<unsigned int>(raster.first_sample[p + 1] - raster.first_sample[p]);
+    for (std::size_t c = 0; c < nc; ++c) pointers[p * nc + c] = raster.samples.data() + raster.first_sample[p] * nc + c;
+  }
+  codecs::size_codec_pool();
+  write_atomically(path.string(), path.extension().string(), [&](const std::string& file) {
+    try {
+      Imf::Header header(raster.width, raster.height);
+      header.setType(Imf::DEEPSCANLINE);
+      header.compression() = Imf::ZIPS_COMPRESSION;
+      codecs::insert_attributes(header, attributes);
+      Imf::DeepFrameBuffer frame;
+      frame.insertSampleCountSlice(Imf::Slice(Imf::UINT, reinterpret_cast<char*>(counts.data()), sizeof(unsigned int),
+                                              w * sizeof(unsigned int)));
+      for (std::size_t c = 0; c < nc; ++c) {
+        header.channels().insert(raster.channels[c], Imf::Channel(Imf::FLOAT));
+        frame.insert(raster.channels[c], Imf::DeepSlice(Imf::FLOAT, reinterpret_cast<char*>(pointers.data() + c), nc * sizeof(float*),
+                                                        w * nc * sizeof(float*), nc * sizeof(float)));
+      }
+      Imf::DeepScanLineOutputFile out(file.c_str(), header);
+      out.setFrameBuffer(frame);
+      out.writePixels(raster.height);
+    } catch (const Error&) {
+      throw;
+    } catch (const std::exception& e) {
+      throw IoError(path.string() + ": cannot write the deep OpenEXR image: " + e.what());
+    }
+  });
 }
 
 }  // namespace lensmith

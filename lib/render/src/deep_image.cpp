@@ -1,6 +1,7 @@
 #include "lensmith/render/deep_image.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -199,6 +200,36 @@ DeepImage deep_image_from(const DeepRaster& raster, const fs::path& path, const 
     for (DeepSample& s : image.samples) s.z_back_m = std::max(s.z_back_m, s.z_m);
   }
   return image;
+}
+
+void write_deep_image(const fs::path& path, const DeepImage& deep, const OutputMetadata& meta) {
+  std::string extension = path.extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (extension != ".exr") throw OptionsError(path.string() + ": a deep image is written as OpenEXR only (.exr)");
+  bool volumes = false;
+  for (const DeepSample& s : deep.samples) volumes = volumes || s.is_volume();
+  DeepRaster raster;
+  raster.width = deep.width;
+  raster.height = deep.height;
+  raster.channels = {"R", "G", "B", "A", "Z"};
+  if (volumes) raster.channels.emplace_back("ZBack");
+  raster.first_sample = deep.first_sample;
+  raster.samples.reserve(deep.samples.size() * raster.channels.size());
+  for (int y = 0; y < deep.height; ++y) {
+    for (int x = 0; x < deep.width; ++x) {
+      for (const DeepSample& s : deep.pixel(x, y)) {
+        const float values[6] = {s.rgb[0], s.rgb[1], s.rgb[2], s.alpha, s.z_m, s.z_back_m};
+        for (std::size_t c = 0; c < raster.channels.size(); ++c) {
+          if (std::isnan(values[c])) {
+            throw ComputationError(path.string() + ": the deep image to write has NaN at pixel (" + std::to_string(x) + ", " +
+                                   std::to_string(y) + ") channel " + raster.channels[c]);
+          }
+          raster.samples.push_back(values[c]);
+        }
+      }
+    }
+  }
+  write_deep_exr(path, raster, output_attributes(meta));
 }
 
 }  // namespace lensmith

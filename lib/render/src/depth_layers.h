@@ -37,14 +37,17 @@ struct DepthLayers : LayerSpacing {
     }
     return false;
   }
-  // The share of pixel p that parts nearer than layer l cover and whose background is not known:
-  // what they cover (at most 1) less what the pixel's parts at layer l or farther are known to cover
-  // behind them (layered input). The hidden-surface extension of layer l fills this share.
+  // The share of pixel p that parts nearer than layer l cover and where layer l is not known: what
+  // they cover (at most 1) less what the pixel's own parts on layer l are known to cover behind them
+  // (layered input). The hidden-surface extension of layer l fills this share. Parts known on
+  // farther layers do not reduce it: the extension also closes the seams where one surface crosses
+  // from layer to layer (a tilted floor), whose blurred edges do not add up to full coverage, and
+  // a known wall behind the floor would show through them.
   float unknown_behind(std::size_t p, int l) const {
     float nearer = 0.0f, known = 0.0f;
     for (std::uint32_t i = part_begin[p]; i < part_begin[p + 1]; ++i) {
       if (parts[i].layer > l) nearer += parts[i].visible;
-      else known += parts[i].hidden;
+      else if (parts[i].layer == l) known += parts[i].hidden;
     }
     return std::max(0.0f, std::min(1.0f, nearer) - known);
   }

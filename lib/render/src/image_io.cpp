@@ -447,6 +447,19 @@ std::string OutputMetadata::to_string() const {
 
 bool output_keeps_alpha(const fs::path& path) { return output_format(path) == OutputFormat::Exr; }
 
+std::vector<ImageAttribute> output_attributes(const OutputMetadata& meta) {
+  std::vector<ImageAttribute> attributes{
+      {"Software", meta.lensmith_version.empty() ? "lensmith" : "lensmith " + meta.lensmith_version},
+      {"ImageDescription", "lensmith render: " + meta.to_string()}};
+  if (!meta.lens.empty()) attributes.push_back({"lensmith:lens", meta.lens});
+  if (!meta.model.empty()) attributes.push_back({"lensmith:model", meta.model});
+  if (!meta.lensmith_version.empty()) attributes.push_back({"lensmith:version", meta.lensmith_version});
+  if (meta.f_number > 0.0) attributes.push_back({"lensmith:f_number", meta.f_number});
+  if (meta.focus_m > 0.0) attributes.push_back({"lensmith:focus_m", meta.focus_m});
+  for (const auto& [key, value] : meta.extra) attributes.push_back({"lensmith:" + key, value});
+  return attributes;
+}
+
 void write_output_image(const fs::path& path, const Image& linear_rgb, const OutputMetadata& meta,
                         const std::vector<std::string>& channel_names) {
   const OutputFormat format = output_format(path);
@@ -461,15 +474,7 @@ void write_output_image(const fs::path& path, const Image& linear_rgb, const Out
   }
   check_no_nan(path, linear_rgb);
 
-  std::vector<ImageAttribute> attributes{
-      {"Software", meta.lensmith_version.empty() ? "lensmith" : "lensmith " + meta.lensmith_version},
-      {"ImageDescription", "lensmith render: " + meta.to_string()}};
-  if (!meta.lens.empty()) attributes.push_back({"lensmith:lens", meta.lens});
-  if (!meta.model.empty()) attributes.push_back({"lensmith:model", meta.model});
-  if (!meta.lensmith_version.empty()) attributes.push_back({"lensmith:version", meta.lensmith_version});
-  if (meta.f_number > 0.0) attributes.push_back({"lensmith:f_number", meta.f_number});
-  if (meta.focus_m > 0.0) attributes.push_back({"lensmith:focus_m", meta.focus_m});
-  for (const auto& [key, value] : meta.extra) attributes.push_back({"lensmith:" + key, value});
+  const std::vector<ImageAttribute> attributes = output_attributes(meta);
 
   if (rgba_exr) {
     write_exr(path, PixelsView<float>{linear_rgb.width, linear_rgb.height, linear_rgb.channels, linear_rgb.data}, names, attributes);

@@ -1,5 +1,6 @@
 #include "lensmith/scene/scene_intersection.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "lensmith/core/units.h"
@@ -12,10 +13,13 @@ std::string SceneHit::to_string() const {
          format_vector(point_m) + " m, normal " + format_vector(normal) + ", radiance " + radiance.to_string() + ")";
 }
 
-std::optional<SceneHit> intersect(const Scene& scene, const SceneRay& ray) {
+std::optional<SceneHit> intersect(const Scene& scene, const SceneRay& ray) { return intersect(scene, ray, {}); }
+
+std::optional<SceneHit> intersect(const Scene& scene, const SceneRay& ray, std::span<const std::size_t> excluded) {
   double nearest_m = kInfinity;
   std::size_t nearest_index = 0;
   for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+    if (std::find(excluded.begin(), excluded.end(), i) != excluded.end()) continue;
     const double t = hit_distance_m(scene.objects[i].shape, ray);
     if (t < nearest_m) {
       nearest_m = t;

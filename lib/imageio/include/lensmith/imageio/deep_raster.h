@@ -13,6 +13,8 @@
 #include <string_view>
 #include <vector>
 
+#include "lensmith/imageio/image_file.h"
+
 namespace lensmith {
 
 struct DeepRaster {
@@ -45,5 +47,11 @@ DeepRaster read_deep_header(const std::filesystem::path& path);
 // deep, its data window differs from its display window, a channel is subsampled or the file holds
 // more than `max_samples` samples (a fuzzer sets fewer).
 DeepRaster read_deep_raster(const std::filesystem::path& path, std::uint64_t max_samples = kMaxDeepSamples);
+
+// Writes `raster` as a deep scanline OpenEXR (32-bit float channels, ZIPS compression, the only
+// block compressions deep files allow besides RLE), atomically like write_exr, with `attributes`.
+// Throws OptionsError when first_sample or samples do not match the size and channels, IoError when
+// the file cannot be written.
+void write_deep_exr(const std::filesystem::path& path, const DeepRaster& raster, const std::vector<ImageAttribute>& attributes);
 
 }  // namespace lensmith

@@ -70,6 +70,12 @@ bool is_deep_picture(const std::filesystem::path& path);
 // camera (under InvalidDepth::Error; far and near override as for flat depth), a ZBack in front of
 // its Z, an alpha outside [0, 1] or NaN, and colour that is NaN, infinite or negative.
 DeepImage read_deep_image(const std::filesystem::path& path, const DepthReadOptions& options, const PinholeFrame& frame);
+// Writes `deep` as a deep scanline OpenEXR (channels R, G, B, A, Z, and ZBack where a sample is a
+// volume; ZIPS compression), atomically, with the attributes of `meta` (output_attributes). Throws
+// OptionsError when `path` is not .exr, ComputationError for a NaN sample (naming the
+// pixel), IoError when it cannot be written.
+void write_deep_image(const std::filesystem::path& path, const DeepImage& deep, const OutputMetadata& meta);
+
 // The same from samples already decoded from `path` (named in the messages).
 DeepImage deep_image_from(const DeepRaster& raster, const std::filesystem::path& path, const DepthReadOptions& options,
                           const PinholeFrame& frame);

@@ -13,6 +13,7 @@
 
 #include "lensmith/camera/pinhole_frame.h"
 #include "lensmith/core/errors.h"
+#include "lensmith/imageio/image_file.h"
 #include "lensmith/imageio/raster.h"
 #include "lensmith/render/image.h"
 
@@ -156,6 +157,10 @@ struct OutputMetadata {
   std::string to_string() const;  // "lens X, f/2.8, focus 2 m, model Y" (the ImageDescription)
   friend std::ostream& operator<<(std::ostream& os, const OutputMetadata& m) { return os << m.to_string(); }
 };
+
+// The file attributes write_output_image records from `meta`: Software, ImageDescription and the
+// lensmith:* keys.
+std::vector<ImageAttribute> output_attributes(const OutputMetadata& meta);
 
 // Writes a linear RGB image (3 channels, or 4 (RGBA, premultiplied) to OpenEXR only, else
 // OptionsError; a NaN is a ComputationError naming the pixel, since whatever made the image

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "lensmith/camera/pinhole_frame.h"
+#include "lensmith/render/deep_image.h"
 #include "lensmith/render/image.h"
 #include "lensmith/scene/scene.h"
 
@@ -40,5 +41,24 @@ struct PinholeRender {
 // shared among threads; the result does not depend on the thread count. Throws SceneError for an
 // invalid scene and OptionsError for invalid options.
 PinholeRender render_pinhole(const Scene& scene, const PinholeFrame& frame, const PinholeRenderOptions& options = {});
+
+// Most layers render_pinhole_layers peels.
+inline constexpr int kMaxPeeledLayers = 16;
+
+// The scene as layered (deep) input by depth peeling: each of the n x n colour rays of a pixel (as
+// render_pinhole's) meets up to `layers` objects, nearest first, each object once (every shape is
+// convex or flat: its front surface). Per pixel, one sample per object its rays meet: planar depth
+// (metres) the mean over those rays; alpha the object's own coverage, the share of the rays known
+// to meet or miss it that meet it (a ray cut off after `layers` objects in front of it is not
+// known to miss it); colour alpha times their mean radiance (premultiplied). Where rays meet
+// nothing, a sample of the background at +inf covering all (behind an opaque object the sky is not
+// a surface to keep). So what hides behind every foreground edge, up to `layers` surfaces deep, is
+// in the file. Composited front to back ("over", DeepImage::flatten) it is render_pinhole's picture
+// where a pixel's hidden surfaces are uniform in colour and its surfaces' coverages independent (a
+// silhouette over a wall); a textured surface behind an edge differs by its colour's variation
+// within the pixel, and where three surfaces share a pixel their coverages are not independent.
+// Throws SceneError for an invalid scene and OptionsError for invalid options or layers outside
+// 1..kMaxPeeledLayers.
+DeepImage render_pinhole_layers(const Scene& scene, const PinholeFrame& frame, int layers, const PinholeRenderOptions& options = {});
 
 }  // namespace lensmith

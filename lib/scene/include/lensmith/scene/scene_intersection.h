@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <optional>
+#include <span>
 #include <ostream>
 #include <string>
 
@@ -32,5 +33,9 @@ struct SceneHit {
 // nothing when the ray escapes to the background. Of two objects at exactly the same distance the
 // one listed first wins. Assumes scene.validate() passed.
 std::optional<SceneHit> intersect(const Scene& scene, const SceneRay& ray);
+// The same, ignoring the objects listed in `excluded` (indices into Scene::objects): the nearest
+// surface behind those, which is how depth peeling finds a ray's next layer (every shape is convex
+// or flat, so an object is met at most once from the outside).
+std::optional<SceneHit> intersect(const Scene& scene, const SceneRay& ray, std::span<const std::size_t> excluded);
 
 }  // namespace lensmith
