@@ -11,16 +11,13 @@
 #include "lensmith/prescription/lens_library.h"
 #include "lensmith/seidel/aberration_vector.h"
 
+#include "camera_options.h"
+
 using namespace lensmith;
 
 namespace {
 
-CameraOptions options(double focus_m, double f_number) {
-  CameraOptions o;
-  o.focus_distance_m = focus_m;
-  o.f_number = f_number;
-  return o;
-}
+CameraOptions options(double focus_m, double f_number) { return testing::camera_options(focus_m, f_number); }
 
 // Sensor hits of a few pupil points for a scene point.
 std::vector<SensorHit> hits(const RayModel& m, const ScenePoint& p, double wavelength_nm, const std::vector<PupilPoint>& pupil) {

@@ -21,16 +21,13 @@
 #include "lensmith/core/number_parsing.h"
 #include "lensmith/core/units.h"
 #include "lensmith/scene/scene_intersection.h"
-#include "lensmith/trace/sequential_tracer.h"
+#include "lensmith/camera/lens_camera.h"
 
 namespace lensmith {
 
 namespace {
 
 constexpr int kMaxSpp = 1 << 20;
-// Radius factor of the sampled exit-pupil disc over the paraxial one: the real pupil of the
-// shipped lenses at their f-numbers lies within a few percent of the paraxial disc.
-constexpr double kPupilEnlargement = 1.15;
 // Floor of the denominator of a pixel's relative error, as a fraction of the image's mean, so that
 // near-black pixels do not dominate the mean relative error.
 constexpr double kRelativeErrorFloor = 0.01;
@@ -164,31 +161,6 @@ LensRender render_progressive(const Camera& camera, const LensRenderOptions& opt
   return out;
 }
 
-// One wavelength node of the lens render: where to aim and what a unit spectral value is worth.
-struct Node {
-  double wavelength_nm = 0.0;
-  double z_exit_pupil_mm = 0.0;
-  double sampled_radius_mm = 0.0;  // enlarged exit-pupil radius
-  Rgb rgb_weight{1.0, 1.0, 1.0};   // spectral: rgb_weights(i) / probability
-  // Sampled disc area / on-axis projected solid angle of the real beam (mm^2 / sr): times cos^4 / D^2
-  // of a sample, the share of the centre's irradiance that sample stands for.
-  double weight_scale = 1.0;
-};
-
-// Polar midpoint grid of the on-axis irradiance integral (rings x sectors over the sampled disc):
-// the beam's edge falls within 1/512 of the disc's radius.
-constexpr int kAxisRings = 512;
-constexpr int kAxisSectors = 8;
-
-// cos^4 of the angle between `towards` (from the sensor point to a point of the exit-pupil plane)
-// and the axis, over the squared axial distance D^2: the projected solid angle per unit area of the
-// plane, cos(theta_sensor) cos(theta_pupil) / d^2 with d = D / cos(theta) (pbrt-v4 RealisticCamera).
-double projected_solid_angle_density(const Eigen::Vector3d& towards) {
-  const double d2 = towards.squaredNorm();
-  const double cos2 = towards.z() * towards.z() / d2;
-  return cos2 * cos2 / (towards.z() * towards.z());
-}
-
 }  // namespace
 
 void LensRenderOptions::validate() const {
@@ -234,21 +206,10 @@ LensRender render_through_lens(const Scene& scene, const Camera& camera, const L
   if (camera.is_thin_lens()) {
     throw OptionsError("render_through_lens needs a camera made from a prescription; use render_through_thin_lens");
   }
-  const Prescription& lens = *camera.lens();
-  TracerOptions tracer_options;
-  tracer_options.image_distance_mm = camera.z_sensor_mm() - lens.last_vertex_z_mm();
-  const SequentialTracer tracer(lens, tracer_options);
-
-  std::vector<Node> nodes;
+  // The wavelengths sampled: the quadrature's nodes, or the reference wavelength.
   std::optional<SpectralQuadrature> quadrature;
-  auto node_at = [&camera](double wavelength_nm) {
-    const FirstOrderSample fo = camera.first_order(wavelength_nm);
-    Node n;
-    n.wavelength_nm = wavelength_nm;
-    n.z_exit_pupil_mm = fo.z_exit_pupil_mm;
-    n.sampled_radius_mm = kPupilEnlargement * fo.exit_pupil_radius_mm;
-    return n;
-  };
+  std::vector<double> wavelengths;
+  std::vector<Rgb> rgb_weights;
   if (options.spectral) {
     SpectralQuadratureOptions q;
     q.sample_count = options.spectral_samples;
@@ -257,82 +218,37 @@ LensRender render_through_lens(const Scene& scene, const Camera& camera, const L
     quadrature.emplace(q);
     for (std::size_t i = 0; i < quadrature->size(); ++i) {
       const WavelengthSample w = quadrature->sample_at(i);
-      Node n = node_at(w.wavelength_nm);
-      n.rgb_weight = w.rgb_weight;
-      nodes.push_back(n);
+      wavelengths.push_back(w.wavelength_nm);
+      rgb_weights.push_back(w.rgb_weight);
     }
   } else {
-    nodes.push_back(node_at(camera.reference_wavelength_nm()));
+    wavelengths.push_back(camera.reference_wavelength_nm());
+    rgb_weights.push_back(Rgb{1.0, 1.0, 1.0});
   }
-  // Irradiance is radiance times the projected solid angle of the beam that reaches the sensor
-  // point: each sample stands for (disc area) cos^4 / D^2 of it. Normalised by the on-axis value of
-  // the real beam at each wavelength, so that a uniform surface in focus renders to its radiance at
-  // the centre of the frame and falls off towards the edges as the lens's relative illumination
-  // (cos^4-type falloff, vignetting, pupil aberration; `lensmith analyze --what illumination`).
-  const double z_sensor_axis = camera.z_sensor_mm();
-  for (Node& n : nodes) {
-    const double disc = n.sampled_radius_mm;
-    double on_axis = 0.0;
-    for (int i = 0; i < kAxisRings; ++i) {
-      const double r = disc * (i + 0.5) / kAxisRings;
-      const double ring_cell = r * (disc / kAxisRings) * (2.0 * kPi / kAxisSectors);
-      for (int j = 0; j < kAxisSectors; ++j) {
-        const double phi = 2.0 * kPi * (j + 0.5) / kAxisSectors;
-        Eigen::Vector3d towards(r * std::cos(phi), r * std::sin(phi), n.z_exit_pupil_mm - z_sensor_axis);
-        if (towards.z() > 0.0) towards = -towards;
-        if (!(towards.z() < 0.0)) continue;
-        Ray ray;
-        ray.position_mm = Eigen::Vector3d(0.0, 0.0, z_sensor_axis);
-        ray.direction = towards.normalized();
-        ray.wavelength_nm = n.wavelength_nm;
-        if (tracer.trace_backward(ray).ok()) on_axis += projected_solid_angle_density(towards) * ring_cell;
-      }
-    }
-    if (!(on_axis > 0.0)) {
-      throw ComputationError("no ray from the centre of the sensor passes the lens at " + format_number(n.wavelength_nm) +
-                             " nm: the stop or a clear aperture closes the beam");
-    }
-    n.weight_scale = kPi * disc * disc / on_axis;
-  }
+  // The primary rays and their weights (lens_camera.h), with the exit pupil and the on-axis
+  // normalisation computed at exactly these wavelengths.
+  const LensCamera lens_camera(camera, wavelengths);
 
   const CameraBasis basis = scene.camera.basis();
   const Eigen::Vector3d position_m = scene.camera.position_m;
-  const double half_width = 0.5 * camera.frame().width_px();
-  const double half_height = 0.5 * camera.frame().height_px();
-  const double px_per_mm = camera.px_per_sensor_mm();
-  const double z_sensor = camera.z_sensor_mm();
-  const double z_persp = camera.z_perspective_mm();
   const SpectralBasis* spectrum = quadrature ? &quadrature->basis() : nullptr;
 
   auto sample = [&](double x_px, double y_px, double node_u, Pcg32& rng) -> SampleResult {
-    const Node& node = nodes[std::min(nodes.size() - 1, static_cast<std::size_t>(node_u * static_cast<double>(nodes.size())))];
-    // The inverse of Camera::output_pixel.
-    const Eigen::Vector3d on_sensor((x_px - half_width) / px_per_mm, (half_height - y_px) / px_per_mm, z_sensor);
-    const double r = node.sampled_radius_mm * std::sqrt(rng.uniform());
-    const double phi = 2.0 * kPi * rng.uniform();
-    Eigen::Vector3d towards = Eigen::Vector3d(r * std::cos(phi), r * std::sin(phi), node.z_exit_pupil_mm) - on_sensor;
-    // A virtual exit pupil behind the sensor: the ray still leaves the sensor towards -z.
-    if (towards.z() > 0.0) towards = -towards;
-    if (!(towards.z() < 0.0)) return {Rgb{}, SampleFate::Failed};
-    Ray ray;
-    ray.position_mm = on_sensor;
-    ray.direction = towards.normalized();
-    ray.wavelength_nm = node.wavelength_nm;
-    const TraceResult traced = tracer.trace_backward(ray);
-    if (!traced.ok()) {
-      return {Rgb{}, traced.status == RayStatus::Vignetted ? SampleFate::Vignetted : SampleFate::Failed};
-    }
-    // Lens frame -> camera frame (file comment of lens_render.h) -> world.
-    const Eigen::Vector3d& p = traced.ray.position_mm;
-    const Eigen::Vector3d& d = traced.ray.direction;
-    const Eigen::Vector3d origin_m = position_m + m_from_mm(p.x()) * basis.right + m_from_mm(p.y()) * basis.up +
-                                     m_from_mm(z_persp - p.z()) * basis.forward;
-    const Eigen::Vector3d direction = (d.x() * basis.right + d.y() * basis.up - d.z() * basis.forward).normalized();
+    const std::size_t node = std::min(wavelengths.size() - 1, static_cast<std::size_t>(node_u * static_cast<double>(wavelengths.size())));
+    const std::array<double, 2> film = lens_camera.film_point_mm(x_px, y_px);
+    const double u = rng.uniform();
+    const double v = rng.uniform();
+    const CameraRaySample s = lens_camera.sample_ray(film[0], film[1], u, v, wavelengths[node]);
+    if (!s.ok()) return {Rgb{}, s.fate == CameraRayFate::Vignetted ? SampleFate::Vignetted : SampleFate::Failed};
+    // Camera frame -> world.
+    const Eigen::Vector3d& o = s.ray.origin_m;
+    const Eigen::Vector3d& d = s.ray.direction;
+    const Eigen::Vector3d origin_m = position_m + o.x() * basis.right + o.y() * basis.up + o.z() * basis.forward;
+    const Eigen::Vector3d direction = (d.x() * basis.right + d.y() * basis.up + d.z() * basis.forward).normalized();
     const std::optional<SceneHit> hit = intersect(scene, SceneRay{origin_m, direction});
     const Rgb radiance = hit ? hit->radiance : scene.background;
-    const double weight = node.weight_scale * projected_solid_angle_density(towards);
-    if (!spectrum) return {weight * radiance, SampleFate::ReachedScene};
-    return {(weight * spectrum->spectrum_value(radiance, node.wavelength_nm)) * node.rgb_weight, SampleFate::ReachedScene};
+    if (!spectrum) return {s.ray.weight * radiance, SampleFate::ReachedScene};
+    return {(s.ray.weight * spectrum->spectrum_value(radiance, wavelengths[node])) * rgb_weights[node], SampleFate::ReachedScene};
   };
   return render_progressive(camera, options, sample);
 }
