@@ -186,6 +186,7 @@ struct ValidateCommandOptions {
   int image_width_px = 320;                       // --image-width/--image-height of those renders
   int image_height_px = 180;
   int image_spp = 64;                             // --image-spp: ground-truth samples per pixel
+  int image_layers = 4;                           // --image-layers: the scenes also as layered input (0: flat only)
   std::optional<double> min_edge_psnr_db;         // --min-edge-psnr: fail when a model's edge-band PSNR is lower
   std::string fit;                                // --fit FILE: the poly model's fit (default: fitted in the run)
 };

@@ -329,6 +329,9 @@ int main(int argc, char** argv) {
       ->check(range(16, 8192));
   validate_cmd->add_option("--image-height", validate.image_height_px, "Height of the image-level renders, px (default 180)")
       ->check(range(16, 8192));
+  validate_cmd->add_option("--image-layers", validate.image_layers,
+                            "Also score each model on the scene as layered (deep) input of this many peeled layers (default 4; 0: the flat picture only)")
+      ->check(range(0, 16));
   validate_cmd->add_option("--image-spp", validate.image_spp, "Samples per pixel of the ground truth (default 64)")
       ->check(range(1, 1 << 20));
   validate_cmd->add_option("--min-edge-psnr", validate.min_edge_psnr_db, "Fail (exit 6) when a model's depth-edge PSNR is below this, dB");

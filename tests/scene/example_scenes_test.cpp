@@ -97,3 +97,28 @@ TEST_CASE("the depth staircase shows its five steps side by side from left to ri
   }
   CHECK(main_depths(out.depth, 50) == std::set<double>{1.0, 1.5, 2.2, 3.3, 5.0});
 }
+
+TEST_CASE("the fence shows slats at 1 m over the wall at 6 m, with lights at 3 m between and behind them", "[scene][examples]") {
+  const PinholeRender out = render_example("fence.json");
+  check_valid(out);
+  const std::set<double> depths = main_depths(out.depth, 20);
+  CHECK(depths.count(1.0) == 1);
+  CHECK(depths.count(6.0) == 1);
+  // Behind a slat the layered render keeps what the picture hides: somewhere a light at 3 m.
+  const Scene scene = load_scene(kScenes + "fence.json");
+  PinholeFrameOptions framing;
+  framing.sensor_width_mm = 36.0;
+  const DeepImage layers = render_pinhole_layers(scene, PinholeFrame::from_options(640, 360, framing, 50.0), 3);
+  int visible_lights = 0, hidden_lights = 0;
+  for (int y = 0; y < 360; ++y) {
+    for (int x = 0; x < 640; ++x) {
+      const auto p = layers.pixel(x, y);
+      if (p.empty()) continue;
+      // A light's samples lie within its 6 mm radius before 3 m (a pixel is 3.4 mm wide there).
+      if (p.front().z_m > 2.99f && p.front().z_m <= 3.0f) ++visible_lights;
+      if (p.size() >= 2 && p.front().z_m == 1.0f && p[1].z_m > 2.99f && p[1].z_m <= 3.0f) ++hidden_lights;
+    }
+  }
+  CHECK(visible_lights > 50);
+  CHECK(hidden_lights > 0);  // 8 pixels at 640 x 360: lights partly behind slats
+}

@@ -14,14 +14,23 @@ TEST_CASE("Bokeh of the occluder scene scores closer to the exact-lens render th
   ImageValidationOptions o;
   o.scenes = {std::string(LENSMITH_SOURCE_DIR) + "/examples/scenes/occluder.json"};
   o.models = {RayModelKind::Paraxial};
-  o.width_px = 160;
-  o.height_px = 90;
+  // 320 x 180: the layered input gains 2.3 dB in the depth-edge band here (measured 2026-12-02); at
+  // 160 x 90 the band is a few hundred pixels and the two inputs came out within 0.15 dB.
+  o.width_px = 320;
+  o.height_px = 180;
   o.spp = 1024;
   const ImageValidation v = validate_images(LensLibrary::load("sasian-triplet").prescription, camera, o);
-  REQUIRE(v.entries.size() == 1);
+  REQUIRE(v.entries.size() == 2);  // the flat picture and the layered input
   REQUIRE(v.unblurred.size() == 1);
   INFO(v.to_markdown());
-  CHECK(v.entries[0].comparison.psnr_db > v.unblurred[0].psnr_db + 3.0);
-  CHECK(v.entries[0].comparison.ssim > v.unblurred[0].ssim);
-  CHECK(v.to_markdown().find("| occluder | paraxial |") != std::string::npos);
+  for (const ImageValidationEntry& e : v.entries) {
+    CHECK(e.comparison.psnr_db > v.unblurred[0].psnr_db + 3.0);
+    CHECK(e.comparison.ssim > v.unblurred[0].ssim);
+  }
+  CHECK(v.entries[0].input == "flat");
+  CHECK(v.entries[1].input == "layered 4");
+  // Knowing what hides behind the disc and the bar helps where it shows: the depth-edge band.
+  CHECK(v.entries[1].comparison.edge_psnr_db > v.entries[0].comparison.edge_psnr_db);
+  CHECK(v.to_markdown().find("| occluder | paraxial | flat |") != std::string::npos);
+  CHECK(v.to_markdown().find("| occluder | paraxial | layered 4 |") != std::string::npos);
 }

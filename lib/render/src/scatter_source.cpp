@@ -148,40 +148,37 @@ DeepSources make_deep_sources(const DeepImage& deep, const Camera& camera, const
     backdrop_coc = result.spacing.coc_min_px + 0.5 * result.spacing.spacing_px;
   }
 
-  // Pass 2: per pixel, pieces of one layer composited into one source.
+  // Pass 2: per pixel, a source per piece. Within a layer footprints average (layer_compositing.h),
+  // so the pieces of one pixel that share a layer are weighted by what the group's nearer pieces let
+  // through (front over back, as the composite would), each keeping its own depth: a small bright
+  // light in front of a wall a layer's width behind keeps its own blur.
   ScatterSources& sources = result.sources;
   sources.reserve(deep.sample_count() + static_cast<std::size_t>(w) * h);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       pixel_pieces(deep.pixel(x, y), camera, options.max_blur_px, clamped, slabs, pieces);
-      double transmitted = 1.0;  // through the sources of this pixel made so far
+      double transmitted = 1.0;  // through the layers of this pixel made so far
       std::size_t i = 0;
       while (i < pieces.size()) {
         const int layer = result.spacing.layer_at(pieces[i].coc_px);
-        std::array<double, 3> rgb{};
-        double alpha = 0.0, weight = 0.0, weighted_w = 0.0, plain_w = 0.0;
-        std::size_t count = 0;
-        for (; i < pieces.size() && result.spacing.layer_at(pieces[i].coc_px) == layer; ++i, ++count) {
+        double alpha = 0.0;  // of the group so far
+        for (; i < pieces.size() && result.spacing.layer_at(pieces[i].coc_px) == layer; ++i) {
           const Piece& p = pieces[i];
           const double through = 1.0 - alpha;  // what the group's nearer pieces let through
-          for (std::size_t c = 0; c < 3; ++c) rgb[c] += through * p.rgb[c];
-          const double adds = through * p.alpha;
-          weighted_w += adds * p.inverse_depth_per_mm;
-          plain_w += p.inverse_depth_per_mm;
-          weight += adds;
-          alpha += adds;
+          const double coverage = through * p.alpha;
+          alpha += coverage;
+          // Light without coverage (an emissive sample of alpha 0: a glow) is kept.
+          if (!(coverage > 0.0) && through * (p.rgb[0] + p.rgb[1] + p.rgb[2]) <= 0.0) continue;
+          ScatterSource s;
+          s.x = x;
+          s.y = y;
+          s.coverage = static_cast<float>(std::min(1.0, coverage));
+          s.hidden = static_cast<float>(std::min(1.0, coverage) * (1.0 - transmitted));
+          s.rgb = {static_cast<float>(through * p.rgb[0]), static_cast<float>(through * p.rgb[1]), static_cast<float>(through * p.rgb[2])};
+          s.inverse_depth_per_mm = p.inverse_depth_per_mm;
+          s.coc_px = p.coc_px;
+          sources.push_back(s);
         }
-        // Light without coverage (an emissive sample of alpha 0: a glow) is kept, at its mean depth.
-        if (!(alpha > 0.0) && rgb[0] + rgb[1] + rgb[2] <= 0.0) continue;
-        ScatterSource s;
-        s.x = x;
-        s.y = y;
-        s.coverage = static_cast<float>(std::min(1.0, alpha));
-        s.hidden = static_cast<float>(std::min(1.0, alpha) * (1.0 - transmitted));
-        s.rgb = {static_cast<float>(rgb[0]), static_cast<float>(rgb[1]), static_cast<float>(rgb[2])};
-        s.inverse_depth_per_mm = weight > 0.0 ? weighted_w / weight : plain_w / static_cast<double>(count);
-        s.coc_px = camera.signed_coc_px(s.inverse_depth_per_mm);
-        sources.push_back(s);
         transmitted *= 1.0 - std::min(1.0, alpha);
       }
       if (transmitted > kOpaqueRemainder) {

@@ -47,11 +47,13 @@ double clamp_inverse_depth(const Camera& camera, double inverse_depth_per_mm, do
 // Sources of a layered picture and the layers they were merged for. Per pixel, front to back: a
 // volume is cut into slabs of at most kVolumeSlabPx of blur each (alpha and colour by the OpenEXR
 // rule for part of a uniform volume: alpha' = 1 - (1 - alpha)^f, colour scaled by alpha' / alpha,
-// f the slab's share of the thickness in z); consecutive samples of one layer are composited into
-// one source (front over back; inverse depth weighted by what each adds); a pixel the samples do
-// not cover fully gets a black source infinitely far for the rest, in a layer of its own behind all
-// others. Each source covers its own alpha (`hidden`: the part nearer sources of its pixel hide), so
-// behind an edge or a peeled foreground the renderer scatters what the file knows is there.
+// f the slab's share of the thickness in z). Each sample is a source at its own depth covering its
+// own alpha (`hidden`: the part that nearer layers of its pixel hide), so behind an edge or a
+// peeled foreground the renderer scatters what the file knows is there; samples of one pixel that
+// share a layer are weighted by what that layer's nearer ones let through (front over back: within
+// a layer footprints average; one source at a coverage-weighted depth gave a small light before a
+// wall the wall's blur). A pixel the samples do not cover fully gets a black source infinitely far
+// for the rest, in a layer of its own behind all others.
 struct DeepSources {
   ScatterSources sources;
   LayerSpacing spacing;

@@ -1,10 +1,13 @@
 #include "lensmith/validate/image_validation.h"
 
+#include <chrono>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 
 #include "lensmith/core/errors.h"
 #include "lensmith/render/bokeh_renderer.h"
+#include "lensmith/render/deep_image.h"
 #include "lensmith/render/image_io.h"
 #include "lensmith/scene/lens_render.h"
 #include "lensmith/scene/pinhole_render.h"
@@ -16,6 +19,9 @@ void ImageValidationOptions::validate() const {
   if (width_px < 16 || height_px < 16) throw OptionsError("image validation needs frames of at least 16 x 16 px");
   if (spp < 1) throw OptionsError("ground-truth samples per pixel must be >= 1");
   if (!(band_radius_px > 0.0)) throw OptionsError("the depth-edge band radius must be > 0 px");
+  if (layers < 0 || layers > kMaxPeeledLayers) {
+    throw OptionsError("layered input needs 1.." + std::to_string(kMaxPeeledLayers) + " layers (0: flat only), got " + std::to_string(layers));
+  }
   for (RayModelKind k : models) {
     if (k == RayModelKind::Exact || k == RayModelKind::Thin) {
       throw OptionsError("image validation scores paraxial, seidel or poly, not " + std::string(to_string(k)));
@@ -54,16 +60,28 @@ ImageValidation validate_images(const Prescription& lens, const CameraOptions& c
       meta.model = "exact (ground truth)";
       write_output_image(options.picture_dir / (name + "-truth.png"), truth.rgb, meta);
     }
+    std::optional<DeepImage> layered;
+    if (options.layers > 0) layered = render_pinhole_layers(scene, camera.frame(), options.layers, pinhole_options);
+    const std::string layered_input = "layered " + std::to_string(options.layers);
     for (RayModelKind kind : options.models) {
       const auto model = make_ray_model(kind, camera, model_options);
       BokehOptions bokeh;
       bokeh.threads = options.threads;
-      const Image result = render_bokeh(pinhole.rgb, pinhole.depth, *model, Aperture::circular(), bokeh);
-      out.entries.push_back({name, kind, compare_images(result, truth.rgb, pinhole.depth, options.band_radius_px)});
-      if (!options.picture_dir.empty()) {
-        meta.model = std::string(to_string(kind));
-        write_output_image(options.picture_dir / (name + "-" + meta.model + ".png"), result, meta);
-        write_output_image(options.picture_dir / (name + "-" + meta.model + "-error.png"), error_map(result, truth.rgb), meta);
+      for (const bool deep : {false, true}) {
+        if (deep && !layered) continue;
+        const auto started = std::chrono::steady_clock::now();
+        const Image result = deep ? render_bokeh(*layered, *model, Aperture::circular(), bokeh)
+                                  : render_bokeh(pinhole.rgb, pinhole.depth, *model, Aperture::circular(), bokeh);
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+        // Both scored on the same band: the flat picture's depth edges.
+        out.entries.push_back({name, kind, deep ? layered_input : "flat",
+                               compare_images(result, truth.rgb, pinhole.depth, options.band_radius_px), seconds});
+        if (!options.picture_dir.empty()) {
+          meta.model = std::string(to_string(kind)) + (deep ? ", " + layered_input : std::string());
+          const std::string stem = name + "-" + std::string(to_string(kind)) + (deep ? "-layered" : "");
+          write_output_image(options.picture_dir / (stem + ".png"), result, meta);
+          write_output_image(options.picture_dir / (stem + "-error.png"), error_map(result, truth.rgb), meta);
+        }
       }
     }
   }
@@ -73,15 +91,20 @@ ImageValidation validate_images(const Prescription& lens, const CameraOptions& c
 std::string ImageValidation::to_markdown() const {
   std::ostringstream os;
   os << std::fixed;
-  os << "| scene | model | PSNR (dB) | SSIM | edge PSNR (dB) | edge SSIM |\n|---|---|---|---|---|---|\n";
-  auto row = [&os](const std::string& scene, const std::string& model, const ImageComparison& c) {
-    os << "| " << scene << " | " << model << " | " << std::setprecision(2) << c.psnr_db << " | " << std::setprecision(4)
-       << c.ssim << " | " << std::setprecision(2) << c.edge_psnr_db << " | " << std::setprecision(4) << c.edge_ssim << " |\n";
+  os << "| scene | model | input | PSNR (dB) | SSIM | edge PSNR (dB) | edge SSIM | time (s) |\n|---|---|---|---|---|---|---|---|\n";
+  auto row = [&os](const std::string& scene, const std::string& model, const std::string& input, const ImageComparison& c,
+                   const std::string& time) {
+    os << "| " << scene << " | " << model << " | " << input << " | " << std::setprecision(2) << c.psnr_db << " | "
+       << std::setprecision(4) << c.ssim << " | " << std::setprecision(2) << c.edge_psnr_db << " | " << std::setprecision(4)
+       << c.edge_ssim << " | " << time << " |\n";
   };
   for (std::size_t s = 0; s < scenes.size(); ++s) {
-    row(scenes[s], "(input, unblurred)", unblurred[s]);
+    row(scenes[s], "(unblurred)", "flat", unblurred[s], "");
     for (const ImageValidationEntry& e : entries) {
-      if (e.scene == scenes[s]) row(e.scene, std::string(to_string(e.model)), e.comparison);
+      if (e.scene != scenes[s]) continue;
+      std::ostringstream t;
+      t << std::fixed << std::setprecision(2) << e.seconds;
+      row(e.scene, std::string(to_string(e.model)), e.input, e.comparison, t.str());
     }
   }
   return os.str();

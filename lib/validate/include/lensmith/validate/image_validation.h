@@ -1,6 +1,7 @@
 // Image-level validation: `lensmith bokeh` with each fast ray model, run on the pinhole render of
 // an analytic scene, against the same scene rendered through the real lens by the exact tracer
-// (which sees what a single image cannot: the hidden background). PSNR and SSIM on x/(1+x) values,
+// (which sees what a single image cannot: the hidden background), and on the scene's layered input
+// (which has it, up to a number of surfaces). PSNR and SSIM on x/(1+x) values,
 // over the frame and over a band around depth edges, with error maps (docs/validation.md).
 #pragma once
 
@@ -24,14 +25,19 @@ struct ImageValidationOptions {
   int spp = 64;                 // samples per pixel of the ground truth
   double band_radius_px = 4.0;  // depth-edge band
   int threads = 0;
-  std::filesystem::path picture_dir;  // when set: <scene>-truth.png, <scene>-<model>.png, <scene>-<model>-error.png
+  // Also each model on the scene's layered input (render_pinhole_layers, this many layers, read as a
+  // deep image): what knowing the hidden surfaces buys. 0: the flat picture only.
+  int layers = 4;
+  std::filesystem::path picture_dir;  // when set: <scene>-truth.png, <scene>-<model>[-layered].png and -error.png
   void validate() const;              // throws OptionsError
 };
 
 struct ImageValidationEntry {
   std::string scene;
   RayModelKind model = RayModelKind::Seidel;
+  std::string input = "flat";  // "flat" (picture and depth) or "layered N" (deep, N peeled layers)
   ImageComparison comparison;
+  double seconds = 0.0;  // render_bokeh's wall time
 };
 
 struct ImageValidation {
