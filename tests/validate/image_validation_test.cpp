@@ -31,6 +31,10 @@ TEST_CASE("Bokeh of the occluder scene scores closer to the exact-lens render th
   CHECK(v.entries[1].input == "layered 4");
   // Knowing what hides behind the disc and the bar helps where it shows: the depth-edge band.
   CHECK(v.entries[1].comparison.edge_psnr_db > v.entries[0].comparison.edge_psnr_db);
+  // And where hidden surfaces can show (around the disc and the bar, within half the wall's blur).
+  REQUIRE(v.hidden_pixels.size() == 1);
+  CHECK(v.hidden_pixels[0] > 1000);
+  CHECK(v.entries[1].hidden_psnr_db > v.entries[0].hidden_psnr_db);
   CHECK(v.to_markdown().find("| occluder | paraxial | flat |") != std::string::npos);
   CHECK(v.to_markdown().find("| occluder | paraxial | layered 4 |") != std::string::npos);
 }

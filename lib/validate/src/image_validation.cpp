@@ -1,11 +1,14 @@
 #include "lensmith/validate/image_validation.h"
 
 #include <chrono>
+#include <cmath>
+#include <cstdint>
 #include <iomanip>
 #include <optional>
 #include <sstream>
 
 #include "lensmith/core/errors.h"
+#include "lensmith/core/units.h"
 #include "lensmith/render/bokeh_renderer.h"
 #include "lensmith/render/deep_image.h"
 #include "lensmith/render/image_io.h"
@@ -28,6 +31,46 @@ void ImageValidationOptions::validate() const {
     }
   }
 }
+
+namespace {
+
+// Pixels where hidden surfaces can show in the picture through the lens: those whose first surface
+// hides most of another (two or more samples, the first of alpha >= 0.5), widened by half the
+// largest blur diameter of the hidden ones (a square, capped at kMaxHiddenReachPx).
+constexpr double kMaxHiddenReachPx = 64.0;
+std::vector<std::uint8_t> hidden_surface_region(const DeepImage& layers, const Camera& camera) {
+  const int w = layers.width, h = layers.height;
+  std::vector<std::uint8_t> seed(static_cast<std::size_t>(w) * h, 0);
+  double reach = 0.0;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const auto p = layers.pixel(x, y);
+      if (p.size() < 2 || p.front().alpha < 0.5f) continue;
+      seed[static_cast<std::size_t>(y) * w + x] = 1;
+      for (std::size_t k = 1; k < p.size(); ++k) {
+        reach = std::max(reach, 0.5 * std::abs(camera.signed_coc_px(inverse_depth_per_mm(p[k].z_m))));
+      }
+    }
+  }
+  const int r = static_cast<int>(std::ceil(std::min(reach, kMaxHiddenReachPx)));
+  // Separable square dilation by r: rows, then columns.
+  std::vector<std::uint8_t> rows(seed.size(), 0), out(seed.size(), 0);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      if (!seed[static_cast<std::size_t>(y) * w + x]) continue;
+      for (int i = std::max(0, x - r); i <= std::min(w - 1, x + r); ++i) rows[static_cast<std::size_t>(y) * w + i] = 1;
+    }
+  }
+  for (int x = 0; x < w; ++x) {
+    for (int y = 0; y < h; ++y) {
+      if (!rows[static_cast<std::size_t>(y) * w + x]) continue;
+      for (int j = std::max(0, y - r); j <= std::min(h - 1, y + r); ++j) out[static_cast<std::size_t>(j) * w + x] = 1;
+    }
+  }
+  return out;
+}
+
+}  // namespace
 
 ImageValidation validate_images(const Prescription& lens, const CameraOptions& camera_options, const ImageValidationOptions& options) {
   options.validate();
@@ -63,6 +106,11 @@ ImageValidation validate_images(const Prescription& lens, const CameraOptions& c
     std::optional<DeepImage> layered;
     if (options.layers > 0) layered = render_pinhole_layers(scene, camera.frame(), options.layers, pinhole_options);
     const std::string layered_input = "layered " + std::to_string(options.layers);
+    std::vector<std::uint8_t> hidden_region;
+    if (layered) hidden_region = hidden_surface_region(*layered, camera);
+    std::size_t hidden_count = 0;
+    for (std::uint8_t m : hidden_region) hidden_count += m;
+    out.hidden_pixels.push_back(hidden_count);
     for (RayModelKind kind : options.models) {
       const auto model = make_ray_model(kind, camera, model_options);
       BokehOptions bokeh;
@@ -74,8 +122,9 @@ ImageValidation validate_images(const Prescription& lens, const CameraOptions& c
                                   : render_bokeh(pinhole.rgb, pinhole.depth, *model, Aperture::circular(), bokeh);
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
         // Both scored on the same band: the flat picture's depth edges.
+        const double hidden_psnr = hidden_count > 0 ? psnr(result, truth.rgb, &hidden_region) : std::numeric_limits<double>::quiet_NaN();
         out.entries.push_back({name, kind, deep ? layered_input : "flat",
-                               compare_images(result, truth.rgb, pinhole.depth, options.band_radius_px), seconds});
+                               compare_images(result, truth.rgb, pinhole.depth, options.band_radius_px), hidden_psnr, seconds});
         if (!options.picture_dir.empty()) {
           meta.model = std::string(to_string(kind)) + (deep ? ", " + layered_input : std::string());
           const std::string stem = name + "-" + std::string(to_string(kind)) + (deep ? "-layered" : "");
@@ -91,22 +140,33 @@ ImageValidation validate_images(const Prescription& lens, const CameraOptions& c
 std::string ImageValidation::to_markdown() const {
   std::ostringstream os;
   os << std::fixed;
-  os << "| scene | model | input | PSNR (dB) | SSIM | edge PSNR (dB) | edge SSIM | time (s) |\n|---|---|---|---|---|---|---|---|\n";
+  os << "| scene | model | input | PSNR (dB) | SSIM | edge PSNR (dB) | edge SSIM | hidden-surface PSNR (dB) | time (s) |\n"
+     << "|---|---|---|---|---|---|---|---|---|\n";
   auto row = [&os](const std::string& scene, const std::string& model, const std::string& input, const ImageComparison& c,
-                   const std::string& time) {
+                   double hidden_psnr, const std::string& time) {
     os << "| " << scene << " | " << model << " | " << input << " | " << std::setprecision(2) << c.psnr_db << " | "
        << std::setprecision(4) << c.ssim << " | " << std::setprecision(2) << c.edge_psnr_db << " | " << std::setprecision(4)
-       << c.edge_ssim << " | " << time << " |\n";
+       << c.edge_ssim << " | ";
+    if (std::isnan(hidden_psnr)) {
+      os << "-";
+    } else {
+      os << std::setprecision(2) << hidden_psnr;
+    }
+    os << " | " << time << " |\n";
   };
   for (std::size_t s = 0; s < scenes.size(); ++s) {
-    row(scenes[s], "(unblurred)", "flat", unblurred[s], "");
+    row(scenes[s], "(unblurred)", "flat", unblurred[s], std::numeric_limits<double>::quiet_NaN(), "");
     for (const ImageValidationEntry& e : entries) {
       if (e.scene != scenes[s]) continue;
       std::ostringstream t;
       t << std::fixed << std::setprecision(2) << e.seconds;
-      row(e.scene, std::string(to_string(e.model)), e.input, e.comparison, t.str());
+      row(e.scene, std::string(to_string(e.model)), e.input, e.comparison, e.hidden_psnr_db, t.str());
     }
   }
+  for (std::size_t s = 0; s < scenes.size() && s < hidden_pixels.size(); ++s) {
+    os << "\n" << scenes[s] << ": " << hidden_pixels[s] << " pixels where hidden surfaces can show";
+  }
+  if (!hidden_pixels.empty()) os << "\n";
   return os.str();
 }
 

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -37,11 +38,15 @@ struct ImageValidationEntry {
   RayModelKind model = RayModelKind::Seidel;
   std::string input = "flat";  // "flat" (picture and depth) or "layered N" (deep, N peeled layers)
   ImageComparison comparison;
+  // PSNR over the pixels where hidden surfaces can show: within half the largest blur of a hidden
+  // surface from a pixel whose first surface hides another (from the layered render; NaN without).
+  double hidden_psnr_db = std::numeric_limits<double>::quiet_NaN();
   double seconds = 0.0;  // render_bokeh's wall time
 };
 
 struct ImageValidation {
   std::vector<ImageValidationEntry> entries;
+  std::vector<std::size_t> hidden_pixels;  // per scene: pixels in the hidden-surface region (0 without layers)
   std::vector<ImageComparison> unblurred;  // the pinhole image itself against the truth, per scene
   std::vector<std::string> scenes;
   std::string to_markdown() const;
