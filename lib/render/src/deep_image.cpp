@@ -25,12 +25,15 @@ std::span<const DeepSample> DeepImage::pixel(int x, int y) const {
   return {samples.data() + first_sample[p], samples.data() + first_sample[p + 1]};
 }
 
-void DeepImage::push_pixel(std::vector<DeepSample> pixel_samples) {
+void DeepImage::push_pixel(std::span<const DeepSample> pixel_samples) {
   if (first_sample.size() > static_cast<std::size_t>(width) * static_cast<std::size_t>(height)) {
     throw OptionsError("DeepImage::push_pixel: all " + std::to_string(width) + " x " + std::to_string(height) + " pixels are already there");
   }
-  std::stable_sort(pixel_samples.begin(), pixel_samples.end(), [](const DeepSample& a, const DeepSample& b) { return a.z_m < b.z_m; });
+  const auto begin = static_cast<std::ptrdiff_t>(samples.size());
   samples.insert(samples.end(), pixel_samples.begin(), pixel_samples.end());
+  // Most pixels hold one sample, or samples already in order.
+  const auto by_depth = [](const DeepSample& a, const DeepSample& b) { return a.z_m < b.z_m; };
+  if (!std::is_sorted(samples.begin() + begin, samples.end(), by_depth)) std::stable_sort(samples.begin() + begin, samples.end(), by_depth);
   first_sample.push_back(samples.size());
 }
 
@@ -121,6 +124,7 @@ DeepImage deep_image_from(const DeepRaster& raster, const fs::path& path, const 
   const std::size_t nc = raster.channels.size();
   constexpr float kFar = std::numeric_limits<float>::infinity();
   DeepImage image(raster.width, raster.height);
+  image.samples.reserve(raster.sample_count());
   // Depths that name no point in front of the camera, resolved after the nearest valid one is known.
   std::vector<std::pair<std::size_t, bool>> invalid;  // (sample index in image.samples, back depth)
   std::string first_invalid;

@@ -168,7 +168,10 @@ DeepImage render_pinhole_layers(const Scene& scene, const PinholeFrame& frame, i
     }
   }
   DeepImage out(width, height);
-  for (std::vector<DeepSample>& p : pixels) out.push_pixel(std::move(p));
+  std::size_t total = 0;
+  for (const std::vector<DeepSample>& p : pixels) total += p.size();
+  out.samples.reserve(total);
+  for (const std::vector<DeepSample>& p : pixels) out.push_pixel(p);
   return out;
 }
 

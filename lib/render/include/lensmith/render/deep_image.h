@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <initializer_list>
 #include <ostream>
 #include <span>
 #include <string>
@@ -46,7 +47,8 @@ struct DeepImage {
   std::size_t sample_count() const { return samples.size(); }
   // Appends the samples of the next pixel (row-major order), sorting them front to back; a whole
   // image is built pixel by pixel, `width * height` calls.
-  void push_pixel(std::vector<DeepSample> pixel_samples);
+  void push_pixel(std::span<const DeepSample> pixel_samples);
+  void push_pixel(std::initializer_list<DeepSample> pixel_samples) { push_pixel(std::span<const DeepSample>(pixel_samples.begin(), pixel_samples.size())); }
 
   // The picture a pinhole camera sees: samples composited front to back ("over"), a volume as one
   // sample. 4 channels: premultiplied RGB and alpha.
