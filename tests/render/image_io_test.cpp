@@ -882,6 +882,26 @@ TEST_CASE("deep OpenEXR files written by OpenImageIO (oiiotool --deepen, scanlin
   }
 }
 
+TEST_CASE("a deep OpenEXR cropped to its element (data window inside the display window) reads with empty pixels around it",
+          "[render][image_io][deep]") {
+  // Renderers crop deep elements to where they have samples; 2 x 1 pixels at (3, 2) of a 6 x 4 frame.
+  TempDir dir;
+  const fs::path path = dir / "cropped.exr";
+  lensmith::testing::write_deep_exr(path, 2, 1, kDeepChannels, {{{1.0f, 0.3f, 0.2f, 0.1f, 2.0f, 2.0f}}, {}}, 0, 6, 4, 3, 2);
+  const DeepImage deep = read_deep_image(path, {}, PinholeFrame(6, 4, 2.0));
+  CHECK(deep.sample_count() == 1);
+  REQUIRE(deep.pixel(3, 2).size() == 1);
+  CHECK(deep.pixel(3, 2)[0].z_m == 2.0f);
+  CHECK(deep.pixel(0, 0).empty());
+  CHECK(deep.pixel(4, 2).empty());
+  // Tiled the same way.
+  lensmith::testing::write_deep_exr(dir / "cropped-tiles.exr", 2, 1, kDeepChannels, {{{1.0f, 0.3f, 0.2f, 0.1f, 2.0f, 2.0f}}, {}}, 2, 6, 4, 3, 2);
+  CHECK(read_deep_image(dir / "cropped-tiles.exr", {}, PinholeFrame(6, 4, 2.0)).pixel(3, 2).size() == 1);
+  // A data window reaching beyond the display window (overscan) is refused.
+  lensmith::testing::write_deep_exr(dir / "overscan.exr", 2, 1, kDeepChannels, {{{1.0f, 0.3f, 0.2f, 0.1f, 2.0f, 2.0f}}, {}}, 0, 6, 4, 5, 2);
+  CHECK_THROWS_WITH(read_deep_image(dir / "overscan.exr", {}, PinholeFrame(6, 4, 2.0)), Contains("differs from the display window"));
+}
+
 TEST_CASE("a deep sample with a bad depth, alpha or colour is refused naming the pixel and the sample", "[render][image_io][deep]") {
   TempDir dir;
   const std::vector<std::string> names{"A", "B", "G", "R", "Z", "ZBack"};

@@ -11,8 +11,14 @@
 namespace lensmith::testing {
 
 void write_deep_exr(const std::filesystem::path& path, int width, int height, const std::vector<std::string>& names,
-                    const std::vector<std::vector<std::vector<float>>>& pixels, int tile_px) {
-  Imf::Header header(width, height);
+                    const std::vector<std::vector<std::vector<float>>>& pixels, int tile_px, int display_width,
+                    int display_height, int data_x, int data_y) {
+  const Imath::Box2i display(Imath::V2i(0, 0), Imath::V2i((display_width > 0 ? display_width : width) - 1,
+                                                          (display_height > 0 ? display_height : height) - 1));
+  const Imath::Box2i data(Imath::V2i(data_x, data_y), Imath::V2i(data_x + width - 1, data_y + height - 1));
+  Imf::Header header(display, data);
+  // OpenEXR addresses the buffers in absolute pixel coordinates: their bases go back to (0, 0).
+  const std::ptrdiff_t origin = static_cast<std::ptrdiff_t>(data_y) * width + data_x;
   header.setType(tile_px > 0 ? Imf::DEEPTILE : Imf::DEEPSCANLINE);
   header.compression() = Imf::ZIPS_COMPRESSION;
   if (tile_px > 0) header.setTileDescription(Imf::TileDescription(static_cast<unsigned>(tile_px), static_cast<unsigned>(tile_px)));
@@ -30,10 +36,10 @@ void write_deep_exr(const std::filesystem::path& path, int width, int height, co
     }
   }
   Imf::DeepFrameBuffer frame;
-  frame.insertSampleCountSlice(Imf::Slice(Imf::UINT, reinterpret_cast<char*>(counts.data()), sizeof(unsigned int),
+  frame.insertSampleCountSlice(Imf::Slice(Imf::UINT, reinterpret_cast<char*>(counts.data() - origin), sizeof(unsigned int),
                                           static_cast<std::size_t>(width) * sizeof(unsigned int)));
   for (std::size_t c = 0; c < names.size(); ++c) {
-    frame.insert(names[c], Imf::DeepSlice(Imf::FLOAT, reinterpret_cast<char*>(pointers[c].data()), sizeof(float*),
+    frame.insert(names[c], Imf::DeepSlice(Imf::FLOAT, reinterpret_cast<char*>(pointers[c].data() - origin), sizeof(float*),
                                           static_cast<std::size_t>(width) * sizeof(float*), sizeof(float)));
   }
   if (tile_px > 0) {

@@ -480,8 +480,15 @@ namespace {
 
 DeepRaster deep_header(const std::filesystem::path& path, const Imf::Header& header) {
   if (!codecs::is_deep(header)) throw ImageFileError(path.string() + ": not a deep image (its samples are flat)");
-  codecs::check_windows(path, header);
-  const Imath::Box2i window = header.dataWindow();
+  // Deep renders of an element are often cropped to where it has samples (a data window inside the
+  // display window): the pixels outside are empty. A data window beyond the display (overscan) would
+  // shift the picture against the pinhole frame and is refused as for flat images.
+  const Imath::Box2i data = header.dataWindow(), display = header.displayWindow();
+  const bool empty = data.max.x < data.min.x || data.max.y < data.min.y;
+  if (!empty && (data.min.x < display.min.x || data.min.y < display.min.y || data.max.x > display.max.x || data.max.y > display.max.y)) {
+    codecs::check_windows(path, header);  // says which windows differ
+  }
+  const Imath::Box2i window = display;
   DeepRaster raster;
   raster.width = window.max.x - window.min.x + 1;
   raster.height = window.max.y - window.min.y + 1;
@@ -512,11 +519,11 @@ DeepRaster read_deep_raster(const std::filesystem::path& path, std::uint64_t max
   const Imf::Header& header = file->header(0);
   DeepRaster raster = deep_header(path, header);
   codecs::size_codec_pool();
-  const Imath::Box2i window = header.dataWindow();
+  const Imath::Box2i window = header.displayWindow(), data = header.dataWindow();
   const auto w = static_cast<std::size_t>(raster.width), h = static_cast<std::size_t>(raster.height);
   const std::size_t nc = raster.channels.size();
-  // OpenEXR addresses the frame buffer from the data window's origin: base pointers are offset back
-  // to pixel (0, 0) of the window's coordinates.
+  // The buffers cover the display window (pixels outside a cropped data window stay empty); OpenEXR
+  // addresses them in absolute pixel coordinates, so base pointers are offset back to (0, 0).
   const std::ptrdiff_t origin = static_cast<std::ptrdiff_t>(window.min.y) * static_cast<std::ptrdiff_t>(w) + window.min.x;
   std::vector<unsigned int> counts(w * h, 0);
   std::vector<float*> pointers(w * h * nc, nullptr);
@@ -543,7 +550,9 @@ DeepRaster read_deep_raster(const std::filesystem::path& path, std::uint64_t max
     }
   };
   try {
-    if (header.type() == Imf::DEEPTILE) {
+    if (data.max.x < data.min.x || data.max.y < data.min.y) {
+      allocate();  // an empty data window: no samples anywhere
+    } else if (header.type() == Imf::DEEPTILE) {
       Imf::DeepTiledInputPart part(*file, 0);
       part.setFrameBuffer(frame);
       part.readPixelSampleCounts(0, part.numXTiles(0) - 1, 0, part.numYTiles(0) - 1);
@@ -552,9 +561,9 @@ DeepRaster read_deep_raster(const std::filesystem::path& path, std::uint64_t max
     } else {
       Imf::DeepScanLineInputPart part(*file, 0);
       part.setFrameBuffer(frame);
-      part.readPixelSampleCounts(window.min.y, window.max.y);
+      part.readPixelSampleCounts(data.min.y, data.max.y);
       allocate();
-      part.readPixels(window.min.y, window.max.y);
+      part.readPixels(data.min.y, data.max.y);
     }
   } catch (const Error&) {
     throw;

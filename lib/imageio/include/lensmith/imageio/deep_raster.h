@@ -43,8 +43,9 @@ bool is_deep_image(const std::filesystem::path& path);
 DeepRaster read_deep_header(const std::filesystem::path& path);
 
 // The first part of a deep OpenEXR (deep scanline, or the full-resolution level of deep tiles),
-// every channel as float. Throws IoError when it cannot be decoded, ImageFileError when it is not
-// deep, its data window differs from its display window, a channel is subsampled or the file holds
+// every channel as float, over its display window: pixels outside a data window cropped inside it
+// (as renderers crop an element) have no samples. Throws IoError when it cannot be decoded,
+// ImageFileError when it is not deep, its data window reaches beyond its display window (overscan), a channel is subsampled or the file holds
 // more than `max_samples` samples (a fuzzer sets fewer).
 DeepRaster read_deep_raster(const std::filesystem::path& path, std::uint64_t max_samples = kMaxDeepSamples);
 
