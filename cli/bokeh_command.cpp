@@ -266,7 +266,12 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   BokehStatistics stats;
   const auto render_started = std::chrono::steady_clock::now();
   Image out = layered ? render_bokeh(*deep, *model, aperture, options, &stats) : render_bokeh(*flat, depth, *model, aperture, options, &stats);
-  if (layered && output_keeps_alpha(output) && deep->max_transparency() > 1e-4) {
+  const bool layered_alpha = layered && deep->max_transparency() > 1e-4;
+  if (layered_alpha && !output_keeps_alpha(output) && !global.quiet) {
+    std::cerr << "note: " << o.image << " leaves pixels uncovered (alpha < 1); only an OpenEXR output (.exr) keeps its alpha, "
+              << output.string() << " gets RGB over black\n";
+  }
+  if (layered_alpha && output_keeps_alpha(output)) {
     // Alpha through the same rays: the samples' alphas as their colour (premultiplied: alpha times
     // one), without vignetting, as for a flat picture's alpha below.
     DeepImage coverage_image = *deep;

@@ -192,6 +192,11 @@ TEST_CASE("lensmith bokeh reads a deep OpenEXR as layered input: a CG element ov
   const lensmith::Image rgb = lensmith::read_radiance_image(out);
   CHECK(rgb.at(32, 24, 0) == Approx(0.5).margin(0.01));
   CHECK(rgb.at(22, 24, 0) == Approx(0.5 * (*alpha)[static_cast<std::size_t>(24 * w + 22)]).margin(0.01));
+  // A PNG cannot hold the element's alpha: RGB over black, with a note.
+  const auto png = run_lensmith("bokeh --image " + in.string() + " --thin-lens --focal-length 50 --fstop 1.4 --focus 0.5 -o " +
+                                scratch("element-deep.png").string());
+  CHECK(png.exit_code == 0);
+  CHECK(png.err.find("only an OpenEXR output (.exr) keeps its alpha") != std::string::npos);
   // A deep image carries its own depth.
   const auto with_depth = run_lensmith("bokeh --image " + in.string() + " --depth " + in.string() +
                                        " --thin-lens --focal-length 50 --focus 2 -o " + scratch("x.exr").string());
