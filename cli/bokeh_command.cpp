@@ -95,7 +95,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   // The picture, its alpha, passes and depth are often one file: decoded once, until the depth is read.
   std::optional<ImageReadCache> read_cache(std::in_place);
   // A deep OpenEXR is layered input: its samples carry colour, alpha and depth together.
-  const bool layered = is_deep_picture(o.image);
+  const bool layered = is_deep_image(o.image);
   if (layered && !o.depth.empty()) {
     throw UsageError(o.image + " is a deep image, whose samples carry their own Z: --depth is for flat pictures");
   }
@@ -207,7 +207,8 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   const PinholeFrame frame = PinholeFrame::from_options(width, height, camera.framing, default_focal_mm);
   std::optional<DeepImage> deep;
   if (layered) deep = read_deep_image(o.image, depth_options, frame);
-  // A layered input's depth per pixel is its front sample's (for --focus-pixel and --keep-depth).
+  // A layered input's depth per pixel is its front sample's, the nearest (for --focus-pixel,
+  // --keep-depth and the models' nearest depth).
   const DepthMap depth = layered ? deep->front_depth() : read_depth(depth_source, depth_options, frame);
   read_cache.reset();
   if (!o.focus_pixel.empty()) {
@@ -239,9 +240,6 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   }
   float nearest_m = std::numeric_limits<float>::infinity();
   for (float z : depth.z_m) nearest_m = std::min(nearest_m, z);
-  if (layered) {
-    for (const DeepSample& sample : deep->samples) nearest_m = std::min(nearest_m, sample.z_m);
-  }
   RayModelOptions model_options;
   model_options.nearest_depth_m = std::isfinite(nearest_m) ? std::max(0.01, static_cast<double>(nearest_m)) : 1.0;
   model_options.seidel_coefficients = parse_seidel_coefficients(o.seidel_coefficients);

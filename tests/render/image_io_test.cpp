@@ -797,8 +797,8 @@ TEST_CASE("a deep OpenEXR is refused by the flat readers, which point to the bok
   CHECK_THROWS_WITH(read_radiance_image(deep), Contains("deep.exr: a deep image; lensmith bokeh reads it as layered input") &&
                                                    Contains("oiiotool --flatten"));
   CHECK_THROWS_WITH(read_depth(DepthSource{deep, ""}, {}, PinholeFrame(2, 1, 2.0)), Contains("a deep image"));
-  CHECK(is_deep_picture(deep));
-  CHECK_FALSE(is_deep_picture(write_channel(dir, "flat.exr", "Z", 2, 1, std::vector<float>(2, 1.0f))));
+  CHECK(is_deep_image(deep));
+  CHECK_FALSE(is_deep_image(write_channel(dir, "flat.exr", "Z", 2, 1, std::vector<float>(2, 1.0f))));
 }
 
 namespace {
@@ -869,7 +869,7 @@ TEST_CASE("deep OpenEXR files written by OpenImageIO (oiiotool --deepen, scanlin
   const Raster flat = read_raster(corpus / "flat-none.exr", info, rgbaz);
   for (const char* name : {"deep-scanline.exr", "deep-tiled.exr"}) {
     INFO(name);
-    REQUIRE(is_deep_picture(corpus / name));
+    REQUIRE(is_deep_image(corpus / name));
     const DeepImage deep = read_deep_image(corpus / name, {}, PinholeFrame(info.width, info.height, 10.0));
     const Image composite = deep.flatten();
     for (int y = 0; y < info.height; ++y) {

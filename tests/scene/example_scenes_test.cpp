@@ -19,13 +19,15 @@ namespace {
 
 const std::string kScenes = std::string(LENSMITH_SOURCE_DIR) + "/examples/scenes/";
 
-PinholeRender render_example(const std::string& file) {
-  const Scene scene = load_scene(kScenes + file);
+// The framing the scenes are designed for: 36 mm sensor behind a 50 mm pinhole.
+PinholeFrame example_frame(int width, int height) {
   PinholeFrameOptions framing;
   framing.sensor_width_mm = 36.0;
   framing.focal_length_mm = 50.0;
-  return render_pinhole(scene, PinholeFrame::from_options(64, 36, framing, 50.0));
+  return PinholeFrame::from_options(width, height, framing, 50.0);
 }
+
+PinholeRender render_example(const std::string& file) { return render_pinhole(load_scene(kScenes + file), example_frame(64, 36)); }
 
 // Every colour finite and >= 0, every depth > 0 (inf allowed, NaN not).
 void check_valid(const PinholeRender& out) {
@@ -105,10 +107,7 @@ TEST_CASE("the fence shows slats at 1 m over the wall at 6 m, with lights at 3 m
   CHECK(depths.count(1.0) == 1);
   CHECK(depths.count(6.0) == 1);
   // Behind a slat the layered render keeps what the picture hides: somewhere a light at 3 m.
-  const Scene scene = load_scene(kScenes + "fence.json");
-  PinholeFrameOptions framing;
-  framing.sensor_width_mm = 36.0;
-  const DeepImage layers = render_pinhole_layers(scene, PinholeFrame::from_options(640, 360, framing, 50.0), 3);
+  const DeepImage layers = render_pinhole_layers(load_scene(kScenes + "fence.json"), example_frame(640, 360), 3);
   int visible_lights = 0, hidden_lights = 0;
   for (int y = 0; y < 360; ++y) {
     for (int x = 0; x < 640; ++x) {

@@ -1,7 +1,6 @@
 #include "lensmith/render/deep_image.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -85,8 +84,6 @@ std::string DeepImage::to_string() const {
      << format_rounded(pixels > 0 ? static_cast<double>(samples.size()) / pixels : 0.0, 3) << " per pixel, " << volumes << " volumes)";
   return os.str();
 }
-
-bool is_deep_picture(const fs::path& path) { return is_deep_image(path); }
 
 namespace {
 
@@ -207,9 +204,7 @@ DeepImage deep_image_from(const DeepRaster& raster, const fs::path& path, const 
 }
 
 void write_deep_image(const fs::path& path, const DeepImage& deep, const OutputMetadata& meta) {
-  std::string extension = path.extension().string();
-  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (extension != ".exr") throw OptionsError(path.string() + ": a deep image is written as OpenEXR only (.exr)");
+  if (!output_keeps_alpha(path)) throw OptionsError(path.string() + ": a deep image is written as OpenEXR only (.exr)");
   bool volumes = false;
   for (const DeepSample& s : deep.samples) volumes = volumes || s.is_volume();
   DeepRaster raster;

@@ -118,19 +118,22 @@ DeepSources make_deep_sources(const DeepImage& deep, const Camera& camera, const
   const int w = deep.width, h = deep.height;
   std::size_t clamped = 0, slabs = 0;
   std::vector<Piece> pieces;
-  // Pass 1: the range of blur, for the layers the pieces are merged into; an uncovered remainder is
-  // infinitely far.
+  // Pass 1, over the samples themselves (a volume's slabs lie between its front and back, and
+  // compose to its alpha): the range of blur, for the layers, and whether some pixel is left
+  // uncovered (the remainder is infinitely far).
   double coc_min = kInfinity, coc_max = -kInfinity;
   bool backdrop = false;
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      std::size_t unused_clamped = 0, unused_slabs = 0;
-      pixel_pieces(deep.pixel(x, y), camera, options.max_blur_px, unused_clamped, unused_slabs, pieces);
       double transmitted = 1.0;
-      for (const Piece& p : pieces) {
-        coc_min = std::min(coc_min, p.coc_px);
-        coc_max = std::max(coc_max, p.coc_px);
-        transmitted *= 1.0 - p.alpha;
+      for (const DeepSample& s : deep.pixel(x, y)) {
+        std::size_t unused = 0;
+        for (const float z : {s.z_m, s.z_back_m}) {
+          const double coc = camera.signed_coc_px(clamp_inverse_depth(camera, inverse_depth_per_mm(z), options.max_blur_px, unused));
+          coc_min = std::min(coc_min, coc);
+          coc_max = std::max(coc_max, coc);
+        }
+        transmitted *= 1.0 - s.alpha;
       }
       backdrop = backdrop || transmitted > kOpaqueRemainder;
     }

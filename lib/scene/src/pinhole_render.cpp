@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include <omp.h>
@@ -96,7 +98,10 @@ DeepImage render_pinhole_layers(const Scene& scene, const PinholeFrame& frame, i
     Rgb radiance{0.0, 0.0, 0.0};
     double depth_sum_m = 0.0;
   };
-  std::vector<std::vector<DeepSample>> pixels(static_cast<std::size_t>(width) * height);
+  // Per row (rows go to threads) its pixels' samples, and per pixel how many: a vector per pixel
+  // cost an allocation each.
+  std::vector<std::vector<DeepSample>> rows(static_cast<std::size_t>(height));
+  std::vector<std::uint32_t> counts(static_cast<std::size_t>(width) * height, 0);
 
 #pragma omp parallel num_threads(threads)
   {
@@ -145,7 +150,8 @@ DeepImage render_pinhole_layers(const Scene& scene, const PinholeFrame& frame, i
             }
           }
         }
-        std::vector<DeepSample>& samples = pixels[static_cast<std::size_t>(y) * width + x];
+        std::vector<DeepSample>& samples = rows[static_cast<std::size_t>(y)];
+        counts[static_cast<std::size_t>(y) * width + x] = static_cast<std::uint32_t>(met.size());
         for (std::size_t i = 0; i < met.size(); ++i) {
           const Met& m = met[i];
           DeepSample s;
@@ -169,9 +175,16 @@ DeepImage render_pinhole_layers(const Scene& scene, const PinholeFrame& frame, i
   }
   DeepImage out(width, height);
   std::size_t total = 0;
-  for (const std::vector<DeepSample>& p : pixels) total += p.size();
+  for (const std::vector<DeepSample>& row : rows) total += row.size();
   out.samples.reserve(total);
-  for (const std::vector<DeepSample>& p : pixels) out.push_pixel(p);
+  for (int y = 0; y < height; ++y) {
+    const DeepSample* next = rows[static_cast<std::size_t>(y)].data();
+    for (int x = 0; x < width; ++x) {
+      const std::uint32_t count = counts[static_cast<std::size_t>(y) * width + x];
+      out.push_pixel(std::span<const DeepSample>(next, count));
+      next += count;
+    }
+  }
   return out;
 }
 

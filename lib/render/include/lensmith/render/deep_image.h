@@ -62,9 +62,6 @@ struct DeepImage {
   friend std::ostream& operator<<(std::ostream& os, const DeepImage& d) { return os << d.to_string(); }
 };
 
-// Whether `path` is a deep OpenEXR (the bokeh command reads those with read_deep_image).
-bool is_deep_picture(const std::filesystem::path& path);
-
 // A deep OpenEXR as a DeepImage: channels R, G, B, A and Z (ZBack when present; else every sample is
 // a surface), depth converted like read_depth's (`options`, pixel (x, y) of `frame`). Samples are
 // sorted front to back. Throws ImageFileError naming the file, pixel and sample for a missing
