@@ -20,6 +20,7 @@
 #include "lensmith/render/bokeh_renderer.h"
 #include "lensmith/render/deep_image.h"
 #include "lensmith/render/image_io.h"
+#include "lensmith/render/multiview_renderer.h"
 
 namespace lensmith::cli {
 
@@ -73,10 +74,50 @@ std::vector<float> defocus_channels(const std::vector<float>& samples, std::size
   return out;
 }
 
+// What every output records of how it was made.
+OutputMetadata output_metadata(const BokehCommandOptions& o, const std::string& lens_name, RayModelKind kind, const Camera& camera,
+                               double focus_m, const Aperture& aperture) {
+  OutputMetadata meta;
+  meta.lens = lens_name;
+  meta.model = std::string(to_string(kind));
+  meta.lensmith_version = LENSMITH_VERSION;
+  meta.f_number = camera.f_number();
+  meta.focus_m = focus_m;
+  meta.extra = {{"aperture", aperture.to_string()}, {"method", o.method},
+                {"vignetting", o.no_vignetting ? "off" : "natural"},
+                {"spectral", o.no_spectral ? std::string("off") : std::to_string(o.spectral_samples) + " nodes"}};
+  if (kind == RayModelKind::Seidel) meta.extra.emplace_back("seidel_coefficients", o.seidel_coefficients);
+  return meta;
+}
+
+// Writes the picture (RGB, or RGBA), with the input's depth (--keep-depth) and its passes after it.
+void write_bokeh_output(Image out, OutputMetadata& meta, const BokehCommandOptions& o, const DepthMap& depth, const OtherChannels& other) {
+  std::vector<std::string> channels{"R", "G", "B"};
+  if (out.channels == 4) channels.emplace_back("A");
+  if (o.keep_depth) {
+    // The depth as read (planar metres from the entrance pupil): a compositor's Z for the picture's
+    // in-focus geometry; the blurred picture has no single depth per pixel.
+    out = with_channels(out, depth.z_m, 1);
+    channels.emplace_back("Z");
+  }
+  if (!other.names.empty()) {
+    // After R, G, B (A, Z): the passes under their own names.
+    out = with_channels(out, other.samples, other.names.size());
+    channels.insert(channels.end(), other.names.begin(), other.names.end());
+    meta.extra.emplace_back("other_channels", o.other_channels);
+  }
+  write_output_image(o.output, out, meta, channels);
+}
+
 }  // namespace
 
 int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   const auto started = std::chrono::steady_clock::now();
+  const bool multiview = o.method == "multiview";
+  if (multiview && !o.scatter_options.empty()) {
+    throw UsageError(o.scatter_options.front() + " is an option of --method scatter; --method multiview traces lens rays through the layers");
+  }
+  if (!multiview && !o.multiview_options.empty()) throw UsageError(o.multiview_options.front() + " is an option of --method multiview");
   // Inputs.
   const std::filesystem::path output = o.output;
   const DepthSource depth_source = DepthSource::parse(o.depth.empty() ? o.image : o.depth);
@@ -248,6 +289,61 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   const auto model = make_ray_model(kind, *cam, model_options);
   const Aperture aperture = make_aperture(o);
 
+  if (multiview && o.other_channels == "defocus" && !other.names.empty()) {
+    throw UsageError("--other-channels defocus with --method multiview: not implemented (use keep or drop, or --method scatter)");
+  }
+  if (multiview) {
+    MultiviewOptions options;
+    options.threads = o.threads;
+    options.samples = o.samples;
+    options.layers = o.layers;
+    options.ray_grid_px = o.ray_grid_px;
+    options.vignetting = !o.no_vignetting;
+    options.spectral = !o.no_spectral;
+    options.spectral_samples = o.spectral_samples;
+    ProgressBar bar("bokeh", !global.quiet);
+    options.progress = [&bar](double f) { bar.update(f); };
+    MultiviewStatistics stats;
+    const auto render_started = std::chrono::steady_clock::now();
+    DeepImage flat_scene;
+    if (!layered) {
+      flat_scene = deep_image_from_flat(*flat, depth);
+      if (alpha) {
+        // A transparent element: its samples cover their alpha (colour premultiplied, as read).
+        for (std::size_t i = 0; i < flat_scene.samples.size(); ++i) flat_scene.samples[i].alpha = std::clamp((*alpha)[i], 0.0f, 1.0f);
+      }
+    }
+    const DeepImage& scene = layered ? *deep : flat_scene;
+    const Image rgba = render_multiview(scene, *model, aperture, options, &stats);
+    const double render_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - render_started).count();
+    bar.finish();
+    const bool transparent = scene.max_transparency() > 1e-4;
+    if (transparent && layered && !output_keeps_alpha(output) && !global.quiet) {
+      std::cerr << "note: " << o.image << " leaves pixels uncovered (alpha < 1); only an OpenEXR output (.exr) keeps its alpha, "
+                << output.string() << " gets RGB over black\n";
+    }
+    const int channels_out = transparent && output_keeps_alpha(output) ? 4 : 3;
+    Image out(rgba.width, rgba.height, channels_out, 0.0f);
+    for (std::size_t i = 0; i < out.pixel_count(); ++i) {
+      for (int c = 0; c < channels_out; ++c) out.data[i * channels_out + c] = rgba.data[i * 4 + c];
+    }
+    OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture);
+    meta.extra.insert(meta.extra.end(), {{"samples", std::to_string(options.samples)}, {"layers", std::to_string(options.layers)}});
+    write_bokeh_output(out, meta, o, depth, other);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    std::ostringstream what;
+    what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds
+         << " s (rendering " << render_seconds << " s)\n  " << lens_name << ", model " << to_string(kind) << ", method multiview, f/"
+         << format_rounded(cam->f_number(), 3) << ", focus " << format_rounded(camera.focus_distance_m, 4) << " m, " << aperture.to_string()
+         << " aperture\n  " << stats.layers << " of " << options.layers << " depth layers hold samples, "
+         << format_rounded(stats.layer_spacing_px, 3) << " px apart; largest blur " << format_rounded(stats.max_abs_coc_px, 3) << " px; "
+         << options.samples << " lens rays per pixel, " << stats.stopped_rays
+         << " stopped by the lens, " << stats.lost_rays << " fell through what the input knows";
+    if (layered) what << "; layered input: " << scene.sample_count() << " deep samples";
+    report_written(what.str(), global);
+    return kExitOk;
+  }
+
   // Render.
   BokehOptions options;
   options.threads = o.threads;
@@ -298,32 +394,9 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   const double render_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - render_started).count();
   bar.finish();
 
-  OutputMetadata meta;
-  meta.lens = lens_name;
-  meta.model = std::string(to_string(kind));
-  meta.lensmith_version = LENSMITH_VERSION;
-  meta.f_number = cam->f_number();
-  meta.focus_m = camera.focus_distance_m;
-  meta.extra = {{"aperture", aperture.to_string()}, {"hidden_surfaces", std::string(to_string(options.hidden))},
-                {"edge_pixels", o.edge_pixels},
-                {"vignetting", options.vignetting ? "natural" : "off"},
-                {"spectral", options.spectral ? std::to_string(options.spectral_samples) + " nodes" : "off"}};
-  if (kind == RayModelKind::Seidel) meta.extra.emplace_back("seidel_coefficients", o.seidel_coefficients);
-  std::vector<std::string> channels{"R", "G", "B"};
-  if (out.channels == 4) channels.emplace_back("A");
-  if (o.keep_depth) {
-    // The depth as read (planar metres from the entrance pupil): a compositor's Z for the picture's
-    // in-focus geometry; the blurred picture has no single depth per pixel.
-    out = with_channels(out, depth.z_m, 1);
-    channels.emplace_back("Z");
-  }
-  if (!other.names.empty()) {
-    // After R, G, B (A, Z): the passes under their own names.
-    out = with_channels(out, other.samples, other.names.size());
-    channels.insert(channels.end(), other.names.begin(), other.names.end());
-    meta.extra.emplace_back("other_channels", o.other_channels);
-  }
-  write_output_image(output, out, meta, channels);
+  OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture);
+  meta.extra.insert(meta.extra.end(), {{"hidden_surfaces", std::string(to_string(options.hidden))}, {"edge_pixels", o.edge_pixels}});
+  write_bokeh_output(out, meta, o, depth, other);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   std::ostringstream what;
   what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds

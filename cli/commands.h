@@ -167,6 +167,12 @@ struct BokehCommandOptions {
   int subrows = 4;                           // --subrows
   double max_blur_px = 1000.0;               // --max-blur
   int threads = 0;                           // --threads (0 = all)
+  std::string method = "scatter";            // --method scatter|multiview
+  int samples = 32;                          // --samples (multiview)
+  int layers = 8;                            // --layers (multiview)
+  int ray_grid_px = 8;                       // --ray-grid (multiview)
+  std::vector<std::string> scatter_options;    // scatter-only options given on the command line
+  std::vector<std::string> multiview_options;  // multiview-only options given
 };
 int run_bokeh(const BokehCommandOptions& options, const GlobalOptions& global);
 

@@ -281,11 +281,24 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"fitted", "sums"}));
   bokeh_cmd->add_option("--fit", bokeh.fit, "Fit file for --model poly (lensmith fit -o); default: fit the lens in this run")
       ->check(CLI::ExistingFile);
-  bokeh_cmd->add_option("--hidden", bokeh.hidden, "Background hidden behind foreground edges: extend (default) | stretch")
-      ->check(CLI::IsMember({"extend", "stretch"}));
-  bokeh_cmd->add_option("--edge-pixels", bokeh.edge_pixels,
+  bokeh_cmd->add_option("--method", bokeh.method,
+                        "scatter (default: every pixel scattered through the ray model, depth-layered) | multiview (Lee et al. 2009: "
+                        "per pixel --samples lens rays traced through the layered scene; for deep input)")
+      ->check(CLI::IsMember({"scatter", "multiview"}));
+  CLI::Option* bokeh_samples =
+      bokeh_cmd->add_option("--samples", bokeh.samples, "multiview: lens rays per output pixel (1-4096, default 32)")->check(range(1, 4096));
+  CLI::Option* bokeh_layers =
+      bokeh_cmd->add_option("--layers", bokeh.layers, "multiview: depth layers, evenly spaced in signed blur (1-64, default 8)")->check(range(1, 64));
+  CLI::Option* bokeh_ray_grid =
+      bokeh_cmd->add_option("--ray-grid", bokeh.ray_grid_px,
+                            "multiview: lens rays computed every this many pixels and interpolated between (1-64, default 8; 1 = every pixel)")
+          ->check(range(1, 64));
+  std::vector<CLI::Option*> bokeh_scatter_only;
+  bokeh_scatter_only.push_back(bokeh_cmd->add_option("--hidden", bokeh.hidden, "Background hidden behind foreground edges: extend (default) | stretch")
+      ->check(CLI::IsMember({"extend", "stretch"})));
+  bokeh_scatter_only.push_back(bokeh_cmd->add_option("--edge-pixels", bokeh.edge_pixels,
                         "Anti-aliased depth-edge pixels: split (default: between their two surfaces by colour) | keep (at their depth)")
-      ->check(CLI::IsMember({"split", "keep"}));
+      ->check(CLI::IsMember({"split", "keep"})));
   bokeh_cmd->add_flag("--no-vignetting", bokeh.no_vignetting,
                       "Every point as bright as on the axis: no cos^4-type falloff, no darkening where clear apertures clip "
                       "(the bokeh keeps its cat's-eye shape)");
@@ -296,11 +309,11 @@ int main(int argc, char** argv) {
       ->check(range(1.0, 1.0e6));
   bokeh_cmd->add_option("--highlight-threshold", bokeh.highlight_threshold, "Encoded value from which a channel counts as clipped (default 0.98)")
       ->check(range(0.5, 1.0));
-  bokeh_cmd->add_option("--layer-spacing", bokeh.layer_spacing_px, "Depth-layer step in signed blur diameter, px (default 2)")
-      ->check(range(0.1, 1000.0));
-  bokeh_cmd->add_option("--subrows", bokeh.subrows, "Sub-rows per pixel of the scatter (1-16, default 4)")->check(range(1, 16));
-  bokeh_cmd->add_option("--max-blur", bokeh.max_blur_px, "Largest blur diameter, px; nearer points are clamped (default 1000)")
-      ->check(range(1.0, 1.0e6));
+  bokeh_scatter_only.push_back(bokeh_cmd->add_option("--layer-spacing", bokeh.layer_spacing_px, "Depth-layer step in signed blur diameter, px (default 2)")
+      ->check(range(0.1, 1000.0)));
+  bokeh_scatter_only.push_back(bokeh_cmd->add_option("--subrows", bokeh.subrows, "Sub-rows per pixel of the scatter (1-16, default 4)")->check(range(1, 16)));
+  bokeh_scatter_only.push_back(bokeh_cmd->add_option("--max-blur", bokeh.max_blur_px, "Largest blur diameter, px; nearer points are clamped (default 1000)")
+      ->check(range(1.0, 1.0e6)));
   bokeh_cmd->add_option("--threads", bokeh.threads, "Threads (default 0 = all cores)")->check(range(0, 4096));
 
   ValidateCommandOptions validate;
@@ -467,7 +480,16 @@ int main(int argc, char** argv) {
     if (*fan_cmd) return run_fan(fan, global);
     if (*layout_cmd) return run_layout(layout, global);
     if (*analyze_cmd) return run_analyze(analyze, global);
-    if (*bokeh_cmd) return run_bokeh(bokeh, global);
+    if (*bokeh_cmd) {
+      // Options of one method given to the other are an error, not silently ignored.
+      for (CLI::Option* option : bokeh_scatter_only) {
+        if (option->count() > 0) bokeh.scatter_options.push_back(option->get_name());
+      }
+      for (CLI::Option* option : {bokeh_samples, bokeh_layers, bokeh_ray_grid}) {
+        if (option->count() > 0) bokeh.multiview_options.push_back(option->get_name());
+      }
+      return run_bokeh(bokeh, global);
+    }
     if (*validate_cmd) return run_validate(validate, global);
     if (*scene_render_cmd) return run_scene_render(scene_render, global);
     if (*fit_cmd) return run_fit(fit, global);

@@ -302,6 +302,7 @@ class PolyModel final : public RayModel {
   bool affine_in_pupil() const override { return false; }
   void map(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
            std::span<SensorHit> hits) const override;
+  std::shared_ptr<const LensFit> fit() const override { return fit_; }
 
  private:
   void map_raw(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil, std::span<SensorHit> hits) const;

@@ -91,6 +91,8 @@ class RayModel {
   // empty. Thread-safe.
   virtual void clip_discs(const ScenePoint& /*point*/, std::vector<PupilDisc>& discs) const { discs.clear(); }
   const Camera& camera() const { return camera_; }
+  // The polynomial fit the poly model maps through; null for the other models.
+  virtual std::shared_ptr<const LensFit> fit() const { return nullptr; }
   virtual std::string to_string() const;
   friend std::ostream& operator<<(std::ostream& os, const RayModel& m) { return os << m.to_string(); }
 

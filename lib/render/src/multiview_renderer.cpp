@@ -1,0 +1,435 @@
+// Lee, Eisemann & Seidel's multiview synthesis through the ray model's lens rays
+// (multiview_renderer.h says what the paper does and what lensmith does differently).
+#include "lensmith/render/multiview_renderer.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <sstream>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "lens_ray_table.h"
+#include "lensmith/color/spectral_quadrature.h"
+#include "lensmith/core/errors.h"
+#include "lensmith/core/huge_page_allocator.h"
+#include "lensmith/core/split_mix.h"
+#include "lensmith/core/units.h"
+
+namespace lensmith {
+
+namespace {
+
+constexpr int kTilePx = 16;                // early culling: occupancy per layer on tiles of this size
+constexpr float kOpaque = 1e-4f;
+constexpr double kLayerOverlap = 0.25;
+// Base points per wavelength node (each with its three rotations): enough radii that no node sees
+// only one ring of the pupil, whose blur differs from the others' (radial colour fringes).
+constexpr std::size_t kBasePointsPerNode = 4;
+constexpr std::size_t kMaxNodes = 64;  // MultiviewOptions::spectral_samples at most
+constexpr std::size_t kRaysPerBand = 8;  // MultiviewOptions::spectral_samples at most     // share of the layer spacing a sample reaches into the next layer           // a ray whose remaining transmittance is below this stops
+constexpr double kMinWavelengthNm = 380.0;  // the spectral range of the scatter path (spectral_groups.cpp)
+constexpr double kMaxWavelengthNm = 780.0;
+
+// Radical inverse of i in base b (Halton's sequence).
+double radical_inverse(std::uint64_t i, std::uint64_t base) {
+  double inv = 1.0 / static_cast<double>(base), f = inv, r = 0.0;
+  while (i > 0) {
+    r += f * static_cast<double>(i % base);
+    i /= base;
+    f *= inv;
+  }
+  return r;
+}
+
+// A layer's sample at one pixel: inverse depth (1/mm; < 0: none) and where its colour is.
+struct Cell {
+  float w = -1.0f;
+  std::uint32_t colour = 0;
+};
+
+struct Layers {
+  int count = 1;
+  int width = 0, height = 0, tiles_x = 0, tiles_y = 0;
+  std::vector<float> w_near, w_far;  // per layer, inverse depth bounds (1/mm), near >= far
+  float overlap = 0.0f;              // samples this close to a bound (1/mm) are in the neighbouring layer too
+  std::vector<Cell, HugePageAllocator<Cell>> cells;                       // [layer][y][x]
+  std::vector<std::array<float, 4>, HugePageAllocator<std::array<float, 4>>> colours;  // premultiplied RGB, alpha
+  std::vector<std::uint8_t> occupied;                                    // [layer][tile]
+  std::vector<std::uint8_t> layer_used;
+  const Cell& cell(int l, int x, int y) const {
+    return cells[(static_cast<std::size_t>(l) * height + static_cast<std::size_t>(y)) * width + static_cast<std::size_t>(x)];
+  }
+};
+
+// Splits the samples into layers evenly spaced in inverse depth (= in signed CoC, Lee et al. eq. 4),
+// compositing a pixel's samples of one layer front to back.
+Layers make_layers(const DeepImage& scene, int layer_count, double& w_min_out, double& w_max_out) {
+  Layers layers;
+  layers.width = scene.width;
+  layers.height = scene.height;
+  double w_min = std::numeric_limits<double>::infinity(), w_max = -w_min;
+  for (const DeepSample& s : scene.samples) {
+    if (!(s.alpha > 0.0f)) continue;
+    const double w = inverse_depth_per_mm(s.z_m);
+    w_min = std::min(w_min, w);
+    w_max = std::max(w_max, w);
+  }
+  if (!(w_max >= w_min)) w_min = w_max = 0.0;  // no sample covers anything
+  w_min_out = w_min;
+  w_max_out = w_max;
+  layers.count = w_max > w_min ? layer_count : 1;
+  const double step = (w_max - w_min) / layers.count;
+  layers.overlap = static_cast<float>(kLayerOverlap * step);
+  for (int l = 0; l < layers.count; ++l) {
+    layers.w_near.push_back(static_cast<float>(w_max - l * step));
+    layers.w_far.push_back(static_cast<float>(l + 1 == layers.count ? w_min : w_max - (l + 1) * step));
+  }
+  const std::size_t pixels = static_cast<std::size_t>(scene.width) * static_cast<std::size_t>(scene.height);
+  layers.cells.assign(pixels * static_cast<std::size_t>(layers.count), Cell{});
+  layers.colours.reserve(scene.samples.size());
+  layers.tiles_x = (scene.width + kTilePx - 1) / kTilePx;
+  layers.tiles_y = (scene.height + kTilePx - 1) / kTilePx;
+  layers.occupied.assign(static_cast<std::size_t>(layers.tiles_x) * layers.tiles_y * layers.count, 0);
+  layers.layer_used.assign(static_cast<std::size_t>(layers.count), 0);
+  for (std::size_t p = 0; p < pixels; ++p) {
+    const int x = static_cast<int>(p % static_cast<std::size_t>(scene.width)), y = static_cast<int>(p / static_cast<std::size_t>(scene.width));
+    for (std::uint64_t k = scene.first_sample[p]; k < scene.first_sample[p + 1]; ++k) {
+      const DeepSample& s = scene.samples[k];
+      if (!(s.alpha > 0.0f)) continue;
+      const double w = inverse_depth_per_mm(s.z_m);
+      // Its layer, and the neighbouring one where it lies within the overlap of their bound (Lee et
+      // al. sec. 4.2 overlap layers by 10 %, against seams; here a quarter of the spacing each side,
+      // so that a surface sloping across a bound is continuous in both).
+      const double position = step > 0.0 ? (w_max - w) / step : 0.0;
+      const int home = std::clamp(static_cast<int>(position), 0, layers.count - 1);
+      const double within = position - home;
+      const int neighbour = within < kLayerOverlap && home > 0 ? home - 1 : within > 1.0 - kLayerOverlap && home + 1 < layers.count ? home + 1 : home;
+      const std::array<int, 2> targets{home, neighbour};
+      for (std::size_t i = 0; i < (neighbour == home ? 1u : 2u); ++i) {
+      const int l = targets[i];
+      Cell& c = layers.cells[static_cast<std::size_t>(l) * pixels + p];
+      if (c.w < 0.0f) {
+        c.w = static_cast<float>(w);
+        c.colour = static_cast<std::uint32_t>(layers.colours.size());
+        layers.colours.push_back({s.rgb[0], s.rgb[1], s.rgb[2], s.alpha});
+        layers.occupied[(static_cast<std::size_t>(l) * layers.tiles_y + static_cast<std::size_t>(y / kTilePx)) * layers.tiles_x +
+                        static_cast<std::size_t>(x / kTilePx)] = 1;
+        layers.layer_used[static_cast<std::size_t>(l)] = 1;
+      } else {
+        // Behind the layer's nearer samples of this pixel: "over", front to back.
+        std::array<float, 4>& q = layers.colours[c.colour];
+        const float t = 1.0f - q[3];
+        for (int ch = 0; ch < 3; ++ch) q[static_cast<std::size_t>(ch)] += t * s.rgb[static_cast<std::size_t>(ch)];
+        q[3] += t * s.alpha;
+      }
+      }
+    }
+  }
+  return layers;
+}
+
+// What one ray brought back.
+struct RayResult {
+  std::array<float, 3> colour{};  // premultiplied radiance it met, each hit weighted by what was left of the ray
+  float transmittance = 1.0f;     // what passed every layer
+  bool left_frame = false;         // it read the layers beyond the frame (as their edge pixels)
+  std::size_t cells = 0;
+};
+
+// Follows the ray p(w) = inf + w k through the layers, nearest first (Lee et al. sec. 4.3), walking
+// each layer's segment cell by cell. The ray hits a cell's sample where it crosses the sample's
+// depth inside the cell, or where it steps from in front of the previous cell's sample to behind
+// this one's (the surface is taken to be continuous between neighbouring samples of one layer, so a
+// sloping surface is not missed between pixel centres). Unlike the paper's height field, a ray that
+// passes behind a sample from the side (behind a foreground edge) does not hit it: it goes on to
+// what the deeper layers hold there. A hit of alpha < 1 lets the rest of the ray go on.
+RayResult follow(const Layers& layers, const PixelRay& ray) {
+  RayResult r;
+  float last_hit_w = std::numeric_limits<float>::infinity();  // layers overlap: a sample is hit once
+  for (int l = 0; l < layers.count && r.transmittance > kOpaque; ++l) {
+    if (!layers.layer_used[static_cast<std::size_t>(l)]) continue;
+    // The layer's interval widened by the overlap its samples were copied into.
+    const float w0 = layers.w_near[static_cast<std::size_t>(l)] + layers.overlap;
+    const float w1 = layers.w_far[static_cast<std::size_t>(l)] - layers.overlap;
+    const float x0 = ray.inf_x + w0 * ray.k_x, y0 = ray.inf_y + w0 * ray.k_y;
+    const float x1 = ray.inf_x + w1 * ray.k_x, y1 = ray.inf_y + w1 * ray.k_y;
+    // Early culling: no tile of this layer under the segment holds a sample.
+    {
+      const int tx0 = std::clamp(static_cast<int>(std::floor(std::min(x0, x1))) / kTilePx, 0, layers.tiles_x - 1);
+      const int tx1 = std::clamp(static_cast<int>(std::floor(std::max(x0, x1))) / kTilePx, 0, layers.tiles_x - 1);
+      const int ty0 = std::clamp(static_cast<int>(std::floor(std::min(y0, y1))) / kTilePx, 0, layers.tiles_y - 1);
+      const int ty1 = std::clamp(static_cast<int>(std::floor(std::max(y0, y1))) / kTilePx, 0, layers.tiles_y - 1);
+      bool any = false;
+      for (int ty = ty0; ty <= ty1 && !any; ++ty) {
+        const std::uint8_t* row = layers.occupied.data() + (static_cast<std::size_t>(l) * layers.tiles_y + ty) * layers.tiles_x;
+        for (int tx = tx0; tx <= tx1; ++tx) any = any || row[tx];
+      }
+      if (!any) continue;
+    }
+    // Amanatides & Woo's walk over the pixel cells of the segment, s in [0, 1] along it.
+    const float dx = x1 - x0, dy = y1 - y0;
+    int cx = static_cast<int>(std::floor(x0)), cy = static_cast<int>(std::floor(y0));
+    const int ex = static_cast<int>(std::floor(x1)), ey = static_cast<int>(std::floor(y1));
+    const int step_x = dx > 0.0f ? 1 : -1, step_y = dy > 0.0f ? 1 : -1;
+    const float inf = std::numeric_limits<float>::infinity();
+    const float delta_x = dx != 0.0f ? 1.0f / std::abs(dx) : inf, delta_y = dy != 0.0f ? 1.0f / std::abs(dy) : inf;
+    float next_x = dx != 0.0f ? (static_cast<float>(cx + (dx > 0.0f ? 1 : 0)) - x0) / dx : inf;
+    float next_y = dy != 0.0f ? (static_cast<float>(cy + (dy > 0.0f ? 1 : 0)) - y0) / dy : inf;
+    int steps_left = std::abs(ex - cx) + std::abs(ey - cy) + 1;
+    float s_in = 0.0f;
+    bool in_front_of_previous = false;  // the previous cell held a sample the ray left in front of
+    while (steps_left-- > 0) {
+      const float s_out = std::min({next_x, next_y, 1.0f});
+      ++r.cells;
+      // Beyond the frame the layers continue as their edge pixels (Lee et al. discard such rays,
+      // which darkens or renormalises every blurred pixel near the border; a scene usually goes on
+      // past the frame as it is at its edge).
+      const bool outside = cx < 0 || cy < 0 || cx >= layers.width || cy >= layers.height;
+      r.left_frame = r.left_frame || outside;
+      const Cell& c = layers.cell(l, std::clamp(cx, 0, layers.width - 1), std::clamp(cy, 0, layers.height - 1));
+      if (c.w < 0.0f) {
+        in_front_of_previous = false;
+      } else {
+        const float w_in = w0 + s_in * (w1 - w0), w_out = w0 + s_out * (w1 - w0);
+        const bool crosses = c.w <= w_in && c.w >= w_out;
+        const bool steps_behind = in_front_of_previous && c.w > w_in;
+        if ((crosses || steps_behind) && c.w < last_hit_w) {
+          const std::array<float, 4>& q = layers.colours[c.colour];
+          for (std::size_t ch = 0; ch < 3; ++ch) r.colour[ch] += r.transmittance * q[ch];
+          r.transmittance *= 1.0f - q[3];
+          last_hit_w = c.w;
+          if (r.transmittance <= kOpaque) break;
+        }
+        in_front_of_previous = w_out > c.w;
+      }
+      if (s_out >= 1.0f) break;
+      s_in = s_out;
+      if (next_x < next_y) {
+        cx += step_x;
+        next_x += delta_x;
+      } else {
+        cy += step_y;
+        next_y += delta_y;
+      }
+    }
+  }
+  return r;
+}
+
+}  // namespace
+
+void MultiviewOptions::validate() const {
+  if (threads < 0) throw OptionsError("threads must be >= 0 (0 = all), got " + std::to_string(threads));
+  if (samples < 1 || samples > 4096) throw OptionsError("--samples must be 1 to 4096 lens rays per pixel, got " + std::to_string(samples));
+  if (layers < 1 || layers > 64) throw OptionsError("--layers must be 1 to 64, got " + std::to_string(layers));
+  if (spectral_samples < 3 || spectral_samples > 64) {
+    throw OptionsError("--spectral-samples must be 3 to 64, got " + std::to_string(spectral_samples));
+  }
+  if (ray_grid_px < 1 || ray_grid_px > 64) throw OptionsError("the lens ray grid must be 1 to 64 px, got " + std::to_string(ray_grid_px));
+}
+
+std::string MultiviewOptions::to_string() const {
+  std::ostringstream os;
+  os << "MultiviewOptions(" << samples << " samples, " << layers << " layers, vignetting " << (vignetting ? "on" : "off")
+     << ", spectral " << (spectral ? std::to_string(spectral_samples) + " nodes" : std::string("off")) << ", ray grid " << ray_grid_px
+     << " px, threads " << threads << ")";
+  return os.str();
+}
+
+std::string MultiviewStatistics::to_string() const {
+  std::ostringstream os;
+  os << "MultiviewStatistics(" << layers << " layers " << layer_spacing_px << " px apart, " << rays << " rays, " << stopped_rays
+     << " stopped, " << lost_rays << " lost, " << cells_visited << " cells, " << direct_rays << " direct)";
+  return os.str();
+}
+
+DeepImage deep_image_from_flat(const Image& image, const DepthMap& depth) {
+  if (image.channels != 3 || image.width != depth.width || image.height != depth.height) {
+    throw OptionsError("a flat picture for multiview needs 3 channels and a depth map of its size");
+  }
+  DeepImage deep;
+  deep.width = image.width;
+  deep.height = image.height;
+  const std::size_t n = image.pixel_count();
+  deep.first_sample.resize(n + 1);
+  deep.samples.resize(n);
+  for (std::size_t p = 0; p < n; ++p) {
+    deep.first_sample[p] = p;
+    DeepSample& s = deep.samples[p];
+    s.rgb = {image.data[3 * p], image.data[3 * p + 1], image.data[3 * p + 2]};
+    s.alpha = 1.0f;
+    s.z_m = s.z_back_m = depth.z_m[p];
+  }
+  deep.first_sample[n] = n;
+  return deep;
+}
+
+Image render_multiview(const DeepImage& scene, const RayModel& model, const Aperture& aperture, const MultiviewOptions& options,
+                       MultiviewStatistics* statistics) {
+  options.validate();
+  const Camera& camera = model.camera();
+  const int width = camera.frame().width_px(), height = camera.frame().height_px();
+  if (scene.width != width || scene.height != height) {
+    throw OptionsError("the layered scene is " + std::to_string(scene.width) + " x " + std::to_string(scene.height) +
+                       " px, the camera frames " + std::to_string(width) + " x " + std::to_string(height));
+  }
+  double w_min = 0.0, w_max = 0.0;
+  const Layers layers = make_layers(scene, options.layers, w_min, w_max);
+  const bool opaque = scene.max_transparency() <= 1e-4;
+
+  // Wavelengths: the scatter path's quadrature (spectral_groups.cpp) in bands of neighbouring
+  // nodes, each band traced at its middle node and carrying the colour of all of its nodes, as the
+  // scatter path's spectral groups do; at least kRaysPerBand rays per band and pixel, because one
+  // wavelength per ray with few rays per pixel is colour noise. Or the reference wavelength alone.
+  std::vector<double> wavelengths;
+  std::vector<Eigen::Matrix3f> to_rgb;  // per band: bands x sum over its nodes of rgb_weights (x) basis
+  if (options.spectral) {
+    SpectralQuadratureOptions q;
+    q.sample_count = options.spectral_samples;
+    q.min_wavelength_nm = kMinWavelengthNm;
+    q.max_wavelength_nm = kMaxWavelengthNm;
+    const SpectralQuadrature quadrature(q);
+    const std::size_t n = quadrature.size();
+    const std::size_t bands = std::clamp<std::size_t>(static_cast<std::size_t>(options.samples) / kRaysPerBand, 1, n);
+    for (std::size_t b = 0; b < bands; ++b) {
+      const std::size_t begin = b * n / bands, end = (b + 1) * n / bands;
+      wavelengths.push_back(quadrature.wavelengths_nm()[(begin + end - 1) / 2]);
+      Eigen::Matrix3f m = Eigen::Matrix3f::Zero();
+      for (std::size_t i = begin; i < end; ++i) {
+        const Rgb weight = quadrature.rgb_weights(i), basis = quadrature.basis().basis_values(quadrature.wavelengths_nm()[i]);
+        for (int out = 0; out < 3; ++out) {
+          for (int in = 0; in < 3; ++in) m(out, in) += static_cast<float>(static_cast<double>(bands) * weight[out] * basis[in]);
+        }
+      }
+      to_rgb.push_back(m);
+    }
+  } else {
+    wavelengths = {camera.reference_wavelength_nm()};
+    to_rgb.push_back(Eigen::Matrix3f::Identity());
+  }
+  // The lens samples (Lee et al. sec. 4.5 use 2N Halton points and an offset per pixel). Here each
+  // wavelength node has its own points, in groups of four: a base point and its rotations by 180,
+  // 90 and 270 degrees, so that every node's set, and every pair a pixel takes, is balanced about
+  // the pupil's centre; a node's base points lie in B strata of radius^2 (jittered per node by the
+  // plastic ratio), their angles from Halton's sequence in base 3 turned per node by the golden
+  // ratio. A pixel takes its N rays from the nodes in turn, starting at a node of its own; node k's
+  // pair p comes from base point (o + k + p) mod B, o the pixel's own offset: within a pixel the
+  // nodes cover the radius strata evenly, and over the pixels every node sees every stratum.
+  // Without that balance a node's few points lean to one side or one ring of the pupil and blurred
+  // edges take its colour (seen as red and green fringes on a fence).
+  const std::size_t n_samples = static_cast<std::size_t>(options.samples), nodes = wavelengths.size();
+  const std::size_t pairs_per_node = std::max<std::size_t>(1, ((n_samples + nodes - 1) / nodes + 1) / 2);
+  const std::size_t strata = std::max(kBasePointsPerNode, pairs_per_node), per_node = 4 * strata;
+  std::vector<LensSample> lens_samples(nodes * per_node);
+  for (std::size_t k = 0; k < nodes; ++k) {
+    const double radial_jitter = std::fmod(static_cast<double>(k) * 0.7548776662466927, 1.0);
+    const double angular_shift = std::fmod(static_cast<double>(k) * 0.6180339887498949, 1.0);
+    for (std::size_t q = 0; q < per_node; ++q) {
+      const std::size_t base = q / 4;
+      static constexpr std::array<double, 4> kTurn{0.0, 0.5, 0.25, 0.75};
+      LensSample& sample = lens_samples[k * per_node + q];
+      sample.u = (static_cast<double>(base) + radial_jitter) / static_cast<double>(strata);
+      sample.v = std::fmod(radical_inverse(base + 1, 3) + angular_shift + kTurn[q % 4], 1.0);
+      sample.node = static_cast<int>(k);
+    }
+  }
+  LensRayTableOptions table_options;
+  table_options.grid_px = options.ray_grid_px;
+  table_options.vignetting = options.vignetting;
+  table_options.threads = options.threads;
+  const LensRayTable rays(model, aperture, wavelengths, lens_samples, table_options);
+
+  Image out(width, height, 4, 0.0f);
+  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  std::size_t total_rays = 0, stopped = 0, lost = 0, cells = 0, outside = 0;
+  int rows_done = 0;
+#pragma omp parallel for schedule(dynamic, 2) num_threads(threads) reduction(+ : total_rays, stopped, lost, cells, outside)
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      // The pixel's first node and its offset into each node's points: fixed per pixel,
+      // decorrelated from its neighbours.
+      std::uint64_t state = (static_cast<std::uint64_t>(y) << 32) ^ static_cast<std::uint64_t>(x);
+      const std::uint64_t hash = splitmix64(state);
+      const std::size_t first_node = static_cast<std::size_t>(hash % nodes), offset = static_cast<std::size_t>((hash >> 24) % strata);
+      // Colour: per wavelength node k, the weighted mean of what its rays met (premultiplied; the
+      // share of a ray lost where an opaque input knows nothing left out), through the node's RGB
+      // matrix M_k (n x the quadrature's weight times the spectral basis); averaged over the nodes.
+      // Sum_k M_k = n I (the quadrature's round trip), so grey stays grey; a node whose rays the
+      // lens stopped takes the pixel's mean colour, so a missing wavelength does not tint it.
+      std::array<Eigen::Vector3f, kMaxNodes> node_sum;
+      std::array<float, kMaxNodes> node_weight{};
+      for (std::size_t k = 0; k < nodes; ++k) node_sum[k].setZero();
+      Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+      double weight_all = 0.0, weight_seen = 0.0, coverage = 0.0;
+      for (std::size_t i = 0; i < n_samples; ++i) {
+        const std::size_t k = (first_node + i) % nodes, occurrence = (first_node + i) / nodes;
+        const std::size_t pair = occurrence / 2, turn = occurrence % 2 + 2 * (pair % 2);
+        const std::size_t j = k * per_node + 4 * ((offset + k + pair) % strata) + turn;
+        const PixelRay ray = rays.ray(x, y, j);
+        ++total_rays;
+        if (!(ray.weight > 0.0f)) {
+          ++stopped;
+          continue;
+        }
+        const RayResult r = follow(layers, ray);
+        cells += r.cells;
+        outside += r.left_frame ? 1 : 0;
+        weight_all += ray.weight;
+        float seen_share = 1.0f;
+        if (opaque && r.transmittance > kOpaque) {
+          seen_share = 1.0f - r.transmittance;
+          ++lost;
+        }
+        weight_seen += ray.weight * seen_share;
+        coverage += ray.weight * (1.0f - r.transmittance);
+        const Eigen::Vector3f met = ray.weight * Eigen::Vector3f(r.colour[0], r.colour[1], r.colour[2]);
+        node_sum[k] += met;
+        node_weight[k] += ray.weight * seen_share;
+        sum += met;
+      }
+      float* px = &out.data[(static_cast<std::size_t>(y) * width + static_cast<std::size_t>(x)) * 4];
+      if (!(weight_seen > 1e-9)) continue;
+      const Eigen::Vector3f mean = sum / static_cast<float>(weight_seen);
+      Eigen::Vector3f rgb = Eigen::Vector3f::Zero();
+      for (std::size_t k = 0; k < nodes; ++k) {
+        rgb += to_rgb[k] * (node_weight[k] > 1e-6f ? Eigen::Vector3f(node_sum[k] / node_weight[k]) : mean);
+      }
+      // Vignetting on: the pixel's light is the mean weight over all N samples (stopped rays bring
+      // none); off: every passing ray counts alike.
+      const float brightness = options.vignetting ? static_cast<float>(weight_all / static_cast<double>(n_samples)) : 1.0f;
+      rgb *= brightness / static_cast<float>(nodes);
+      for (int c = 0; c < 3; ++c) px[c] = std::max(0.0f, rgb[c]);
+      px[3] = static_cast<float>(std::clamp(coverage / weight_seen, 0.0, 1.0));
+    }
+    if (options.progress) {
+#pragma omp critical(multiview_progress)
+      {
+        ++rows_done;
+        if (rows_done % 16 == 0 || rows_done == height) options.progress(static_cast<double>(rows_done) / height);
+      }
+    }
+  }
+  if (statistics) {
+    int used = 0;
+    for (std::uint8_t u : layers.layer_used) used += u;
+    statistics->layers = used;
+    const double coc_near = camera.signed_coc_px(w_max), coc_far = camera.signed_coc_px(w_min);
+    statistics->layer_spacing_px = std::abs(coc_near - coc_far) / layers.count;
+    statistics->max_abs_coc_px = std::max(std::abs(coc_near), std::abs(coc_far));
+    statistics->rays = total_rays;
+    statistics->stopped_rays = stopped;
+    statistics->lost_rays = lost;
+    statistics->cells_visited = cells;
+    statistics->outside_rays = outside;
+    statistics->direct_rays = rays.direct_rays();
+  }
+  return out;
+}
+
+}  // namespace lensmith
