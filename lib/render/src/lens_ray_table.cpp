@@ -225,8 +225,12 @@ PixelRay LensRayTable::ray(int x, int y, std::size_t j) const {
   const PixelRay& c = base[static_cast<std::size_t>(iy1) * nodes_x_ + ix];
   const PixelRay& d = base[static_cast<std::size_t>(iy1) * nodes_x_ + ix1];
   if (tx == 0.0f && ty == 0.0f) return a;
-  if (a.weight <= 0.0f || b.weight <= 0.0f || c.weight <= 0.0f || d.weight <= 0.0f) {
-    // A stopped corner: the beam's edge crosses this cell.
+  const int stopped_corners = (a.weight <= 0.0f) + (b.weight <= 0.0f) + (c.weight <= 0.0f) + (d.weight <= 0.0f);
+  // Stopped at every corner: stopped inside (the region where a pupil sample passes is convex
+  // enough over a cell that no beam edge enters and leaves between corners).
+  if (stopped_corners == 4) return {};
+  if (stopped_corners > 0) {
+    // The beam's edge crosses this cell: the pixel's own ray.
     direct_rays_.fetch_add(1, std::memory_order_relaxed);
     return direct_ray(x + 0.5, y + 0.5, j);
   }

@@ -28,9 +28,10 @@ namespace {
 constexpr int kTilePx = 16;                // early culling: occupancy per layer on tiles of this size
 constexpr float kOpaque = 1e-4f;
 constexpr double kLayerOverlap = 0.25;
+constexpr double kConnectPx = 1.0;  // neighbouring samples whose signed CoC differs less are one surface (px)
 // Base points per wavelength node (each with its three rotations): enough radii that no node sees
 // only one ring of the pupil, whose blur differs from the others' (radial colour fringes).
-constexpr std::size_t kBasePointsPerNode = 4;
+constexpr std::size_t kBasePointsPerNode = 8;
 constexpr std::size_t kMaxNodes = 64;  // MultiviewOptions::spectral_samples at most
 constexpr std::size_t kRaysPerBand = 8;  // MultiviewOptions::spectral_samples at most     // share of the layer spacing a sample reaches into the next layer           // a ray whose remaining transmittance is below this stops
 constexpr double kMinWavelengthNm = 380.0;  // the spectral range of the scatter path (spectral_groups.cpp)
@@ -58,6 +59,7 @@ struct Layers {
   int width = 0, height = 0, tiles_x = 0, tiles_y = 0;
   std::vector<float> w_near, w_far;  // per layer, inverse depth bounds (1/mm), near >= far
   float overlap = 0.0f;              // samples this close to a bound (1/mm) are in the neighbouring layer too
+  float connect = 0.0f;              // neighbouring samples closer than this (1/mm) are one continuous surface
   std::vector<Cell, HugePageAllocator<Cell>> cells;                       // [layer][y][x]
   std::vector<std::array<float, 4>, HugePageAllocator<std::array<float, 4>>> colours;  // premultiplied RGB, alpha
   std::vector<std::uint8_t> occupied;                                    // [layer][tile]
@@ -146,7 +148,8 @@ struct RayResult {
 // each layer's segment cell by cell. The ray hits a cell's sample where it crosses the sample's
 // depth inside the cell, or where it steps from in front of the previous cell's sample to behind
 // this one's (the surface is taken to be continuous between neighbouring samples of one layer, so a
-// sloping surface is not missed between pixel centres). Unlike the paper's height field, a ray that
+// sloping surface is not missed between pixel centres; samples whose blur differs by more than
+// kConnectPx are not one surface, whatever the layers). Unlike the paper's height field, a ray that
 // passes behind a sample from the side (behind a foreground edge) does not hit it: it goes on to
 // what the deeper layers hold there. A hit of alpha < 1 lets the rest of the ray go on.
 RayResult follow(const Layers& layers, const PixelRay& ray) {
@@ -184,6 +187,7 @@ RayResult follow(const Layers& layers, const PixelRay& ray) {
     int steps_left = std::abs(ex - cx) + std::abs(ey - cy) + 1;
     float s_in = 0.0f;
     bool in_front_of_previous = false;  // the previous cell held a sample the ray left in front of
+    float previous_w = 0.0f;
     while (steps_left-- > 0) {
       const float s_out = std::min({next_x, next_y, 1.0f});
       ++r.cells;
@@ -198,7 +202,7 @@ RayResult follow(const Layers& layers, const PixelRay& ray) {
       } else {
         const float w_in = w0 + s_in * (w1 - w0), w_out = w0 + s_out * (w1 - w0);
         const bool crosses = c.w <= w_in && c.w >= w_out;
-        const bool steps_behind = in_front_of_previous && c.w > w_in;
+        const bool steps_behind = in_front_of_previous && c.w > w_in && std::abs(c.w - previous_w) < layers.connect;
         if ((crosses || steps_behind) && c.w < last_hit_w) {
           const std::array<float, 4>& q = layers.colours[c.colour];
           for (std::size_t ch = 0; ch < 3; ++ch) r.colour[ch] += r.transmittance * q[ch];
@@ -207,6 +211,7 @@ RayResult follow(const Layers& layers, const PixelRay& ray) {
           if (r.transmittance <= kOpaque) break;
         }
         in_front_of_previous = w_out > c.w;
+        previous_w = c.w;
       }
       if (s_out >= 1.0f) break;
       s_in = s_out;
@@ -280,7 +285,12 @@ Image render_multiview(const DeepImage& scene, const RayModel& model, const Aper
                        " px, the camera frames " + std::to_string(width) + " x " + std::to_string(height));
   }
   double w_min = 0.0, w_max = 0.0;
-  const Layers layers = make_layers(scene, options.layers, w_min, w_max);
+  Layers layers = make_layers(scene, options.layers, w_min, w_max);
+  {
+    // Signed CoC is linear in inverse depth: its slope turns kConnectPx into inverse depth.
+    const double slope = std::abs(camera.signed_coc_px(1e-3) - camera.signed_coc_px(0.0)) / 1e-3;
+    layers.connect = static_cast<float>(slope > 0.0 ? kConnectPx / slope : std::numeric_limits<double>::infinity());
+  }
   const bool opaque = scene.max_transparency() <= 1e-4;
 
   // Wavelengths: the scatter path's quadrature (spectral_groups.cpp) in bands of neighbouring
@@ -314,21 +324,21 @@ Image render_multiview(const DeepImage& scene, const RayModel& model, const Aper
     to_rgb.push_back(Eigen::Matrix3f::Identity());
   }
   // The lens samples (Lee et al. sec. 4.5 use 2N Halton points and an offset per pixel). Here each
-  // wavelength node has its own points, in groups of four: a base point and its rotations by 180,
-  // 90 and 270 degrees, so that every node's set, and every pair a pixel takes, is balanced about
-  // the pupil's centre; a node's base points lie in B strata of radius^2 (jittered per node by the
-  // plastic ratio), their angles from Halton's sequence in base 3 turned per node by the golden
-  // ratio. A pixel takes its N rays from the nodes in turn, starting at a node of its own; node k's
-  // pair p comes from base point (o + k + p) mod B, o the pixel's own offset: within a pixel the
-  // nodes cover the radius strata evenly, and over the pixels every node sees every stratum.
-  // Without that balance a node's few points lean to one side or one ring of the pupil and blurred
-  // edges take its colour (seen as red and green fringes on a fence).
+  // wavelength band has its own points, in groups of four: a base point and its rotations by 180,
+  // 90 and 270 degrees, so that every band's set, and every pair a pixel takes, is balanced about
+  // the pupil's centre. A band's B base points lie one in each of B strata of radius^2 (jittered per
+  // band by the plastic ratio), their angles from Halton's sequence in base 3 turned per band by the
+  // golden ratio. A pixel takes its N rays from the bands in turn, starting at a band of its own;
+  // band k's pairs come from base points spread evenly over the strata from (o + k) mod B, o the
+  // pixel's own offset: every pixel's rays of one band span the pupil's radius, and over the pixels
+  // every band sees every point. Without that balance a band's few points lean to one side or one
+  // ring of the pupil and blurred edges take its colour (seen as red and green fringes on a fence).
   const std::size_t n_samples = static_cast<std::size_t>(options.samples), nodes = wavelengths.size();
   const std::size_t pairs_per_node = std::max<std::size_t>(1, ((n_samples + nodes - 1) / nodes + 1) / 2);
   const std::size_t strata = std::max(kBasePointsPerNode, pairs_per_node), per_node = 4 * strata;
   std::vector<LensSample> lens_samples(nodes * per_node);
   for (std::size_t k = 0; k < nodes; ++k) {
-    const double radial_jitter = std::fmod(static_cast<double>(k) * 0.7548776662466927, 1.0);
+    const double radial_jitter = std::fmod(0.5 + static_cast<double>(k) * 0.7548776662466927, 1.0);
     const double angular_shift = std::fmod(static_cast<double>(k) * 0.6180339887498949, 1.0);
     for (std::size_t q = 0; q < per_node; ++q) {
       const std::size_t base = q / 4;
@@ -370,7 +380,8 @@ Image render_multiview(const DeepImage& scene, const RayModel& model, const Aper
       for (std::size_t i = 0; i < n_samples; ++i) {
         const std::size_t k = (first_node + i) % nodes, occurrence = (first_node + i) / nodes;
         const std::size_t pair = occurrence / 2, turn = occurrence % 2 + 2 * (pair % 2);
-        const std::size_t j = k * per_node + 4 * ((offset + k + pair) % strata) + turn;
+        const std::size_t base = (offset + k + pair * strata / pairs_per_node) % strata;
+        const std::size_t j = k * per_node + 4 * base + turn;
         const PixelRay ray = rays.ray(x, y, j);
         ++total_rays;
         if (!(ray.weight > 0.0f)) {
