@@ -170,7 +170,7 @@ struct BokehCommandOptions {
   std::string method = "scatter";            // --method scatter|multiview
   int samples = 32;                          // --samples (multiview)
   int layers = 8;                            // --layers (multiview)
-  int ray_grid_px = 8;                       // --ray-grid (multiview)
+  int ray_grid_px = 16;                      // --ray-grid (multiview)
   std::vector<std::string> scatter_options;    // scatter-only options given on the command line
   std::vector<std::string> multiview_options;  // multiview-only options given
 };
@@ -193,6 +193,8 @@ struct ValidateCommandOptions {
   int image_height_px = 180;
   int image_spp = 64;                             // --image-spp: ground-truth samples per pixel
   int image_layers = 4;                           // --image-layers: the scenes also as layered input (0: flat only)
+  std::vector<std::string> image_methods{"scatter", "multiview"};  // --image-methods
+  int image_samples = 32;                         // --image-samples: multiview lens rays per pixel
   std::optional<double> min_edge_psnr_db;         // --min-edge-psnr: fail when a model's edge-band PSNR is lower
   std::string fit;                                // --fit FILE: the poly model's fit (default: fitted in the run)
 };

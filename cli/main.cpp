@@ -291,7 +291,7 @@ int main(int argc, char** argv) {
       bokeh_cmd->add_option("--layers", bokeh.layers, "multiview: depth layers, evenly spaced in signed blur (1-64, default 8)")->check(range(1, 64));
   CLI::Option* bokeh_ray_grid =
       bokeh_cmd->add_option("--ray-grid", bokeh.ray_grid_px,
-                            "multiview: lens rays computed every this many pixels and interpolated between (1-64, default 8; 1 = every pixel)")
+                            "multiview: lens rays computed every this many pixels and interpolated between (1-64, default 16; 1 = every pixel)")
           ->check(range(1, 64));
   std::vector<CLI::Option*> bokeh_scatter_only;
   bokeh_scatter_only.push_back(bokeh_cmd->add_option("--hidden", bokeh.hidden, "Background hidden behind foreground edges: extend (default) | stretch")
@@ -345,6 +345,11 @@ int main(int argc, char** argv) {
   validate_cmd->add_option("--image-layers", validate.image_layers,
                             "Also score each model on the scene as layered (deep) input of this many peeled layers (default 4; 0: the flat picture only)")
       ->check(range(0, 16));
+  validate_cmd->add_option("--image-methods", validate.image_methods,
+                           "Depth-of-field methods scored on each scene: scatter and multiview (default both)")
+      ->check(CLI::IsMember({"scatter", "multiview"}));
+  validate_cmd->add_option("--image-samples", validate.image_samples, "Lens rays per pixel of the multiview method (default 32)")
+      ->check(range(1, 4096));
   validate_cmd->add_option("--image-spp", validate.image_spp, "Samples per pixel of the ground truth (default 64)")
       ->check(range(1, 1 << 20));
   validate_cmd->add_option("--min-edge-psnr", validate.min_edge_psnr_db, "Fail (exit 6) when a model's depth-edge PSNR is below this, dB");

@@ -71,16 +71,19 @@ int run_validate(const ValidateCommandOptions& o, const GlobalOptions& global) {
     image_options.height_px = o.image_height_px;
     image_options.spp = o.image_spp;
     image_options.layers = o.image_layers;
+    image_options.methods = o.image_methods;
+    image_options.multiview_samples = o.image_samples;
     image_options.picture_dir = dir;
     images = validate_images(lens, camera_options, image_options);
-    report << "`lensmith bokeh` with each model on the pinhole render of each scene"
+    report << "`lensmith bokeh` with each model and method (scatter; multiview with " << o.image_samples
+           << " lens rays per pixel) on the pinhole render of each scene"
            << (o.image_layers > 0 ? " (flat: picture and depth) and on its " + std::to_string(o.image_layers) +
                                         " depth-peeled layers as a deep image (layered)"
                                   : std::string())
            << ", against the scene rendered through the lens by the exact tracer (" << o.image_spp << " samples per pixel), "
            << o.image_width_px << " x " << o.image_height_px << " px; PSNR and SSIM on x/(1+x) values, "
            << "over the frame and within " << image_options.band_radius_px << " px of depth edges. Pictures: "
-           << "`<scene>-truth.png`, `<scene>-<model>[-layered].png`, `<scene>-<model>[-layered]-error.png`; time: `render_bokeh` alone.\n\n"
+           << "`<scene>-truth.png`, `<scene>-<model>[-multiview][-layered].png` and its `-error.png`; time: the render alone.\n\n"
            << images.to_markdown();
   }
   const std::string text = report.str();
@@ -104,7 +107,7 @@ int run_validate(const ValidateCommandOptions& o, const GlobalOptions& global) {
   }
   for (const ImageValidationEntry& e : images.entries) {
     if (o.min_edge_psnr_db && e.comparison.edge_psnr_db < *o.min_edge_psnr_db) {
-      std::cerr << "lensmith validate: " << to_string(e.model) << " on " << e.scene << ": edge PSNR "
+      std::cerr << "lensmith validate: " << to_string(e.model) << " (" << e.method << ", " << e.input << ") on " << e.scene << ": edge PSNR "
                 << e.comparison.edge_psnr_db << " dB is below --min-edge-psnr " << *o.min_edge_psnr_db << "\n";
       failed = true;
     }

@@ -43,7 +43,7 @@ struct LensSample {
 };
 
 struct LensRayTableOptions {
-  int grid_px = 8;             // film grid step, output pixels (>= 1)
+  int grid_px = 16;            // film grid step, output pixels (>= 1)
   bool vignetting = true;      // false: every passing ray weighs 1 (the cat's eye kept, its light not)
   int threads = 0;
 };
@@ -63,6 +63,16 @@ class LensRayTable {
   // The same computed directly, without the grid (for tests and for cells with stopped corners).
   PixelRay direct_ray(double x_px, double y_px, std::size_t j) const;
   std::size_t direct_rays() const;  // rays computed without interpolation so far (statistics)
+
+  // The grid: nodes at output pixel centres every grid_px() pixels; pixel (x, y) lies in the cell
+  // whose corners are nodes (x / g, y / g) to (x / g + 1, y / g + 1) (clamped to the last node).
+  int grid_px() const { return grid_; }
+  int nodes_x() const { return nodes_x_; }
+  int nodes_y() const { return nodes_y_; }
+  const PixelRay& node_ray(int node_x, int node_y, std::size_t j) const {
+    return grid_rays_[(j * static_cast<std::size_t>(nodes_y_) + static_cast<std::size_t>(node_y)) * static_cast<std::size_t>(nodes_x_) +
+                      static_cast<std::size_t>(node_x)];
+  }
 
   struct Source;  // where rays come from (lens_ray_table.cpp)
 

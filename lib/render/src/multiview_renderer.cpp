@@ -25,15 +25,12 @@ namespace lensmith {
 
 namespace {
 
-constexpr int kTilePx = 16;                // early culling: occupancy per layer on tiles of this size
-constexpr float kOpaque = 1e-4f;
-constexpr double kLayerOverlap = 0.25;
-constexpr double kConnectPx = 1.0;  // neighbouring samples whose signed CoC differs less are one surface (px)
-// Base points per wavelength node (each with its three rotations): enough radii that no node sees
-// only one ring of the pupil, whose blur differs from the others' (radial colour fringes).
-constexpr std::size_t kBasePointsPerNode = 8;
-constexpr std::size_t kMaxNodes = 64;  // MultiviewOptions::spectral_samples at most
-constexpr std::size_t kRaysPerBand = 8;  // MultiviewOptions::spectral_samples at most     // share of the layer spacing a sample reaches into the next layer           // a ray whose remaining transmittance is below this stops
+constexpr int kTilePx = 16;                    // early culling: occupancy per layer on tiles of this size
+constexpr float kOpaque = 1e-4f;               // a ray whose remaining transmittance is below this stops
+constexpr double kLayerOverlap = 0.25;         // share of the layer spacing a sample reaches into the next layer
+constexpr double kConnectPx = 1.0;             // neighbouring samples whose signed CoC differs less are one surface (px)
+constexpr std::size_t kMaxBands = 8;           // wavelength bands a pupil point may be traced in
+constexpr float kChromaticTolerancePx = 0.5f;  // bands closer than this follow one ray (BokehOptions' default)
 constexpr double kMinWavelengthNm = 380.0;  // the spectral range of the scatter path (spectral_groups.cpp)
 constexpr double kMaxWavelengthNm = 780.0;
 
@@ -293,10 +290,9 @@ Image render_multiview(const DeepImage& scene, const RayModel& model, const Aper
   }
   const bool opaque = scene.max_transparency() <= 1e-4;
 
-  // Wavelengths: the scatter path's quadrature (spectral_groups.cpp) in bands of neighbouring
-  // nodes, each band traced at its middle node and carrying the colour of all of its nodes, as the
-  // scatter path's spectral groups do; at least kRaysPerBand rays per band and pixel, because one
-  // wavelength per ray with few rays per pixel is colour noise. Or the reference wavelength alone.
+  // Wavelengths: the scatter path's quadrature (spectral_groups.cpp) in at most kMaxBands bands of
+  // neighbouring nodes, each traced at its middle node and carrying the colour of all of its nodes
+  // (as the scatter path's spectral groups do). Or the reference wavelength alone.
   std::vector<double> wavelengths;
   std::vector<Eigen::Matrix3f> to_rgb;  // per band: bands x sum over its nodes of rgb_weights (x) basis
   if (options.spectral) {
@@ -305,8 +301,7 @@ Image render_multiview(const DeepImage& scene, const RayModel& model, const Aper
     q.min_wavelength_nm = kMinWavelengthNm;
     q.max_wavelength_nm = kMaxWavelengthNm;
     const SpectralQuadrature quadrature(q);
-    const std::size_t n = quadrature.size();
-    const std::size_t bands = std::clamp<std::size_t>(static_cast<std::size_t>(options.samples) / kRaysPerBand, 1, n);
+    const std::size_t n = quadrature.size(), bands = std::min(n, kMaxBands);
     for (std::size_t b = 0; b < bands; ++b) {
       const std::size_t begin = b * n / bands, end = (b + 1) * n / bands;
       wavelengths.push_back(quadrature.wavelengths_nm()[(begin + end - 1) / 2]);
@@ -323,30 +318,27 @@ Image render_multiview(const DeepImage& scene, const RayModel& model, const Aper
     wavelengths = {camera.reference_wavelength_nm()};
     to_rgb.push_back(Eigen::Matrix3f::Identity());
   }
-  // The lens samples (Lee et al. sec. 4.5 use 2N Halton points and an offset per pixel). Here each
-  // wavelength band has its own points, in groups of four: a base point and its rotations by 180,
-  // 90 and 270 degrees, so that every band's set, and every pair a pixel takes, is balanced about
-  // the pupil's centre. A band's B base points lie one in each of B strata of radius^2 (jittered per
-  // band by the plastic ratio), their angles from Halton's sequence in base 3 turned per band by the
-  // golden ratio. A pixel takes its N rays from the bands in turn, starting at a band of its own;
-  // band k's pairs come from base points spread evenly over the strata from (o + k) mod B, o the
-  // pixel's own offset: every pixel's rays of one band span the pupil's radius, and over the pixels
-  // every band sees every point. Without that balance a band's few points lean to one side or one
-  // ring of the pupil and blurred edges take its colour (seen as red and green fringes on a fence).
-  const std::size_t n_samples = static_cast<std::size_t>(options.samples), nodes = wavelengths.size();
-  const std::size_t pairs_per_node = std::max<std::size_t>(1, ((n_samples + nodes - 1) / nodes + 1) / 2);
-  const std::size_t strata = std::max(kBasePointsPerNode, pairs_per_node), per_node = 4 * strata;
-  std::vector<LensSample> lens_samples(nodes * per_node);
-  for (std::size_t k = 0; k < nodes; ++k) {
-    const double radial_jitter = std::fmod(0.5 + static_cast<double>(k) * 0.7548776662466927, 1.0);
-    const double angular_shift = std::fmod(static_cast<double>(k) * 0.6180339887498949, 1.0);
-    for (std::size_t q = 0; q < per_node; ++q) {
-      const std::size_t base = q / 4;
+  const std::size_t bands = wavelengths.size(), middle_band = bands / 2;
+
+  // The pupil points (Lee et al. sec. 4.5 use 2N Halton points and an offset per pixel): 2N points
+  // in groups of four, a Halton point (bases 2 and 3: radius^2, angle) and its rotations by 180, 90
+  // and 270 degrees, so that every pixel's set is balanced about the pupil's centre; a pixel takes
+  // N consecutive ones from an offset of its own. Every band traces the same pupil points: where
+  // the bands' rays of a point land within kChromaticTolerancePx of each other over the scene's
+  // depths (most points, most pixels), the middle band's ray alone is followed and its colour
+  // stands for all bands, so a pixel's colour is not the noise of different pupil points per
+  // wavelength (one wavelength per ray put colour noise of 5 dB PSNR on a grey occluder); where the
+  // lens separates the colours, each band's ray is followed.
+  const std::size_t n_samples = static_cast<std::size_t>(options.samples);
+  const std::size_t bases_per_pixel = (n_samples + 3) / 4, base_count = 2 * bases_per_pixel, points = 4 * base_count;
+  std::vector<LensSample> lens_samples(bands * points);
+  for (std::size_t b = 0; b < bands; ++b) {
+    for (std::size_t q = 0; q < points; ++q) {
       static constexpr std::array<double, 4> kTurn{0.0, 0.5, 0.25, 0.75};
-      LensSample& sample = lens_samples[k * per_node + q];
-      sample.u = (static_cast<double>(base) + radial_jitter) / static_cast<double>(strata);
-      sample.v = std::fmod(radical_inverse(base + 1, 3) + angular_shift + kTurn[q % 4], 1.0);
-      sample.node = static_cast<int>(k);
+      LensSample& sample = lens_samples[b * points + q];
+      sample.u = radical_inverse(q / 4 + 1, 2);
+      sample.v = std::fmod(radical_inverse(q / 4 + 1, 3) + kTurn[q % 4], 1.0);
+      sample.node = static_cast<int>(b);
     }
   }
   LensRayTableOptions table_options;
@@ -354,67 +346,113 @@ Image render_multiview(const DeepImage& scene, const RayModel& model, const Aper
   table_options.vignetting = options.vignetting;
   table_options.threads = options.threads;
   const LensRayTable rays(model, aperture, wavelengths, lens_samples, table_options);
+  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+
+  // Per grid cell and pupil point: do the bands' rays agree at every corner (or all stop there)?
+  const int cells_x = rays.nodes_x(), cells_y = rays.nodes_y();
+  std::vector<std::uint8_t> achromatic(static_cast<std::size_t>(cells_x) * static_cast<std::size_t>(cells_y) * points, 1);
+  if (bands > 1) {
+    const auto w_near = static_cast<float>(w_max), w_far = static_cast<float>(w_min);
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
+    for (int cy = 0; cy < cells_y; ++cy) {
+      for (int cx = 0; cx < cells_x; ++cx) {
+        for (std::size_t q = 0; q < points; ++q) {
+          bool agree = true;
+          for (int corner = 0; corner < 4 && agree; ++corner) {
+            const int nx = std::min(cx + (corner & 1), cells_x - 1), ny = std::min(cy + (corner >> 1), cells_y - 1);
+            const PixelRay& ref = rays.node_ray(nx, ny, middle_band * points + q);
+            for (std::size_t b = 0; b < bands && agree; ++b) {
+              const PixelRay& r = rays.node_ray(nx, ny, b * points + q);
+              if ((r.weight > 0.0f) != (ref.weight > 0.0f)) agree = false;
+              if (!(r.weight > 0.0f)) continue;
+              for (const float w : {w_near, w_far}) {
+                const float dx = (r.inf_x - ref.inf_x) + w * (r.k_x - ref.k_x), dy = (r.inf_y - ref.inf_y) + w * (r.k_y - ref.k_y);
+                if (dx * dx + dy * dy > kChromaticTolerancePx * kChromaticTolerancePx) agree = false;
+              }
+            }
+          }
+          achromatic[(static_cast<std::size_t>(cy) * static_cast<std::size_t>(cells_x) + static_cast<std::size_t>(cx)) * points + q] = agree;
+        }
+      }
+    }
+  }
 
   Image out(width, height, 4, 0.0f);
-  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
-  std::size_t total_rays = 0, stopped = 0, lost = 0, cells = 0, outside = 0;
+  std::size_t total_rays = 0, stopped = 0, lost = 0, cells = 0, outside = 0, chromatic = 0;
   int rows_done = 0;
-#pragma omp parallel for schedule(dynamic, 2) num_threads(threads) reduction(+ : total_rays, stopped, lost, cells, outside)
+#pragma omp parallel for schedule(dynamic, 2) num_threads(threads) reduction(+ : total_rays, stopped, lost, cells, outside, chromatic)
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
-      // The pixel's first node and its offset into each node's points: fixed per pixel,
-      // decorrelated from its neighbours.
+      // The pixel's offset into the pupil points: fixed per pixel, decorrelated from its neighbours.
       std::uint64_t state = (static_cast<std::uint64_t>(y) << 32) ^ static_cast<std::uint64_t>(x);
-      const std::uint64_t hash = splitmix64(state);
-      const std::size_t first_node = static_cast<std::size_t>(hash % nodes), offset = static_cast<std::size_t>((hash >> 24) % strata);
-      // Colour: per wavelength node k, the weighted mean of what its rays met (premultiplied; the
-      // share of a ray lost where an opaque input knows nothing left out), through the node's RGB
-      // matrix M_k (n x the quadrature's weight times the spectral basis); averaged over the nodes.
-      // Sum_k M_k = n I (the quadrature's round trip), so grey stays grey; a node whose rays the
-      // lens stopped takes the pixel's mean colour, so a missing wavelength does not tint it.
-      std::array<Eigen::Vector3f, kMaxNodes> node_sum;
-      std::array<float, kMaxNodes> node_weight{};
-      for (std::size_t k = 0; k < nodes; ++k) node_sum[k].setZero();
-      Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-      double weight_all = 0.0, weight_seen = 0.0, coverage = 0.0;
+      const std::size_t offset = static_cast<std::size_t>(splitmix64(state) % base_count);
+      const std::uint8_t* cell_agrees =
+          achromatic.data() + (static_cast<std::size_t>(std::min(y / rays.grid_px(), cells_y - 1)) * static_cast<std::size_t>(cells_x) +
+                               static_cast<std::size_t>(std::min(x / rays.grid_px(), cells_x - 1))) * points;
+      // Colour: per band b, the weighted mean of what its rays met (premultiplied; the share of a
+      // ray lost where an opaque input knows nothing left out), through the band's RGB matrix M_b
+      // (bands x its nodes' quadrature weights times the spectral basis), averaged over the bands:
+      // Sum_b M_b = bands I (the quadrature's round trip), so grey stays grey. Rays followed once
+      // for all bands count in every band's mean; a band whose rays the lens stopped takes the
+      // pixel's mean colour, so a missing wavelength does not tint it.
+      std::array<Eigen::Vector3f, kMaxBands> band_sum;
+      std::array<float, kMaxBands> band_seen{};
+      for (std::size_t b = 0; b < bands; ++b) band_sum[b].setZero();
+      Eigen::Vector3f common_sum = Eigen::Vector3f::Zero();
+      float common_seen = 0.0f;
+      double weight_all = 0.0, weight_seen = 0.0, coverage = 0.0;  // bands' rays at 1 / bands each
       for (std::size_t i = 0; i < n_samples; ++i) {
-        const std::size_t k = (first_node + i) % nodes, occurrence = (first_node + i) / nodes;
-        const std::size_t pair = occurrence / 2, turn = occurrence % 2 + 2 * (pair % 2);
-        const std::size_t base = (offset + k + pair * strata / pairs_per_node) % strata;
-        const std::size_t j = k * per_node + 4 * base + turn;
-        const PixelRay ray = rays.ray(x, y, j);
-        ++total_rays;
-        if (!(ray.weight > 0.0f)) {
-          ++stopped;
-          continue;
+        const std::size_t q = 4 * ((offset + i / 4) % base_count) + i % 4;
+        const bool all_bands = cell_agrees[q] != 0;
+        const std::size_t first = all_bands ? middle_band : 0, last = all_bands ? middle_band + 1 : bands;
+        const float share = all_bands ? 1.0f : 1.0f / static_cast<float>(bands);
+        chromatic += all_bands ? 0 : 1;
+        for (std::size_t b = first; b < last; ++b) {
+          const PixelRay ray = rays.ray(x, y, b * points + q);
+          ++total_rays;
+          if (!(ray.weight > 0.0f)) {
+            ++stopped;
+            continue;
+          }
+          const RayResult r = follow(layers, ray);
+          cells += r.cells;
+          outside += r.left_frame ? 1 : 0;
+          float seen_share = 1.0f;
+          if (opaque && r.transmittance > kOpaque) {
+            seen_share = 1.0f - r.transmittance;
+            ++lost;
+          }
+          weight_all += share * ray.weight;
+          weight_seen += share * ray.weight * seen_share;
+          coverage += share * ray.weight * (1.0f - r.transmittance);
+          const Eigen::Vector3f met = ray.weight * Eigen::Vector3f(r.colour[0], r.colour[1], r.colour[2]);
+          if (all_bands) {
+            common_sum += met;
+            common_seen += ray.weight * seen_share;
+          } else {
+            band_sum[b] += met;
+            band_seen[b] += ray.weight * seen_share;
+          }
         }
-        const RayResult r = follow(layers, ray);
-        cells += r.cells;
-        outside += r.left_frame ? 1 : 0;
-        weight_all += ray.weight;
-        float seen_share = 1.0f;
-        if (opaque && r.transmittance > kOpaque) {
-          seen_share = 1.0f - r.transmittance;
-          ++lost;
-        }
-        weight_seen += ray.weight * seen_share;
-        coverage += ray.weight * (1.0f - r.transmittance);
-        const Eigen::Vector3f met = ray.weight * Eigen::Vector3f(r.colour[0], r.colour[1], r.colour[2]);
-        node_sum[k] += met;
-        node_weight[k] += ray.weight * seen_share;
-        sum += met;
       }
       float* px = &out.data[(static_cast<std::size_t>(y) * width + static_cast<std::size_t>(x)) * 4];
       if (!(weight_seen > 1e-9)) continue;
-      const Eigen::Vector3f mean = sum / static_cast<float>(weight_seen);
+      Eigen::Vector3f all_sum = common_sum * static_cast<float>(bands);
+      float all_seen = common_seen * static_cast<float>(bands);
+      for (std::size_t b = 0; b < bands; ++b) {
+        all_sum += band_sum[b];
+        all_seen += band_seen[b];
+      }
+      const Eigen::Vector3f mean = all_sum / all_seen;
       Eigen::Vector3f rgb = Eigen::Vector3f::Zero();
-      for (std::size_t k = 0; k < nodes; ++k) {
-        rgb += to_rgb[k] * (node_weight[k] > 1e-6f ? Eigen::Vector3f(node_sum[k] / node_weight[k]) : mean);
+      for (std::size_t b = 0; b < bands; ++b) {
+        const float seen = common_seen + band_seen[b];
+        rgb += to_rgb[b] * (seen > 1e-6f ? Eigen::Vector3f((common_sum + band_sum[b]) / seen) : mean);
       }
       // Vignetting on: the pixel's light is the mean weight over all N samples (stopped rays bring
       // none); off: every passing ray counts alike.
       const float brightness = options.vignetting ? static_cast<float>(weight_all / static_cast<double>(n_samples)) : 1.0f;
-      rgb *= brightness / static_cast<float>(nodes);
+      rgb *= brightness / static_cast<float>(bands);
       for (int c = 0; c < 3; ++c) px[c] = std::max(0.0f, rgb[c]);
       px[3] = static_cast<float>(std::clamp(coverage / weight_seen, 0.0, 1.0));
     }
@@ -439,6 +477,7 @@ Image render_multiview(const DeepImage& scene, const RayModel& model, const Aper
     statistics->cells_visited = cells;
     statistics->outside_rays = outside;
     statistics->direct_rays = rays.direct_rays();
+    statistics->chromatic_samples = chromatic;
   }
   return out;
 }

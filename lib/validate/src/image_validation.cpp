@@ -12,6 +12,7 @@
 #include "lensmith/render/bokeh_renderer.h"
 #include "lensmith/render/deep_image.h"
 #include "lensmith/render/image_io.h"
+#include "lensmith/render/multiview_renderer.h"
 #include "lensmith/scene/lens_render.h"
 #include "lensmith/scene/pinhole_render.h"
 #include "lensmith/scene/scene_json.h"
@@ -25,6 +26,10 @@ void ImageValidationOptions::validate() const {
   if (layers < 0 || layers > kMaxPeeledLayers) {
     throw OptionsError("layered input needs 1.." + std::to_string(kMaxPeeledLayers) + " layers (0: flat only), got " + std::to_string(layers));
   }
+  for (const std::string& m : methods) {
+    if (m != "scatter" && m != "multiview") throw OptionsError("image validation methods are scatter and multiview, not " + m);
+  }
+  if (multiview_samples < 1 || multiview_samples > 4096) throw OptionsError("multiview samples must be 1 to 4096");
   for (RayModelKind k : models) {
     if (k == RayModelKind::Exact || k == RayModelKind::Thin) {
       throw OptionsError("image validation scores paraxial, seidel or poly, not " + std::string(to_string(k)));
@@ -115,21 +120,38 @@ ImageValidation validate_images(const Prescription& lens, const CameraOptions& c
       const auto model = make_ray_model(kind, camera, model_options);
       BokehOptions bokeh;
       bokeh.threads = options.threads;
-      for (const bool deep : {false, true}) {
-        if (deep && !layered) continue;
-        const auto started = std::chrono::steady_clock::now();
-        const Image result = deep ? render_bokeh(*layered, *model, Aperture::circular(), bokeh)
-                                  : render_bokeh(pinhole.rgb, pinhole.depth, *model, Aperture::circular(), bokeh);
-        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-        // Both scored on the same band: the flat picture's depth edges.
-        const double hidden_psnr = hidden_count > 0 ? psnr(result, truth.rgb, &hidden_region) : std::numeric_limits<double>::quiet_NaN();
-        out.entries.push_back({name, kind, deep ? layered_input : "flat",
-                               compare_images(result, truth.rgb, pinhole.depth, options.band_radius_px), hidden_psnr, seconds});
-        if (!options.picture_dir.empty()) {
-          meta.model = std::string(to_string(kind)) + (deep ? ", " + layered_input : std::string());
-          const std::string stem = name + "-" + std::string(to_string(kind)) + (deep ? "-layered" : "");
-          write_output_image(options.picture_dir / (stem + ".png"), result, meta);
-          write_output_image(options.picture_dir / (stem + "-error.png"), error_map(result, truth.rgb), meta);
+      MultiviewOptions multiview;
+      multiview.threads = options.threads;
+      multiview.samples = options.multiview_samples;
+      std::optional<DeepImage> flat_scene;
+      for (const std::string& method : options.methods) {
+        const bool lee = method == "multiview";
+        if (lee && !flat_scene) flat_scene = deep_image_from_flat(pinhole.rgb, pinhole.depth);
+        for (const bool deep : {false, true}) {
+          if (deep && !layered) continue;
+          const auto started = std::chrono::steady_clock::now();
+          Image result;
+          if (lee) {
+            const Image rgba = render_multiview(deep ? *layered : *flat_scene, *model, Aperture::circular(), multiview);
+            result = Image(rgba.width, rgba.height, 3);
+            for (std::size_t i = 0; i < result.pixel_count(); ++i) {
+              for (std::size_t c = 0; c < 3; ++c) result.data[3 * i + c] = rgba.data[4 * i + c];
+            }
+          } else {
+            result = deep ? render_bokeh(*layered, *model, Aperture::circular(), bokeh)
+                          : render_bokeh(pinhole.rgb, pinhole.depth, *model, Aperture::circular(), bokeh);
+          }
+          const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+          // Both scored on the same band: the flat picture's depth edges.
+          const double hidden_psnr = hidden_count > 0 ? psnr(result, truth.rgb, &hidden_region) : std::numeric_limits<double>::quiet_NaN();
+          out.entries.push_back({name, kind, method, deep ? layered_input : "flat",
+                                 compare_images(result, truth.rgb, pinhole.depth, options.band_radius_px), hidden_psnr, seconds});
+          if (!options.picture_dir.empty()) {
+            meta.model = std::string(to_string(kind)) + (lee ? ", multiview" : std::string()) + (deep ? ", " + layered_input : std::string());
+            const std::string stem = name + "-" + std::string(to_string(kind)) + (lee ? "-multiview" : "") + (deep ? "-layered" : "");
+            write_output_image(options.picture_dir / (stem + ".png"), result, meta);
+            write_output_image(options.picture_dir / (stem + "-error.png"), error_map(result, truth.rgb), meta);
+          }
         }
       }
     }
@@ -140,11 +162,11 @@ ImageValidation validate_images(const Prescription& lens, const CameraOptions& c
 std::string ImageValidation::to_markdown() const {
   std::ostringstream os;
   os << std::fixed;
-  os << "| scene | model | input | PSNR (dB) | SSIM | edge PSNR (dB) | edge SSIM | hidden-surface PSNR (dB) | time (s) |\n"
-     << "|---|---|---|---|---|---|---|---|---|\n";
-  auto row = [&os](const std::string& scene, const std::string& model, const std::string& input, const ImageComparison& c,
-                   double hidden_psnr, const std::string& time) {
-    os << "| " << scene << " | " << model << " | " << input << " | " << std::setprecision(2) << c.psnr_db << " | "
+  os << "| scene | model | method | input | PSNR (dB) | SSIM | edge PSNR (dB) | edge SSIM | hidden-surface PSNR (dB) | time (s) |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|\n";
+  auto row = [&os](const std::string& scene, const std::string& model, const std::string& method, const std::string& input,
+                   const ImageComparison& c, double hidden_psnr, const std::string& time) {
+    os << "| " << scene << " | " << model << " | " << method << " | " << input << " | " << std::setprecision(2) << c.psnr_db << " | "
        << std::setprecision(4) << c.ssim << " | " << std::setprecision(2) << c.edge_psnr_db << " | " << std::setprecision(4)
        << c.edge_ssim << " | ";
     if (std::isnan(hidden_psnr)) {
@@ -155,12 +177,12 @@ std::string ImageValidation::to_markdown() const {
     os << " | " << time << " |\n";
   };
   for (std::size_t s = 0; s < scenes.size(); ++s) {
-    row(scenes[s], "(unblurred)", "flat", unblurred[s], std::numeric_limits<double>::quiet_NaN(), "");
+    row(scenes[s], "(unblurred)", "-", "flat", unblurred[s], std::numeric_limits<double>::quiet_NaN(), "");
     for (const ImageValidationEntry& e : entries) {
       if (e.scene != scenes[s]) continue;
       std::ostringstream t;
       t << std::fixed << std::setprecision(2) << e.seconds;
-      row(e.scene, std::string(to_string(e.model)), e.input, e.comparison, e.hidden_psnr_db, t.str());
+      row(e.scene, std::string(to_string(e.model)), e.method, e.input, e.comparison, e.hidden_psnr_db, t.str());
     }
   }
   for (std::size_t s = 0; s < scenes.size() && s < hidden_pixels.size(); ++s) {

@@ -50,7 +50,7 @@ struct MultiviewOptions {
   bool vignetting = true;        // as BokehOptions::vignetting
   bool spectral = true;          // false: every ray at the reference wavelength, RGB as given
   int spectral_samples = 16;     // wavelength nodes (3..64)
-  int ray_grid_px = 8;           // lens rays computed every this many output pixels and interpolated (1..64)
+  int ray_grid_px = 16;          // lens rays computed every this many output pixels and interpolated (1..64)
   std::function<void(double)> progress;  // fraction done, from one thread at a time
   void validate() const;         // throws OptionsError naming the option
   std::string to_string() const;
@@ -66,6 +66,7 @@ struct MultiviewStatistics {
   std::size_t outside_rays = 0;   // read the layers beyond the frame (continued as their edge pixels)
   std::size_t cells_visited = 0;  // pixel cells the rays walked through
   std::size_t direct_rays = 0;    // rays computed for a pixel instead of interpolated (beam edges)
+  std::size_t chromatic_samples = 0;  // pupil samples followed in every wavelength band (the lens separates them)
   std::string to_string() const;
 };
 

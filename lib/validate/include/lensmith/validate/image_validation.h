@@ -1,4 +1,4 @@
-// Image-level validation: `lensmith bokeh` with each fast ray model, run on the pinhole render of
+// Image-level validation: `lensmith bokeh` with each fast ray model and each method, run on the pinhole render of
 // an analytic scene, against the same scene rendered through the real lens by the exact tracer
 // (which sees what a single image cannot: the hidden background), and on the scene's layered input
 // (which has it, up to a number of surfaces). PSNR and SSIM on x/(1+x) values,
@@ -29,19 +29,24 @@ struct ImageValidationOptions {
   // Also each model on the scene's layered input (render_pinhole_layers, this many layers, read as a
   // deep image): what knowing the hidden surfaces buys. 0: the flat picture only.
   int layers = 4;
-  std::filesystem::path picture_dir;  // when set: <scene>-truth.png, <scene>-<model>[-layered].png and -error.png
+  // The depth-of-field methods scored, each on the flat and the layered input: "scatter"
+  // (render_bokeh) and "multiview" (render_multiview, `multiview_samples` lens rays per pixel).
+  std::vector<std::string> methods{"scatter", "multiview"};
+  int multiview_samples = 32;
+  std::filesystem::path picture_dir;  // when set: <scene>-truth.png, <scene>-<model>[-multiview][-layered].png and -error.png
   void validate() const;              // throws OptionsError
 };
 
 struct ImageValidationEntry {
   std::string scene;
   RayModelKind model = RayModelKind::Seidel;
+  std::string method = "scatter";  // "scatter" or "multiview"
   std::string input = "flat";  // "flat" (picture and depth) or "layered N" (deep, N peeled layers)
   ImageComparison comparison;
   // PSNR over the pixels where hidden surfaces can show: within half the largest blur of a hidden
   // surface from a pixel whose first surface hides another (from the layered render; NaN without).
   double hidden_psnr_db = std::numeric_limits<double>::quiet_NaN();
-  double seconds = 0.0;  // render_bokeh's wall time
+  double seconds = 0.0;  // the render's wall time
 };
 
 struct ImageValidation {
