@@ -282,3 +282,54 @@ TEST_CASE("lensmith bokeh passes an EXR's other channels through: kept in focus,
   CHECK(run_lensmith("bokeh --image " + bad.string() + " --thin-lens --focal-length 50 --fstop 2 --focus 2 --other-channels drop -o " +
                      scratch("passes-nan-drop.exr").string() + " --quiet").exit_code == 0);
 }
+
+TEST_CASE("lensmith bokeh --method multiview traces a deep element's lens rays, keeps its coverage and says how it was made",
+          "[cli][bokeh][multiview]") {
+  // The deep element above, through Lee et al.'s multiview synthesis: the same coverage (each
+  // pixel's alpha is the share of its lens rays the square stops), the colour premultiplied by it.
+  const int w = 64, h = 48;
+  std::vector<std::vector<std::vector<float>>> pixels(static_cast<std::size_t>(w * h));
+  for (int y = 16; y < 32; ++y) {
+    for (int x = 24; x < 40; ++x) pixels[static_cast<std::size_t>(y * w + x)] = {{1.0f, 0.5f, 0.5f, 0.5f, 2.0f}};  // A, B, G, R, Z
+  }
+  const fs::path in = scratch("element-deep-mv.exr");
+  lensmith::testing::write_deep_exr(in, w, h, {"A", "B", "G", "R", "Z"}, pixels);
+  const fs::path out = scratch("element-deep-mv-out.exr");
+  const auto r = run_lensmith("bokeh --image " + in.string() + " --thin-lens --focal-length 50 --fstop 1.4 --focus 0.5 --method multiview " +
+                              "--samples 64 -o " + out.string());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.err.find("method multiview") != std::string::npos);
+  CHECK(r.err.find("64 lens rays per pixel") != std::string::npos);
+  const auto meta = lensmith::read_image_metadata(out);
+  CHECK(value_of(meta, "lensmith:method") == "multiview");
+  CHECK(value_of(meta, "lensmith:samples") == "64");
+  const auto alpha = lensmith::read_alpha(out);
+  REQUIRE(alpha.has_value());
+  double total = 0.0;
+  for (float a : *alpha) total += a;
+  // Every ray the square stops is coverage; 64 rays a pixel over the blurred rim: within 2 %.
+  CHECK(total == Approx(256.0).epsilon(0.02));
+  CHECK((*alpha)[0] == Approx(0.0).margin(1e-6));
+  CHECK((*alpha)[static_cast<std::size_t>(24 * w + 32)] == Approx(1.0).margin(1e-6));  // inside: every ray stopped
+  const lensmith::Image rgb = lensmith::read_radiance_image(out);
+  CHECK(rgb.at(32, 24, 0) == Approx(0.5).margin(1e-3));
+  CHECK(rgb.at(22, 24, 0) == Approx(0.5 * (*alpha)[static_cast<std::size_t>(24 * w + 22)]).margin(0.01));
+}
+
+TEST_CASE("lensmith bokeh refuses options of the other method and apertures multiview cannot sample with traced rays",
+          "[cli][bokeh][multiview]") {
+  const std::string base = "bokeh --image " + kScene + " --lens sasian-triplet --focus 3 -o " + scratch("m.exr").string() + " ";
+  const auto hidden = run_lensmith(base + "--method multiview --hidden stretch");
+  CHECK(hidden.exit_code == 2);
+  CHECK(hidden.err.find("--hidden is an option of --method scatter") != std::string::npos);
+  const auto samples = run_lensmith(base + "--samples 8");
+  CHECK(samples.exit_code == 2);
+  CHECK(samples.err.find("--samples is an option of --method multiview") != std::string::npos);
+  const auto blades = run_lensmith(base + "--method multiview --model exact --blades 6");
+  CHECK(blades.exit_code != 0);
+  CHECK(blades.err.find("not implemented") != std::string::npos);
+  const auto zero = run_lensmith(base + "--method multiview --samples 0");
+  CHECK(zero.exit_code == 2);
+  CHECK_FALSE(fs::exists(scratch("m.exr")));
+}
