@@ -2,6 +2,7 @@
 // (docs/bokeh.md). Reads the inputs, builds the camera and the ray model, renders, writes.
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -153,6 +154,9 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     if (!unused.empty() && !global.quiet) {
       std::cerr << "note: " << o.image << " is deep; its channels besides R, G, B, A, Z and ZBack (" << unused.size()
                 << ", e.g. " << unused.front() << ") are not read\n";
+    }
+    if (std::find(header.channels.begin(), header.channels.end(), "A") == header.channels.end() && !global.quiet) {
+      std::cerr << "note: " << o.image << " is deep without an A channel: every sample is taken as opaque\n";
     }
   } else {
     flat = read_radiance_image(o.image, read);

@@ -928,10 +928,16 @@ TEST_CASE("a deep sample with a bad depth, alpha or colour is refused naming the
   far.invalid = InvalidDepth::Far;
   const DeepImage d = read_deep_image(one_bad({1.0f, 0.1f, 0.1f, 0.1f, -1.0f, -1.0f}), far, frame);
   CHECK(std::isinf(d.pixel(1, 1).back().z_m));
-  // Without A the samples cannot be composited.
-  lensmith::testing::write_deep_exr(dir / "no_alpha.exr", 1, 1, {"B", "G", "R", "Z"}, {{{0.1f, 0.1f, 0.1f, 1.0f}}});
-  CHECK_THROWS_WITH(read_deep_image(dir / "no_alpha.exr", {}, PinholeFrame(1, 1, 2.0)),
-                    Contains("a deep image without channel A; lensmith reads deep R, G, B, A and Z"));
+  // Without A every sample is opaque (`oiiotool --deepen` of a picture without alpha writes B, G, R, Z).
+  lensmith::testing::write_deep_exr(dir / "no_alpha.exr", 1, 1, {"B", "G", "R", "Z"}, {{{0.1f, 0.2f, 0.3f, 1.0f}}});
+  const DeepImage opaque = read_deep_image(dir / "no_alpha.exr", {}, PinholeFrame(1, 1, 2.0));
+  REQUIRE(opaque.pixel(0, 0).size() == 1);
+  CHECK(opaque.pixel(0, 0)[0].alpha == 1.0f);
+  CHECK(opaque.pixel(0, 0)[0].rgb[0] == Approx(0.3f));
+  // Without Z there is no depth.
+  lensmith::testing::write_deep_exr(dir / "no_z.exr", 1, 1, {"A", "B", "G", "R"}, {{{1.0f, 0.1f, 0.1f, 0.1f}}});
+  CHECK_THROWS_WITH(read_deep_image(dir / "no_z.exr", {}, PinholeFrame(1, 1, 2.0)),
+                    Contains("a deep image without channel Z; lensmith reads deep R, G, B and Z"));
   CHECK_THROWS_WITH(read_deep_image(one_bad({1.0f, 0.1f, 0.1f, 0.1f, 3.0f, 3.0f}), {}, PinholeFrame(3, 2, 2.0)),
                     Contains("deep image of 2 x 2 pixels, but the camera is framed for 3 x 2"));
 }

@@ -104,14 +104,16 @@ DeepImage deep_image_from(const DeepRaster& raster, const fs::path& path, const 
     if (c < 0 && required) missing.emplace_back(name);
     return c;
   };
-  const int r = channel("R", true), g = channel("G", true), b = channel("B", true), a = channel("A", true), z = channel("Z", true);
+  const int r = channel("R", true), g = channel("G", true), b = channel("B", true), z = channel("Z", true);
+  // Without A every sample is opaque: what `oiiotool --deepen` makes of a picture without alpha.
+  const int a = channel("A", false);
   const int z_back = channel("ZBack", false);
   if (!missing.empty()) {
     std::string names, have;
     for (std::size_t i = 0; i < missing.size(); ++i) names += (i ? ", " : "") + missing[i];
     for (std::size_t i = 0; i < raster.channels.size(); ++i) have += (i ? ", " : "") + raster.channels[i];
-    throw ImageFileError(path.string() + ": a deep image without channel " + names + "; lensmith reads deep R, G, B, A and Z " +
-                         "(ZBack optional); the file has " + have);
+    throw ImageFileError(path.string() + ": a deep image without channel " + names + "; lensmith reads deep R, G, B and Z " +
+                         "(A and ZBack optional); the file has " + have);
   }
   if (raster.width != frame.width_px() || raster.height != frame.height_px()) {
     throw ImageFileError(path.string() + ": deep image of " + std::to_string(raster.width) + " x " + std::to_string(raster.height) +
@@ -136,7 +138,7 @@ DeepImage deep_image_from(const DeepRaster& raster, const fs::path& path, const 
         const float* v = raster.samples.data() + s * nc;
         const std::size_t k = static_cast<std::size_t>(s - raster.first_sample[p]);
         DeepSample d;
-        d.alpha = v[a];
+        d.alpha = a >= 0 ? v[a] : 1.0f;
         if (!(d.alpha >= 0.0f && d.alpha <= 1.0f)) {
           throw ImageFileError(where(path, x, y, k) + ": A = " + format_number(d.alpha) + ": deep alpha must lie in [0, 1]");
         }

@@ -62,7 +62,8 @@ struct DeepImage {
   friend std::ostream& operator<<(std::ostream& os, const DeepImage& d) { return os << d.to_string(); }
 };
 
-// A deep OpenEXR as a DeepImage: channels R, G, B, A and Z (ZBack when present; else every sample is
+// A deep OpenEXR as a DeepImage: channels R, G, B and Z, A when present (else every sample is opaque,
+// as `oiiotool --deepen` writes a picture without alpha), ZBack when present (else every sample is
 // a surface), depth converted like read_depth's (`options`, pixel (x, y) of `frame`). Samples are
 // sorted front to back. Throws ImageFileError naming the file, pixel and sample for a missing
 // channel, another size than the frame, a Z or ZBack that is NaN or names no point in front of the
