@@ -302,6 +302,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     options.samples = o.samples;
     options.layers = o.layers;
     options.ray_grid_px = o.ray_grid_px;
+    options.cone_tracing = !o.no_cone_tracing;
     options.vignetting = !o.no_vignetting;
     options.spectral = !o.no_spectral;
     options.spectral_samples = o.spectral_samples;
@@ -332,7 +333,8 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
       for (int c = 0; c < channels_out; ++c) out.data[i * channels_out + c] = rgba.data[i * 4 + c];
     }
     OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture);
-    meta.extra.insert(meta.extra.end(), {{"samples", std::to_string(options.samples)}, {"layers", std::to_string(options.layers)}});
+    meta.extra.insert(meta.extra.end(), {{"samples", std::to_string(options.samples)}, {"layers", std::to_string(options.layers)},
+                                         {"cone_tracing", options.cone_tracing ? "on" : "off"}});
     write_bokeh_output(out, meta, o, depth, other);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     std::ostringstream what;

@@ -171,6 +171,7 @@ struct BokehCommandOptions {
   int samples = 32;                          // --samples (multiview)
   int layers = 8;                            // --layers (multiview)
   int ray_grid_px = 16;                      // --ray-grid (multiview)
+  bool no_cone_tracing = false;              // --no-cone-tracing (multiview)
   std::vector<std::string> scatter_options;    // scatter-only options given on the command line
   std::vector<std::string> multiview_options;  // multiview-only options given
 };

@@ -293,6 +293,9 @@ int main(int argc, char** argv) {
       bokeh_cmd->add_option("--ray-grid", bokeh.ray_grid_px,
                             "multiview: lens rays computed every this many pixels and interpolated between (1-64, default 16; 1 = every pixel)")
           ->check(range(1, 64));
+  CLI::Option* bokeh_cones = bokeh_cmd->add_flag(
+      "--no-cone-tracing", bokeh.no_cone_tracing,
+      "multiview: each lens ray sees one pixel where it hits, not the mean over its cone (Lee et al.'s approximate cone tracing, on by default)");
   std::vector<CLI::Option*> bokeh_scatter_only;
   bokeh_scatter_only.push_back(bokeh_cmd->add_option("--hidden", bokeh.hidden, "Background hidden behind foreground edges: extend (default) | stretch")
       ->check(CLI::IsMember({"extend", "stretch"})));
@@ -490,7 +493,7 @@ int main(int argc, char** argv) {
       for (CLI::Option* option : bokeh_scatter_only) {
         if (option->count() > 0) bokeh.scatter_options.push_back(option->get_name());
       }
-      for (CLI::Option* option : {bokeh_samples, bokeh_layers, bokeh_ray_grid}) {
+      for (CLI::Option* option : {bokeh_samples, bokeh_layers, bokeh_ray_grid, bokeh_cones}) {
         if (option->count() > 0) bokeh.multiview_options.push_back(option->get_name());
       }
       return run_bokeh(bokeh, global);

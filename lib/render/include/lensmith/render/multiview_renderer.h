@@ -24,7 +24,9 @@
 //     over the pupil, wavelengths in strata), each pixel using N consecutive ones from its own
 //     offset, so neighbouring pixels see different views and the noise is fine-grained, not banded;
 //     deterministic.
-//   - Approximate cone tracing on mipmapped layers (sec. 4.4): not implemented.
+//   - Approximate cone tracing on mipmapped layers (sec. 4.4): as the paper's (on by default; the
+//     cone's diameter is lambda |CoC| with lambda = sqrt(pi / 4N), the side of one sample's share
+//     of the pupil, where the paper measures the mean distance between its samples).
 //   - Beyond the frame the layers continue as their edge pixels (the paper discards rays that leave
 //     the frame, which makes every blurred pixel near the border noisier and biased). For an opaque
 //     input, the share of a ray that falls through every layer (where the input does not know what
@@ -51,6 +53,10 @@ struct MultiviewOptions {
   bool spectral = true;          // false: every ray at the reference wavelength, RGB as given
   int spectral_samples = 16;     // wavelength nodes (3..64)
   int ray_grid_px = 16;          // lens rays computed every this many output pixels and interpolated (1..64)
+  // Lee et al.'s approximate cone tracing (their sec. 4.4): a ray that hits a layer takes the mean
+  // colour and coverage over its cone's window of the mipmapped layer, so few samples give smooth
+  // bokeh instead of sparkles (docs/multiview.md); the cone shrinks as 1/sqrt(samples).
+  bool cone_tracing = true;
   std::function<void(double)> progress;  // fraction done, from one thread at a time
   void validate() const;         // throws OptionsError naming the option
   std::string to_string() const;
