@@ -209,3 +209,34 @@ TEST_CASE("Multiview with cone tracing: few lens rays come closer to the converg
   // The light is kept: the mean of the frame within 2 % (spots near the border spread beyond it).
   CHECK(cones.mean(1) == Approx(converged.mean(1)).epsilon(0.02));
 }
+
+TEST_CASE("Multiview: no lens ray passes through an opaque floor that slopes across every depth layer", "[render][multiview]") {
+  // A plane seen from above at a slant fills the frame: inverse depth linear in the row, from 1.5 m
+  // at the bottom to 10 m at the top, focus at 1 m so every row is blurred. A continuous opaque
+  // surface stops every ray, whichever layers its samples fall in and where a ray crosses it
+  // between pixel centres or layer bounds (with and without cone tracing).
+  const int w = 80, h = 60;
+  const Camera camera = thin_camera(w, h, 1.0);
+  const auto model = make_ray_model(RayModelKind::Thin, camera);
+  DeepImage floor(w, h);
+  for (int y = 0; y < h; ++y) {
+    const double t = (y + 0.5) / h;  // 0 at the top
+    const auto z = static_cast<float>(1.0 / ((1.0 - t) / 10.0 + t / 1.5));
+    for (int x = 0; x < w; ++x) {
+      const float v = ((x / 4 + y / 4) % 2) ? 0.8f : 0.2f;
+      floor.push_pixel({DeepSample{{v, v, v}, 1.0f, z, z}});
+    }
+  }
+  for (const bool cones : {true, false}) {
+    for (const int layer_count : {1, 8, 16}) {
+      MultiviewOptions o;
+      o.threads = 2;
+      o.layers = layer_count;
+      o.cone_tracing = cones;
+      MultiviewStatistics stats;
+      render_multiview(floor, *model, Aperture::circular(), o, &stats);
+      INFO((cones ? "cones, " : "no cones, ") << layer_count << " layers: " << stats.to_string());
+      CHECK(stats.lost_rays == 0);
+    }
+  }
+}

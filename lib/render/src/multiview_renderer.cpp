@@ -296,15 +296,19 @@ RayResult follow(const Layers& layers, const PixelRay& ray, const Cones& cones) 
         const bool steps_behind = in_front_of_previous && c.w > w_in && std::abs(c.w - previous_w) < layers.connect;
         if ((crosses || steps_behind) && c.w < last_hit_w) {
           std::array<float, 4> q = layers.colours[c.colour];
+          bool cone = false;
           if (cones.pyramids) {
             const float diameter = cones.lambda * std::abs(cones.coc_per_w * c.w + cones.coc_at_infinity);
             if (diameter > 1.0f) {
               q = sample_window((*cones.pyramids)[static_cast<std::size_t>(l)], ray.inf_x + c.w * ray.k_x, ray.inf_y + c.w * ray.k_y, diameter);
+              cone = true;
             }
           }
           for (std::size_t ch = 0; ch < 3; ++ch) r.colour[ch] += r.transmittance * q[ch];
           r.transmittance *= 1.0f - q[3];
-          last_hit_w = c.w;
+          // A cone's window sees only this layer's share of a surface that runs on into the next
+          // layer (a floor crossing the layers' bounds): the rest of the cone may meet it there.
+          if (!cone) last_hit_w = c.w;
           if (r.transmittance <= kOpaque) break;
         }
         in_front_of_previous = w_out > c.w;
