@@ -75,6 +75,13 @@ std::vector<float> defocus_channels(const std::vector<float>& samples, std::size
   return out;
 }
 
+// A layered input that leaves pixels uncovered, written where alpha cannot go: said once.
+void note_uncovered_without_alpha(const BokehCommandOptions& o, const GlobalOptions& global) {
+  if (output_keeps_alpha(o.output) || global.quiet) return;
+  std::cerr << "note: " << o.image << " leaves pixels uncovered (alpha < 1); only an OpenEXR output (.exr) keeps its alpha, " << o.output
+            << " gets RGB over black\n";
+}
+
 // What every output records of how it was made.
 OutputMetadata output_metadata(const BokehCommandOptions& o, const std::string& lens_name, RayModelKind kind, const Camera& camera,
                                double focus_m, const Aperture& aperture) {
@@ -323,15 +330,8 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     const double render_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - render_started).count();
     bar.finish();
     const bool transparent = scene.max_transparency() > 1e-4;
-    if (transparent && layered && !output_keeps_alpha(output) && !global.quiet) {
-      std::cerr << "note: " << o.image << " leaves pixels uncovered (alpha < 1); only an OpenEXR output (.exr) keeps its alpha, "
-                << output.string() << " gets RGB over black\n";
-    }
-    const int channels_out = transparent && output_keeps_alpha(output) ? 4 : 3;
-    Image out(rgba.width, rgba.height, channels_out, 0.0f);
-    for (std::size_t i = 0; i < out.pixel_count(); ++i) {
-      for (int c = 0; c < channels_out; ++c) out.data[i * channels_out + c] = rgba.data[i * 4 + c];
-    }
+    if (transparent && layered) note_uncovered_without_alpha(o, global);
+    const Image out = rgba.leading_channels(transparent && output_keeps_alpha(output) ? 4 : 3);
     OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture);
     meta.extra.insert(meta.extra.end(), {{"samples", std::to_string(options.samples)}, {"layers", std::to_string(options.layers)},
                                          {"cone_tracing", options.cone_tracing ? "on" : "off"}});
@@ -367,10 +367,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   const auto render_started = std::chrono::steady_clock::now();
   Image out = layered ? render_bokeh(*deep, *model, aperture, options, &stats) : render_bokeh(*flat, depth, *model, aperture, options, &stats);
   const bool layered_alpha = layered && deep->max_transparency() > 1e-4;
-  if (layered_alpha && !output_keeps_alpha(output) && !global.quiet) {
-    std::cerr << "note: " << o.image << " leaves pixels uncovered (alpha < 1); only an OpenEXR output (.exr) keeps its alpha, "
-              << output.string() << " gets RGB over black\n";
-  }
+  if (layered_alpha) note_uncovered_without_alpha(o, global);
   if (layered_alpha && output_keeps_alpha(output)) {
     // Alpha through the same rays: the samples' alphas as their colour (premultiplied: alpha times
     // one), without vignetting, as for a flat picture's alpha below.

@@ -32,6 +32,19 @@ std::string value_of(const std::vector<std::pair<std::string, std::string>>& met
   return "";
 }
 
+// A CG element over nothing as a deep image (as renderers write one): one opaque sample per pixel
+// of a 16 x 16 square at 2 m, colour 0.5, no samples elsewhere; 64 x 48 pixels.
+constexpr int kElementWidth = 64, kElementHeight = 48;
+fs::path write_deep_element(const std::string& name) {
+  std::vector<std::vector<std::vector<float>>> pixels(static_cast<std::size_t>(kElementWidth * kElementHeight));
+  for (int y = 16; y < 32; ++y) {
+    for (int x = 24; x < 40; ++x) pixels[static_cast<std::size_t>(y * kElementWidth + x)] = {{1.0f, 0.5f, 0.5f, 0.5f, 2.0f}};  // A, B, G, R, Z
+  }
+  const fs::path path = scratch(name);
+  lensmith::testing::write_deep_exr(path, kElementWidth, kElementHeight, {"A", "B", "G", "R", "Z"}, pixels);
+  return path;
+}
+
 }  // namespace
 
 TEST_CASE("lensmith bokeh renders the bundled scene to an EXR that says how it was made, and to a PNG", "[cli][bokeh]") {
@@ -169,13 +182,8 @@ TEST_CASE("lensmith bokeh reads a deep OpenEXR as layered input: a CG element ov
           "[cli][bokeh][deep]") {
   // The element of the test above as a deep image: one opaque sample per pixel of the square, no
   // samples elsewhere (as renderers write an element over nothing).
-  const int w = 64, h = 48;
-  std::vector<std::vector<std::vector<float>>> pixels(static_cast<std::size_t>(w * h));
-  for (int y = 16; y < 32; ++y) {
-    for (int x = 24; x < 40; ++x) pixels[static_cast<std::size_t>(y * w + x)] = {{1.0f, 0.5f, 0.5f, 0.5f, 2.0f}};  // A, B, G, R, Z
-  }
-  const fs::path in = scratch("element-deep.exr");
-  lensmith::testing::write_deep_exr(in, w, h, {"A", "B", "G", "R", "Z"}, pixels);
+  const int w = kElementWidth;
+  const fs::path in = write_deep_element("element-deep.exr");
   const fs::path out = scratch("element-deep-out.exr");
   const auto r = run_lensmith("bokeh --image " + in.string() + " --thin-lens --focal-length 50 --fstop 1.4 --focus 0.5 -o " + out.string());
   INFO(r.err);
@@ -287,13 +295,8 @@ TEST_CASE("lensmith bokeh --method multiview traces a deep element's lens rays, 
           "[cli][bokeh][multiview]") {
   // The deep element above, through Lee et al.'s multiview synthesis: the same coverage (each
   // pixel's alpha is the share of its lens rays the square stops), the colour premultiplied by it.
-  const int w = 64, h = 48;
-  std::vector<std::vector<std::vector<float>>> pixels(static_cast<std::size_t>(w * h));
-  for (int y = 16; y < 32; ++y) {
-    for (int x = 24; x < 40; ++x) pixels[static_cast<std::size_t>(y * w + x)] = {{1.0f, 0.5f, 0.5f, 0.5f, 2.0f}};  // A, B, G, R, Z
-  }
-  const fs::path in = scratch("element-deep-mv.exr");
-  lensmith::testing::write_deep_exr(in, w, h, {"A", "B", "G", "R", "Z"}, pixels);
+  const int w = kElementWidth;
+  const fs::path in = write_deep_element("element-deep-mv.exr");
   const fs::path out = scratch("element-deep-mv-out.exr");
   const auto r = run_lensmith("bokeh --image " + in.string() + " --thin-lens --focal-length 50 --fstop 1.4 --focus 0.5 --method multiview " +
                               "--samples 64 -o " + out.string());

@@ -17,6 +17,18 @@ Image::Image(int width_px, int height_px, int channel_count, float fill)
   data.assign(pixel_count() * static_cast<std::size_t>(channels), fill);
 }
 
+Image Image::leading_channels(int count) const {
+  if (count < 1 || count > channels) {
+    throw OptionsError("an image of " + std::to_string(channels) + " channels has no first " + std::to_string(count));
+  }
+  Image out(width, height, count);
+  const auto in_stride = static_cast<std::size_t>(channels), out_stride = static_cast<std::size_t>(count);
+  for (std::size_t i = 0; i < pixel_count(); ++i) {
+    for (std::size_t c = 0; c < out_stride; ++c) out.data[i * out_stride + c] = data[i * in_stride + c];
+  }
+  return out;
+}
+
 double Image::mean(int c) const {
   double sum = 0.0;
   for (std::size_t i = 0; i < pixel_count(); ++i) sum += data[i * channels + c];

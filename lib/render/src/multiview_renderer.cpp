@@ -15,7 +15,7 @@
 #include <Eigen/Dense>
 
 #include "lens_ray_table.h"
-#include "lensmith/color/spectral_quadrature.h"
+#include "spectral_groups.h"
 #include "lensmith/core/errors.h"
 #include "lensmith/core/huge_page_allocator.h"
 #include "lensmith/core/split_mix.h"
@@ -31,8 +31,6 @@ constexpr double kLayerOverlap = 0.25;         // share of the layer spacing a s
 constexpr double kConnectPx = 1.0;             // neighbouring samples whose signed CoC differs less are one surface (px)
 constexpr std::size_t kMaxBands = 8;           // wavelength bands a pupil point may be traced in
 constexpr float kChromaticTolerancePx = 0.5f;  // bands closer than this follow one ray (BokehOptions' default)
-constexpr double kMinWavelengthNm = 380.0;  // the spectral range of the scatter path (spectral_groups.cpp)
-constexpr double kMaxWavelengthNm = 780.0;
 
 // Radical inverse of i in base b (Halton's sequence).
 double radical_inverse(std::uint64_t i, std::uint64_t base) {
@@ -111,22 +109,22 @@ Layers make_layers(const DeepImage& scene, int layer_count, double& w_min_out, d
       const int neighbour = within < kLayerOverlap && home > 0 ? home - 1 : within > 1.0 - kLayerOverlap && home + 1 < layers.count ? home + 1 : home;
       const std::array<int, 2> targets{home, neighbour};
       for (std::size_t i = 0; i < (neighbour == home ? 1u : 2u); ++i) {
-      const int l = targets[i];
-      Cell& c = layers.cells[static_cast<std::size_t>(l) * pixels + p];
-      if (c.w < 0.0f) {
-        c.w = static_cast<float>(w);
-        c.colour = static_cast<std::uint32_t>(layers.colours.size());
-        layers.colours.push_back({s.rgb[0], s.rgb[1], s.rgb[2], s.alpha});
-        layers.occupied[(static_cast<std::size_t>(l) * layers.tiles_y + static_cast<std::size_t>(y / kTilePx)) * layers.tiles_x +
-                        static_cast<std::size_t>(x / kTilePx)] = 1;
-        layers.layer_used[static_cast<std::size_t>(l)] = 1;
-      } else {
-        // Behind the layer's nearer samples of this pixel: "over", front to back.
-        std::array<float, 4>& q = layers.colours[c.colour];
-        const float t = 1.0f - q[3];
-        for (int ch = 0; ch < 3; ++ch) q[static_cast<std::size_t>(ch)] += t * s.rgb[static_cast<std::size_t>(ch)];
-        q[3] += t * s.alpha;
-      }
+        const int l = targets[i];
+        Cell& c = layers.cells[static_cast<std::size_t>(l) * pixels + p];
+        if (c.w < 0.0f) {
+          c.w = static_cast<float>(w);
+          c.colour = static_cast<std::uint32_t>(layers.colours.size());
+          layers.colours.push_back({s.rgb[0], s.rgb[1], s.rgb[2], s.alpha});
+          layers.occupied[(static_cast<std::size_t>(l) * layers.tiles_y + static_cast<std::size_t>(y / kTilePx)) * layers.tiles_x +
+                          static_cast<std::size_t>(x / kTilePx)] = 1;
+          layers.layer_used[static_cast<std::size_t>(l)] = 1;
+        } else {
+          // Behind the layer's nearer samples of this pixel: "over", front to back.
+          std::array<float, 4>& q = layers.colours[c.colour];
+          const float t = 1.0f - q[3];
+          for (int ch = 0; ch < 3; ++ch) q[static_cast<std::size_t>(ch)] += t * s.rgb[static_cast<std::size_t>(ch)];
+          q[3] += t * s.alpha;
+        }
       }
     }
   }
@@ -394,33 +392,21 @@ Image render_multiview(const DeepImage& scene, const RayModel& model, const Aper
   }
   const bool opaque = scene.max_transparency() <= 1e-4;
 
-  // Wavelengths: the scatter path's quadrature (spectral_groups.cpp) in at most kMaxBands bands of
-  // neighbouring nodes, each traced at its middle node and carrying the colour of all of its nodes
-  // (as the scatter path's spectral groups do). Or the reference wavelength alone.
+  // Wavelengths: the scatter path's spectral groups (spectral_groups.h), split into at most
+  // kMaxBands bands of neighbouring quadrature nodes, each traced at its middle node and carrying
+  // the colour of all of its nodes; without spectral colour, the reference wavelength alone.
+  const render_detail::SpectralGroups groups(camera, options.spectral, options.spectral_samples);
+  const std::vector<render_detail::SpectralGroup>& split =
+      groups.split(std::min(groups.max_count(), static_cast<int>(kMaxBands)));
   std::vector<double> wavelengths;
-  std::vector<Eigen::Matrix3f> to_rgb;  // per band: bands x sum over its nodes of rgb_weights (x) basis
-  if (options.spectral) {
-    SpectralQuadratureOptions q;
-    q.sample_count = options.spectral_samples;
-    q.min_wavelength_nm = kMinWavelengthNm;
-    q.max_wavelength_nm = kMaxWavelengthNm;
-    const SpectralQuadrature quadrature(q);
-    const std::size_t n = quadrature.size(), bands = std::min(n, kMaxBands);
-    for (std::size_t b = 0; b < bands; ++b) {
-      const std::size_t begin = b * n / bands, end = (b + 1) * n / bands;
-      wavelengths.push_back(quadrature.wavelengths_nm()[(begin + end - 1) / 2]);
-      Eigen::Matrix3f m = Eigen::Matrix3f::Zero();
-      for (std::size_t i = begin; i < end; ++i) {
-        const Rgb weight = quadrature.rgb_weights(i), basis = quadrature.basis().basis_values(quadrature.wavelengths_nm()[i]);
-        for (int out = 0; out < 3; ++out) {
-          for (int in = 0; in < 3; ++in) m(out, in) += static_cast<float>(static_cast<double>(bands) * weight[out] * basis[in]);
-        }
-      }
-      to_rgb.push_back(m);
+  std::vector<Eigen::Matrix3f> to_rgb;  // per band: bands x its group's matrix, so that they average to the identity
+  for (const render_detail::SpectralGroup& g : split) {
+    wavelengths.push_back(g.wavelength_nm);
+    Eigen::Matrix3f m;
+    for (int out = 0; out < 3; ++out) {
+      for (int in = 0; in < 3; ++in) m(out, in) = static_cast<float>(split.size()) * g.m[static_cast<std::size_t>(out)][static_cast<std::size_t>(in)];
     }
-  } else {
-    wavelengths = {camera.reference_wavelength_nm()};
-    to_rgb.push_back(Eigen::Matrix3f::Identity());
+    to_rgb.push_back(m);
   }
   const std::size_t bands = wavelengths.size(), middle_band = bands / 2;
 

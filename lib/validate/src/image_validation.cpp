@@ -132,11 +132,7 @@ ImageValidation validate_images(const Prescription& lens, const CameraOptions& c
           const auto started = std::chrono::steady_clock::now();
           Image result;
           if (lee) {
-            const Image rgba = render_multiview(deep ? *layered : *flat_scene, *model, Aperture::circular(), multiview);
-            result = Image(rgba.width, rgba.height, 3);
-            for (std::size_t i = 0; i < result.pixel_count(); ++i) {
-              for (std::size_t c = 0; c < 3; ++c) result.data[3 * i + c] = rgba.data[4 * i + c];
-            }
+            result = render_multiview(deep ? *layered : *flat_scene, *model, Aperture::circular(), multiview).leading_channels(3);
           } else {
             result = deep ? render_bokeh(*layered, *model, Aperture::circular(), bokeh)
                           : render_bokeh(pinhole.rgb, pinhole.depth, *model, Aperture::circular(), bokeh);

@@ -24,6 +24,8 @@ struct Image {
   float at(int x, int y, int c) const { return data[(static_cast<std::size_t>(y) * width + x) * channels + c]; }
   // Mean of channel c over all pixels (double accumulation).
   double mean(int c) const;
+  // The first `count` channels (1..channels), e.g. RGB of an RGBA image. Throws OptionsError otherwise.
+  Image leading_channels(int count) const;
   std::string to_string() const;  // "Image(640 x 360, 3 channels)"
   friend std::ostream& operator<<(std::ostream& os, const Image& i) { return os << i.to_string(); }
 };
