@@ -8,6 +8,7 @@
 #include "lensmith/core/units.h"
 #include "lensmith/prescription/lens_library.h"
 #include "lensmith/render/bokeh_renderer.h"
+#include "lensmith/render/lightfield_renderer.h"
 
 using namespace lensmith;
 
@@ -46,9 +47,8 @@ BenchScene make_scene(double blur_px) {
   return s;
 }
 
-void run(benchmark::State& state, RayModelKind kind) {
-  const double blur = static_cast<double>(state.range(0));
-  const BenchScene scene = make_scene(blur);
+// The thin lens, or the shipped pbrt-dgauss-50mm through `kind`, at f/2 focused at the scene's focus.
+auto bench_model(RayModelKind kind) {
   CameraOptions o;
   o.focus_distance_m = m_from_mm(kFocusMm);
   o.f_number = kFNumber;
@@ -59,7 +59,13 @@ void run(benchmark::State& state, RayModelKind kind) {
                             : Camera::from_lens(LensLibrary::load("pbrt-dgauss-50mm").prescription, o, kWidth, kHeight);
   RayModelOptions mo;
   mo.nearest_depth_m = 0.2;
-  const auto model = make_ray_model(kind, camera, mo);
+  return make_ray_model(kind, camera, mo);
+}
+
+void run(benchmark::State& state, RayModelKind kind) {
+  const double blur = static_cast<double>(state.range(0));
+  const BenchScene scene = make_scene(blur);
+  const auto model = bench_model(kind);
   BokehOptions options;
   options.threads = static_cast<int>(state.range(1));
   for (auto _ : state) {
@@ -68,6 +74,29 @@ void run(benchmark::State& state, RayModelKind kind) {
   }
   state.counters["Mpixel/s"] = benchmark::Counter(static_cast<double>(kWidth) * kHeight * 1e-6,
                                                   benchmark::Counter::kIsIterationInvariantRate);
+}
+
+// Yu et al.'s light-field synthesis on the same scene (36 views, their default): its cost is the
+// views' warps, which the blur should not change (their table 1 scales with the views alone).
+void run_lightfield(benchmark::State& state, RayModelKind kind) {
+  const double blur = static_cast<double>(state.range(0));
+  const BenchScene scene = make_scene(blur);
+  const auto model = bench_model(kind);
+  LightfieldOptions options;
+  options.threads = static_cast<int>(state.range(1));
+  options.views = static_cast<int>(state.range(2));
+  for (auto _ : state) {
+    Image out = render_lightfield(scene.image, scene.depth, *model, Aperture::circular(), options);
+    benchmark::DoNotOptimize(out.data.data());
+  }
+  state.counters["Mpixel/s"] = benchmark::Counter(static_cast<double>(kWidth) * kHeight * 1e-6,
+                                                  benchmark::Counter::kIsIterationInvariantRate);
+}
+
+void lightfield_args(benchmark::internal::Benchmark* b) {
+  for (int blur : {4, 16, 48, 128}) b->Args({blur, 2, 36});
+  b->Args({16, 2, 12});
+  b->ArgNames({"blur_px", "threads", "views"})->Unit(benchmark::kSecond)->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true)->UseRealTime();
 }
 
 void args(benchmark::internal::Benchmark* b) {
@@ -82,5 +111,7 @@ void args(benchmark::internal::Benchmark* b) {
 BENCHMARK_CAPTURE(run, thin, RayModelKind::Thin)->Apply(args);
 BENCHMARK_CAPTURE(run, paraxial, RayModelKind::Paraxial)->Apply(args);
 BENCHMARK_CAPTURE(run, seidel, RayModelKind::Seidel)->Apply(args);
+BENCHMARK_CAPTURE(run_lightfield, thin, RayModelKind::Thin)->Apply(lightfield_args);
+BENCHMARK_CAPTURE(run_lightfield, seidel, RayModelKind::Seidel)->Apply(lightfield_args);
 
 BENCHMARK_MAIN();

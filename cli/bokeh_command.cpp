@@ -21,6 +21,7 @@
 #include "lensmith/render/bokeh_renderer.h"
 #include "lensmith/render/deep_image.h"
 #include "lensmith/render/image_io.h"
+#include "lensmith/render/lightfield_renderer.h"
 #include "lensmith/render/multiview_renderer.h"
 
 namespace lensmith::cli {
@@ -121,11 +122,12 @@ void write_bokeh_output(Image out, OutputMetadata& meta, const BokehCommandOptio
 
 int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   const auto started = std::chrono::steady_clock::now();
-  const bool multiview = o.method == "multiview";
-  if (multiview && !o.scatter_options.empty()) {
-    throw UsageError(o.scatter_options.front() + " is an option of --method scatter; --method multiview traces lens rays through the layers");
+  const bool multiview = o.method == "multiview", lightfield = o.method == "lightfield";
+  if (o.method != "scatter" && !o.scatter_options.empty()) {
+    throw UsageError(o.scatter_options.front() + " is an option of --method scatter, not of --method " + o.method);
   }
   if (!multiview && !o.multiview_options.empty()) throw UsageError(o.multiview_options.front() + " is an option of --method multiview");
+  if (!lightfield && !o.lightfield_options.empty()) throw UsageError(o.lightfield_options.front() + " is an option of --method lightfield");
   // Inputs.
   const std::filesystem::path output = o.output;
   const DepthSource depth_source = DepthSource::parse(o.depth.empty() ? o.image : o.depth);
@@ -302,6 +304,40 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
 
   if (multiview && o.other_channels == "defocus" && !other.names.empty()) {
     throw UsageError("--other-channels defocus with --method multiview: not implemented (use keep or drop, or --method scatter)");
+  }
+  if (lightfield) {
+    if (other.names.size() > 0 && o.other_channels == "defocus") {
+      throw UsageError("--other-channels defocus with --method lightfield: not implemented (use keep or drop, or --method scatter)");
+    }
+    if (layered) throw UsageError("--method lightfield warps one surface per pixel: a deep (layered) input is not implemented; use --method multiview or scatter");
+    if (alpha) throw UsageError("--method lightfield: a picture with transparent pixels (alpha) is not implemented; use --method scatter or multiview");
+    LightfieldOptions options;
+    options.threads = o.threads;
+    options.views = o.views;
+    options.mip_filter = !o.no_mip_filter;
+    options.vignetting = !o.no_vignetting;
+    ProgressBar bar("bokeh", !global.quiet);
+    options.progress = [&bar](double f) { bar.update(f); };
+    LightfieldStatistics stats;
+    const auto render_started = std::chrono::steady_clock::now();
+    const Image out = render_lightfield(*flat, depth, *model, aperture, options, &stats);
+    const double render_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - render_started).count();
+    bar.finish();
+    OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture);
+    meta.extra.insert(meta.extra.end(), {{"views", std::to_string(options.views)}, {"mip_filter", options.mip_filter ? "on" : "off"}});
+    write_bokeh_output(out, meta, o, depth, other);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    const double pixel_views = static_cast<double>(out.width) * out.height * options.views;
+    std::ostringstream what;
+    what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds
+         << " s (rendering " << render_seconds << " s)\n  " << lens_name << ", model " << to_string(kind) << ", method lightfield, f/"
+         << format_rounded(cam->f_number(), 3) << ", focus " << format_rounded(camera.focus_distance_m, 4) << " m, " << aperture.to_string()
+         << " aperture\n  " << options.views << " views, each at " << format_rounded(cam->reference_wavelength_nm(), 4)
+         << " nm (spectral colour is not implemented for lightfield); " << stats.stopped
+         << " warped rays stopped by the lens; " << format_rounded(100.0 * static_cast<double>(stats.holes) / pixel_views, 3)
+         << " % of pixel views holes (no source landed), " << stats.unfilled_pixels << " pixels no view reached (input colour kept)";
+    report_written(what.str(), global);
+    return kExitOk;
   }
   if (multiview) {
     MultiviewOptions options;

@@ -167,13 +167,16 @@ struct BokehCommandOptions {
   int subrows = 4;                           // --subrows
   double max_blur_px = 1000.0;               // --max-blur
   int threads = 0;                           // --threads (0 = all)
-  std::string method = "scatter";            // --method scatter|multiview
+  std::string method = "scatter";            // --method scatter|multiview|lightfield
   int samples = 32;                          // --samples (multiview)
   int layers = 8;                            // --layers (multiview)
   int ray_grid_px = 16;                      // --ray-grid (multiview)
   bool no_cone_tracing = false;              // --no-cone-tracing (multiview)
-  std::vector<std::string> scatter_options;    // scatter-only options given on the command line
-  std::vector<std::string> multiview_options;  // multiview-only options given
+  int views = 36;                            // --views (lightfield)
+  bool no_mip_filter = false;                // --no-mip-filter (lightfield)
+  std::vector<std::string> scatter_options;     // scatter-only options given on the command line
+  std::vector<std::string> multiview_options;   // multiview-only options given
+  std::vector<std::string> lightfield_options;  // lightfield-only options given
 };
 int run_bokeh(const BokehCommandOptions& options, const GlobalOptions& global);
 
@@ -194,8 +197,9 @@ struct ValidateCommandOptions {
   int image_height_px = 180;
   int image_spp = 64;                             // --image-spp: ground-truth samples per pixel
   int image_layers = 4;                           // --image-layers: the scenes also as layered input (0: flat only)
-  std::vector<std::string> image_methods{"scatter", "multiview"};  // --image-methods
+  std::vector<std::string> image_methods{"scatter", "multiview", "lightfield"};  // --image-methods
   int image_samples = 32;                         // --image-samples: multiview lens rays per pixel
+  int image_views = 36;                           // --image-views: lightfield views
   std::optional<double> min_edge_psnr_db;         // --min-edge-psnr: fail when a model's edge-band PSNR is lower
   std::string fit;                                // --fit FILE: the poly model's fit (default: fitted in the run)
 };

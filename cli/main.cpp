@@ -283,8 +283,9 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   bokeh_cmd->add_option("--method", bokeh.method,
                         "scatter (default: every pixel scattered through the ray model, depth-layered) | multiview (Lee et al. 2009: "
-                        "per pixel --samples lens rays traced through the layered scene; for deep input)")
-      ->check(CLI::IsMember({"scatter", "multiview"}));
+                        "per pixel --samples lens rays traced through the layered scene; for deep input) | lightfield (Yu et al. "
+                        "2010: the picture warped to --views pupil points through the ray model, nearest wins, views averaged)")
+      ->check(CLI::IsMember({"scatter", "multiview", "lightfield"}));
   CLI::Option* bokeh_samples =
       bokeh_cmd->add_option("--samples", bokeh.samples, "multiview: lens rays per output pixel (1-4096, default 32)")->check(range(1, 4096));
   CLI::Option* bokeh_layers =
@@ -296,6 +297,11 @@ int main(int argc, char** argv) {
   CLI::Option* bokeh_cones = bokeh_cmd->add_flag(
       "--no-cone-tracing", bokeh.no_cone_tracing,
       "multiview: each lens ray sees one pixel where it hits, not the mean over its cone (Lee et al.'s approximate cone tracing, on by default)");
+  CLI::Option* bokeh_views =
+      bokeh_cmd->add_option("--views", bokeh.views, "lightfield: views, one per pupil point (1-1024, default 36 as Yu et al.)")->check(range(1, 1024));
+  CLI::Option* bokeh_mip = bokeh_cmd->add_flag(
+      "--no-mip-filter", bokeh.no_mip_filter,
+      "lightfield: read each view's colour from its pixel, not from the mipmap window of its share of the blur (Yu et al.'s pre-filter, on by default)");
   std::vector<CLI::Option*> bokeh_scatter_only;
   bokeh_scatter_only.push_back(bokeh_cmd->add_option("--hidden", bokeh.hidden, "Background hidden behind foreground edges: extend (default) | stretch")
       ->check(CLI::IsMember({"extend", "stretch"})));
@@ -349,8 +355,9 @@ int main(int argc, char** argv) {
                             "Also score each model on the scene as layered (deep) input of this many peeled layers (default 4; 0: the flat picture only)")
       ->check(range(0, 16));
   validate_cmd->add_option("--image-methods", validate.image_methods,
-                           "Depth-of-field methods scored on each scene: scatter and multiview (default both)")
-      ->check(CLI::IsMember({"scatter", "multiview"}));
+                           "Depth-of-field methods scored on each scene: scatter, multiview, lightfield (default all three)")
+      ->check(CLI::IsMember({"scatter", "multiview", "lightfield"}));
+  validate_cmd->add_option("--image-views", validate.image_views, "Views of the lightfield method (default 36)")->check(range(1, 1024));
   validate_cmd->add_option("--image-samples", validate.image_samples, "Lens rays per pixel of the multiview method (default 32)")
       ->check(range(1, 4096));
   validate_cmd->add_option("--image-spp", validate.image_spp, "Samples per pixel of the ground truth (default 64)")
@@ -495,6 +502,9 @@ int main(int argc, char** argv) {
       }
       for (CLI::Option* option : {bokeh_samples, bokeh_layers, bokeh_ray_grid, bokeh_cones}) {
         if (option->count() > 0) bokeh.multiview_options.push_back(option->get_name());
+      }
+      for (CLI::Option* option : {bokeh_views, bokeh_mip}) {
+        if (option->count() > 0) bokeh.lightfield_options.push_back(option->get_name());
       }
       return run_bokeh(bokeh, global);
     }

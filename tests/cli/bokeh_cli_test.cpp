@@ -336,3 +336,38 @@ TEST_CASE("lensmith bokeh refuses options of the other method and apertures mult
   CHECK(zero.exit_code == 2);
   CHECK_FALSE(fs::exists(scratch("m.exr")));
 }
+
+TEST_CASE("lensmith bokeh --method lightfield warps the picture to its views, says how it was made and refuses what it cannot do",
+          "[cli][bokeh][lightfield]") {
+  const fs::path out = scratch("lightfield-out.exr");
+  const auto r = run_lensmith("bokeh --image " + kScene + " --lens sasian-triplet --focus 3 --method lightfield --views 12 --threads 2 -o " +
+                              out.string());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.err.find("method lightfield") != std::string::npos);
+  CHECK(r.err.find("12 views") != std::string::npos);
+  CHECK(r.err.find("spectral colour is not implemented") != std::string::npos);
+  const auto meta = lensmith::read_image_metadata(out);
+  CHECK(value_of(meta, "lensmith:method") == "lightfield");
+  CHECK(value_of(meta, "lensmith:views") == "12");
+  const std::string base = "bokeh --image " + kScene + " --lens sasian-triplet --focus 3 -o " + scratch("lf.exr").string() + " ";
+  const auto views = run_lensmith(base + "--views 8");
+  CHECK(views.exit_code == 2);
+  CHECK(views.err.find("--views is an option of --method lightfield") != std::string::npos);
+  const auto hidden = run_lensmith(base + "--method lightfield --hidden stretch");
+  CHECK(hidden.exit_code == 2);
+  CHECK(hidden.err.find("--hidden is an option of --method scatter") != std::string::npos);
+  const auto samples = run_lensmith(base + "--method lightfield --samples 8");
+  CHECK(samples.exit_code == 2);
+  CHECK(samples.err.find("--samples is an option of --method multiview") != std::string::npos);
+  const auto mask = run_lensmith(base + "--method lightfield --blades 6");
+  CHECK(mask.exit_code == 0);  // a bladed iris: its views weighted by their share of the area
+  const fs::path deep = write_deep_element("element-deep-lf.exr");
+  const auto layered = run_lensmith("bokeh --image " + deep.string() + " --thin-lens --focal-length 50 --fstop 1.4 --focus 0.5 --method lightfield -o " +
+                                    scratch("lf-deep.exr").string());
+  CHECK(layered.exit_code == 2);
+  CHECK(layered.err.find("not implemented") != std::string::npos);
+  CHECK_FALSE(fs::exists(scratch("lf-deep.exr")));
+  const auto zero = run_lensmith(base + "--method lightfield --views 0");
+  CHECK(zero.exit_code == 2);
+}

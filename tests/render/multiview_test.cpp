@@ -11,46 +11,23 @@
 #include <cmath>
 
 #include "lensmith/core/units.h"
+#include "thin_lens_geometry.h"
 #include "lensmith/prescription/lens_library.h"
 #include "lensmith/render/bokeh_renderer.h"
 #include "lensmith/render/multiview_renderer.h"
 
 using namespace lensmith;
 
-namespace {
-
-constexpr double kFocalLengthMm = 50.0;
-constexpr double kFNumber = 2.0;
-
-Camera thin_camera(int w, int h, double focus_m) {
-  CameraOptions o;
-  o.focus_distance_m = focus_m;
-  o.f_number = kFNumber;
-  o.framing.sensor_width_mm = 18.0;
-  return Camera::thin_lens(kFocalLengthMm, o, w, h);
-}
-
-// Share of the unit disc left of the line x = c.
-double disc_share_left_of(double c) {
-  if (c <= -1.0) return 0.0;
-  if (c >= 1.0) return 1.0;
-  return 0.5 + (c * std::sqrt(1.0 - c * c) + std::asin(c)) / kPi;
-}
-
-}  // namespace
+using test::disc_share_left_of;
+using test::thin_camera;
+constexpr double kFocalLengthMm = test::kThinFocalLengthMm;
+constexpr double kFNumber = test::kThinFNumber;
 
 TEST_CASE("Multiview: a textured plane in focus comes back as it went in, colours and all", "[render][multiview]") {
   const int w = 48, h = 32;
   const Camera camera = thin_camera(w, h, 2.0);
   const auto model = make_ray_model(RayModelKind::Thin, camera);
-  Image image(w, h, 3);
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      image.at(x, y, 0) = 0.1f + 0.03f * static_cast<float>(x % 11);
-      image.at(x, y, 1) = (x + y) % 5 == 0 ? 4.0f : 0.2f;
-      image.at(x, y, 2) = 0.05f * static_cast<float>(y % 7);
-    }
-  }
+  const Image image = test::textured_image(w, h);
   const DeepImage scene = deep_image_from_flat(image, DepthMap(w, h, 2.0f));
   MultiviewOptions o;
   o.threads = 2;

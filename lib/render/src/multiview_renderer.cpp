@@ -15,13 +15,17 @@
 #include <Eigen/Dense>
 
 #include "lens_ray_table.h"
+#include "mip_pyramid.h"
 #include "spectral_groups.h"
 #include "lensmith/core/errors.h"
+#include "lensmith/core/halton.h"
 #include "lensmith/core/huge_page_allocator.h"
 #include "lensmith/core/split_mix.h"
 #include "lensmith/core/units.h"
 
 namespace lensmith {
+
+using render_detail::MipPyramid;
 
 namespace {
 
@@ -32,16 +36,6 @@ constexpr double kConnectPx = 1.0;             // neighbouring samples whose sig
 constexpr std::size_t kMaxBands = 8;           // wavelength bands a pupil point may be traced in
 constexpr float kChromaticTolerancePx = 0.5f;  // bands closer than this follow one ray (BokehOptions' default)
 
-// Radical inverse of i in base b (Halton's sequence).
-double radical_inverse(std::uint64_t i, std::uint64_t base) {
-  double inv = 1.0 / static_cast<double>(base), f = inv, r = 0.0;
-  while (i > 0) {
-    r += f * static_cast<double>(i % base);
-    i /= base;
-    f *= inv;
-  }
-  return r;
-}
 
 // A layer's sample at one pixel: inverse depth (1/mm; < 0: none) and where its colour is.
 struct Cell {
@@ -132,21 +126,15 @@ Layers make_layers(const DeepImage& scene, int layer_count, double& w_min_out, d
 }
 
 // Approximate cone tracing (Lee et al. sec. 4.4): each layer's premultiplied colour and coverage
-// (0 where the layer has no sample) as a mipmap; a ray that hits a layer takes the mean over the
-// window its cone covers there instead of the one cell, as the share v of the cone the layer
-// blocks, and goes on with the rest.
-struct LayerPyramid {
-  std::vector<std::vector<std::array<float, 4>>> levels;  // level k: ceil(W / 2^k) x ceil(H / 2^k)
-  std::vector<int> widths, heights;
-};
-
-std::vector<LayerPyramid> make_pyramids(const Layers& layers, int threads) {
-  std::vector<LayerPyramid> out(static_cast<std::size_t>(layers.count));
+// (0 where the layer has no sample) as a mipmap (mip_pyramid.h); a ray that hits a layer takes the
+// mean over the window its cone covers there instead of the one cell, as the share v of the cone
+// the layer blocks, and goes on with the rest.
+std::vector<MipPyramid> make_pyramids(const Layers& layers, int threads) {
+  std::vector<MipPyramid> out(static_cast<std::size_t>(layers.count));
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
   for (int l = 0; l < layers.count; ++l) {
     if (!layers.layer_used[static_cast<std::size_t>(l)]) continue;  // never hit
-    LayerPyramid& p = out[static_cast<std::size_t>(l)];
-    int w = layers.width, h = layers.height;
+    const int w = layers.width, h = layers.height;
     std::vector<std::array<float, 4>> base(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), std::array<float, 4>{});
     for (int y = 0; y < h; ++y) {
       for (int x = 0; x < w; ++x) {
@@ -154,65 +142,8 @@ std::vector<LayerPyramid> make_pyramids(const Layers& layers, int threads) {
         if (c.w >= 0.0f) base[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] = layers.colours[c.colour];
       }
     }
-    p.levels.push_back(std::move(base));
-    p.widths.push_back(w);
-    p.heights.push_back(h);
-    while (w > 1 || h > 1) {
-      const int nw = (w + 1) / 2, nh = (h + 1) / 2;
-      const auto& prev = p.levels.back();
-      std::vector<std::array<float, 4>> next(static_cast<std::size_t>(nw) * static_cast<std::size_t>(nh));
-      for (int y = 0; y < nh; ++y) {
-        for (int x = 0; x < nw; ++x) {
-          std::array<float, 4> sum{};
-          for (int dy = 0; dy < 2; ++dy) {
-            for (int dx = 0; dx < 2; ++dx) {
-              const int sx = std::min(2 * x + dx, w - 1), sy = std::min(2 * y + dy, h - 1);
-              const auto& v = prev[static_cast<std::size_t>(sy) * static_cast<std::size_t>(w) + static_cast<std::size_t>(sx)];
-              for (std::size_t c = 0; c < 4; ++c) sum[c] += 0.25f * v[c];
-            }
-          }
-          next[static_cast<std::size_t>(y) * static_cast<std::size_t>(nw) + static_cast<std::size_t>(x)] = sum;
-        }
-      }
-      p.levels.push_back(std::move(next));
-      p.widths.push_back(nw);
-      p.heights.push_back(nh);
-      w = nw;
-      h = nh;
-    }
+    out[static_cast<std::size_t>(l)] = MipPyramid(std::move(base), w, h);
   }
-  return out;
-}
-
-// Bilinear lookup of level k at continuous pixel position (x, y) of level 0 (clamped at the edges).
-std::array<float, 4> sample_level(const LayerPyramid& p, std::size_t k, float x, float y) {
-  const float scale = 1.0f / static_cast<float>(1 << k);
-  const int w = p.widths[k], h = p.heights[k];
-  const float fx = std::clamp(x * scale - 0.5f, 0.0f, static_cast<float>(w - 1));
-  const float fy = std::clamp(y * scale - 0.5f, 0.0f, static_cast<float>(h - 1));
-  const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
-  const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
-  const float tx = fx - static_cast<float>(x0), ty = fy - static_cast<float>(y0);
-  const auto& L = p.levels[k];
-  auto at = [&](int xi, int yi) -> const std::array<float, 4>& {
-    return L[static_cast<std::size_t>(yi) * static_cast<std::size_t>(w) + static_cast<std::size_t>(xi)];
-  };
-  std::array<float, 4> out{};
-  for (std::size_t c = 0; c < 4; ++c) {
-    out[c] = (1 - tx) * (1 - ty) * at(x0, y0)[c] + tx * (1 - ty) * at(x1, y0)[c] + (1 - tx) * ty * at(x0, y1)[c] + tx * ty * at(x1, y1)[c];
-  }
-  return out;
-}
-
-// The mean over a window of `diameter` pixels centred at (x, y): trilinear between mip levels.
-std::array<float, 4> sample_window(const LayerPyramid& p, float x, float y, float diameter) {
-  const float level = std::clamp(std::log2(diameter), 0.0f, static_cast<float>(p.levels.size() - 1));
-  const auto k0 = static_cast<std::size_t>(level);
-  const std::size_t k1 = std::min(k0 + 1, p.levels.size() - 1);
-  const float t = level - static_cast<float>(k0);
-  const std::array<float, 4> a = sample_level(p, k0, x, y), b = sample_level(p, k1, x, y);
-  std::array<float, 4> out{};
-  for (std::size_t c = 0; c < 4; ++c) out[c] = (1 - t) * a[c] + t * b[c];
   return out;
 }
 
@@ -220,7 +151,7 @@ std::array<float, 4> sample_window(const LayerPyramid& p, float x, float y, floa
 // linear in w (Lee et al.: lambda the mean distance between lens samples, as a share of the pupil's
 // diameter).
 struct Cones {
-  const std::vector<LayerPyramid>* pyramids = nullptr;  // null: no cone tracing
+  const std::vector<MipPyramid>* pyramids = nullptr;  // null: no cone tracing
   float lambda = 0.0f;
   float coc_per_w = 0.0f, coc_at_infinity = 0.0f;
 };
@@ -298,7 +229,7 @@ RayResult follow(const Layers& layers, const PixelRay& ray, const Cones& cones) 
           if (cones.pyramids) {
             const float diameter = cones.lambda * std::abs(cones.coc_per_w * c.w + cones.coc_at_infinity);
             if (diameter > 1.0f) {
-              q = sample_window((*cones.pyramids)[static_cast<std::size_t>(l)], ray.inf_x + c.w * ray.k_x, ray.inf_y + c.w * ray.k_y, diameter);
+              q = (*cones.pyramids)[static_cast<std::size_t>(l)].window(ray.inf_x + c.w * ray.k_x, ray.inf_y + c.w * ray.k_y, diameter);
               cone = true;
             }
           }
@@ -468,7 +399,7 @@ Image render_multiview(const DeepImage& scene, const RayModel& model, const Aper
   }
 
   Cones cones;
-  std::vector<LayerPyramid> pyramids;
+  std::vector<MipPyramid> pyramids;
   if (options.cone_tracing) {
     pyramids = make_pyramids(layers, threads);
     cones.pyramids = &pyramids;

@@ -12,6 +12,7 @@
 #include "lensmith/render/bokeh_renderer.h"
 #include "lensmith/render/deep_image.h"
 #include "lensmith/render/image_io.h"
+#include "lensmith/render/lightfield_renderer.h"
 #include "lensmith/render/multiview_renderer.h"
 #include "lensmith/scene/lens_render.h"
 #include "lensmith/scene/pinhole_render.h"
@@ -27,9 +28,12 @@ void ImageValidationOptions::validate() const {
     throw OptionsError("layered input needs 1.." + std::to_string(kMaxPeeledLayers) + " layers (0: flat only), got " + std::to_string(layers));
   }
   for (const std::string& m : methods) {
-    if (m != "scatter" && m != "multiview") throw OptionsError("image validation methods are scatter and multiview, not " + m);
+    if (m != "scatter" && m != "multiview" && m != "lightfield") {
+      throw OptionsError("image validation methods are scatter, multiview and lightfield, not " + m);
+    }
   }
   if (multiview_samples < 1 || multiview_samples > 4096) throw OptionsError("multiview samples must be 1 to 4096");
+  if (lightfield_views < 1 || lightfield_views > 1024) throw OptionsError("lightfield views must be 1 to 1024");
   for (RayModelKind k : models) {
     if (k == RayModelKind::Exact || k == RayModelKind::Thin) {
       throw OptionsError("image validation scores paraxial, seidel or poly, not " + std::string(to_string(k)));
@@ -124,14 +128,19 @@ ImageValidation validate_images(const Prescription& lens, const CameraOptions& c
       multiview.threads = options.threads;
       multiview.samples = options.multiview_samples;
       std::optional<DeepImage> flat_scene;
+      LightfieldOptions lightfield;
+      lightfield.threads = options.threads;
+      lightfield.views = options.lightfield_views;
       for (const std::string& method : options.methods) {
-        const bool lee = method == "multiview";
+        const bool lee = method == "multiview", yu = method == "lightfield";
         if (lee && !flat_scene) flat_scene = deep_image_from_flat(pinhole.rgb, pinhole.depth);
         for (const bool deep : {false, true}) {
-          if (deep && !layered) continue;
+          if (deep && (!layered || yu)) continue;  // lightfield: one surface per pixel
           const auto started = std::chrono::steady_clock::now();
           Image result;
-          if (lee) {
+          if (yu) {
+            result = render_lightfield(pinhole.rgb, pinhole.depth, *model, Aperture::circular(), lightfield);
+          } else if (lee) {
             result = render_multiview(deep ? *layered : *flat_scene, *model, Aperture::circular(), multiview).leading_channels(3);
           } else {
             result = deep ? render_bokeh(*layered, *model, Aperture::circular(), bokeh)
@@ -143,8 +152,10 @@ ImageValidation validate_images(const Prescription& lens, const CameraOptions& c
           out.entries.push_back({name, kind, method, deep ? layered_input : "flat",
                                  compare_images(result, truth.rgb, pinhole.depth, options.band_radius_px), hidden_psnr, seconds});
           if (!options.picture_dir.empty()) {
-            meta.model = std::string(to_string(kind)) + (lee ? ", multiview" : std::string()) + (deep ? ", " + layered_input : std::string());
-            const std::string stem = name + "-" + std::string(to_string(kind)) + (lee ? "-multiview" : "") + (deep ? "-layered" : "");
+            const std::string method_tag = method == "scatter" ? std::string() : "-" + method;
+            meta.model = std::string(to_string(kind)) + (method == "scatter" ? std::string() : ", " + method) +
+                         (deep ? ", " + layered_input : std::string());
+            const std::string stem = name + "-" + std::string(to_string(kind)) + method_tag + (deep ? "-layered" : "");
             write_output_image(options.picture_dir / (stem + ".png"), result, meta);
             write_output_image(options.picture_dir / (stem + "-error.png"), error_map(result, truth.rgb), meta);
           }

@@ -30,17 +30,20 @@ struct ImageValidationOptions {
   // deep image): what knowing the hidden surfaces buys. 0: the flat picture only.
   int layers = 4;
   // The depth-of-field methods scored, each on the flat and the layered input: "scatter"
-  // (render_bokeh) and "multiview" (render_multiview, `multiview_samples` lens rays per pixel).
-  std::vector<std::string> methods{"scatter", "multiview"};
+  // (render_bokeh), "multiview" (render_multiview, `multiview_samples` lens rays per pixel) and
+  // "lightfield" (render_lightfield, `lightfield_views` views; the flat input only: it warps one
+  // surface per pixel).
+  std::vector<std::string> methods{"scatter", "multiview", "lightfield"};
   int multiview_samples = 32;
-  std::filesystem::path picture_dir;  // when set: <scene>-truth.png, <scene>-<model>[-multiview][-layered].png and -error.png
+  int lightfield_views = 36;
+  std::filesystem::path picture_dir;  // when set: <scene>-truth.png, <scene>-<model>[-<method>][-layered].png and -error.png
   void validate() const;              // throws OptionsError
 };
 
 struct ImageValidationEntry {
   std::string scene;
   RayModelKind model = RayModelKind::Seidel;
-  std::string method = "scatter";  // "scatter" or "multiview"
+  std::string method = "scatter";  // "scatter", "multiview" or "lightfield"
   std::string input = "flat";  // "flat" (picture and depth) or "layered N" (deep, N peeled layers)
   ImageComparison comparison;
   // PSNR over the pixels where hidden surfaces can show: within half the largest blur of a hidden
