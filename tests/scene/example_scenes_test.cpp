@@ -121,3 +121,43 @@ TEST_CASE("the fence shows slats at 1 m over the wall at 6 m, with lights at 3 m
   CHECK(visible_lights > 50);
   CHECK(hidden_lights > 0);  // 8 pixels at 640 x 360: lights partly behind slats
 }
+
+TEST_CASE("the branches cross at 0.8, 0.95 and 1.1 m in front of lights at 4 m and the wall at 8 m", "[scene][examples]") {
+  // At 640 x 360 the branches are 1.5 to 2 px wide: thin features that a method must not lose.
+  const PinholeRender out = render_pinhole(load_scene(kScenes + "branches.json"), example_frame(640, 360));
+  check_valid(out);
+  const std::set<double> depths = main_depths(out.depth, 50);
+  CHECK(depths.count(0.8) == 1);
+  CHECK(depths.count(0.95) == 1);
+  CHECK(depths.count(1.1) == 1);
+  CHECK(depths.count(8.0) == 1);
+  // The lights at 4 m: the far wall's depth everywhere else (a light's samples lie within 8 mm of 4 m).
+  const auto lights = std::count_if(out.depth.z_m.begin(), out.depth.z_m.end(), [](float z) { return z > 3.99f && z <= 4.0f; });
+  CHECK(lights > 10);
+}
+
+TEST_CASE("the frame-edge scene cuts a disc at 0.8 m by the right edge and a bar at 1.2 m by the top", "[scene][examples]") {
+  const PinholeRender out = render_example("frame-edge.json");
+  check_valid(out);
+  const std::set<double> depths = main_depths(out.depth, 10);
+  CHECK(depths.count(0.8) == 1);
+  CHECK(depths.count(1.2) == 1);
+  CHECK(depths.count(2.5) == 1);
+  const int w = out.depth.width, h = out.depth.height;
+  CHECK(out.depth.at(w - 1, h / 2) == Approx(0.8f));  // the disc reaches beyond the right edge
+  CHECK(out.depth.at(w / 4, 0) == Approx(1.2f));      // the bar beyond the top
+}
+
+TEST_CASE("the crossing planes meet at 2.1 m in the middle of the frame, each nearer on its own side", "[scene][examples]") {
+  const PinholeRender out = render_example("crossing-planes.json");
+  check_valid(out);
+  const int w = out.depth.width, h = out.depth.height;
+  // Along the middle row the nearer plane's depth falls towards the middle from both sides: 2.1 m
+  // at the crossing (tangent 0), and less than that on either side.
+  const float middle = out.depth.at(w / 2, h / 2);
+  CHECK(middle == Approx(2.1f).epsilon(0.02));
+  CHECK(out.depth.at(w / 8, h / 2) < middle);
+  CHECK(out.depth.at(7 * w / 8, h / 2) < middle);
+  // Left of the crossing the checker plane is in front, right of it the noise plane (blue).
+  CHECK(out.rgb.at(7 * w / 8, h / 2, 2) > out.rgb.at(7 * w / 8, h / 2, 0));
+}

@@ -328,6 +328,16 @@ Canvas Canvas::read_image(const std::string& path) {
   return canvas;
 }
 
+void Canvas::paste(const Canvas& picture, int x0, int y0) {
+  for (int y = std::max(0, -y0); y < picture.height_ && y0 + y < height_; ++y) {
+    for (int x = std::max(0, -x0); x < picture.width_ && x0 + x < width_; ++x) {
+      const std::size_t from = 3 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(picture.width_) + static_cast<std::size_t>(x));
+      const std::size_t to = 3 * (static_cast<std::size_t>(y0 + y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x0 + x));
+      for (std::size_t c = 0; c < 3; ++c) pixels_[to + c] = picture.pixels_[from + c];
+    }
+  }
+}
+
 void Canvas::write_png(const std::string& path) const {
   // Canvas values are display values: stored as 8-bit codes, rounded.
   std::vector<std::uint8_t> codes(pixels_.size());

@@ -1,5 +1,6 @@
 #include "lensmith/validate/image_validation.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -9,6 +10,7 @@
 
 #include "lensmith/core/errors.h"
 #include "lensmith/core/units.h"
+#include "lensmith/plot/canvas.h"
 #include "lensmith/render/bokeh_renderer.h"
 #include "lensmith/render/deep_image.h"
 #include "lensmith/render/image_io.h"
@@ -79,6 +81,53 @@ std::vector<std::uint8_t> hidden_surface_region(const DeepImage& layers, const C
   return out;
 }
 
+// The scene's pictures side by side, `<scene>-methods.png`: per model a row of its methods'
+// pictures (the truth first) and under it a row of their error maps, each labelled with its model,
+// method and input and with its PSNR over the frame and the depth-edge band.
+void write_contact_sheet(const std::filesystem::path& dir, const std::string& scene, const std::vector<ImageValidationEntry>& entries,
+                         const std::vector<std::string>& stems) {
+  constexpr int kPad = 4, kLabel = 18;
+  constexpr double kFontPx = 12.0;
+  const plot::Canvas truth = plot::Canvas::read_image((dir / (scene + "-truth.png")).string());
+  const int cw = truth.width(), ch = truth.height();
+  std::vector<RayModelKind> models;
+  std::vector<std::vector<std::size_t>> rows;
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const auto at = std::find(models.begin(), models.end(), entries[i].model);
+    if (at == models.end()) {
+      models.push_back(entries[i].model);
+      rows.push_back({i});
+    } else {
+      rows[static_cast<std::size_t>(at - models.begin())].push_back(i);
+    }
+  }
+  std::size_t columns = 0;
+  for (const auto& row : rows) columns = std::max(columns, row.size() + 1);
+  const int cell_w = cw + kPad, cell_h = ch + kLabel + kPad;
+  plot::Canvas sheet(static_cast<int>(columns) * cell_w + kPad, static_cast<int>(rows.size()) * 2 * cell_h + kPad, plot::kWhite);
+  sheet.set_font(plot::Canvas::find_default_font());
+  auto place = [&](const plot::Canvas& picture, int column, int row, const std::string& label) {
+    const int x0 = kPad + column * cell_w, y0 = kPad + row * cell_h;
+    sheet.text({static_cast<double>(x0), static_cast<double>(y0 + kLabel - 5)}, label, kFontPx, plot::kBlack);
+    sheet.paste(picture, x0, y0 + kLabel);
+  };
+  std::ostringstream psnr;
+  psnr << std::fixed << std::setprecision(2);
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    place(truth, 0, static_cast<int>(2 * r), "truth (exact tracer)");
+    for (std::size_t k = 0; k < rows[r].size(); ++k) {
+      const ImageValidationEntry& e = entries[rows[r][k]];
+      const std::string& stem = stems[rows[r][k]];
+      place(plot::Canvas::read_image((dir / (stem + ".png")).string()), static_cast<int>(k + 1), static_cast<int>(2 * r),
+            std::string(to_string(e.model)) + ", " + e.method + ", " + e.input);
+      psnr.str("");
+      psnr << "error: " << e.comparison.psnr_db << " dB, edge " << e.comparison.edge_psnr_db << " dB";
+      place(plot::Canvas::read_image((dir / (stem + "-error.png")).string()), static_cast<int>(k + 1), static_cast<int>(2 * r + 1), psnr.str());
+    }
+  }
+  sheet.write_png((dir / (scene + "-methods.png")).string());
+}
+
 }  // namespace
 
 ImageValidation validate_images(const Prescription& lens, const CameraOptions& camera_options, const ImageValidationOptions& options) {
@@ -112,6 +161,8 @@ ImageValidation validate_images(const Prescription& lens, const CameraOptions& c
       meta.model = "exact (ground truth)";
       write_output_image(options.picture_dir / (name + "-truth.png"), truth.rgb, meta);
     }
+    const std::size_t first_entry = out.entries.size();
+    std::vector<std::string> stems;  // of this scene's entries' pictures
     std::optional<DeepImage> layered;
     if (options.layers > 0) layered = render_pinhole_layers(scene, camera.frame(), options.layers, pinhole_options);
     const std::string layered_input = "layered " + std::to_string(options.layers);
@@ -158,9 +209,15 @@ ImageValidation validate_images(const Prescription& lens, const CameraOptions& c
             const std::string stem = name + "-" + std::string(to_string(kind)) + method_tag + (deep ? "-layered" : "");
             write_output_image(options.picture_dir / (stem + ".png"), result, meta);
             write_output_image(options.picture_dir / (stem + "-error.png"), error_map(result, truth.rgb), meta);
+            stems.push_back(stem);
           }
         }
       }
+    }
+    if (!options.picture_dir.empty()) {
+      write_contact_sheet(options.picture_dir, name,
+                          std::vector<ImageValidationEntry>(out.entries.begin() + static_cast<std::ptrdiff_t>(first_entry), out.entries.end()),
+                          stems);
     }
   }
   return out;

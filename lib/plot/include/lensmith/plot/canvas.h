@@ -92,6 +92,10 @@ class Canvas {
   };
   const std::vector<TextBox>& text_boxes() const { return text_boxes_; }
 
+  // Copies `picture`'s pixels with its top-left corner at (x0, y0), clipped to this canvas (contact
+  // sheets of rendered pictures).
+  void paste(const Canvas& picture, int x0, int y0);
+
   // Writes an 8-bit sRGB-encoded PNG through a temporary file in the same folder and a rename.
   // Throws IoError naming the path.
   void write_png(const std::string& path) const;

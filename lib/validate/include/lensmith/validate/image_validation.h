@@ -36,7 +36,9 @@ struct ImageValidationOptions {
   std::vector<std::string> methods{"scatter", "multiview", "lightfield"};
   int multiview_samples = 32;
   int lightfield_views = 36;
-  std::filesystem::path picture_dir;  // when set: <scene>-truth.png, <scene>-<model>[-<method>][-layered].png and -error.png
+  // When set: <scene>-truth.png, <scene>-<model>[-<method>][-layered].png and -error.png, and
+  // <scene>-methods.png, all of them side by side (per model a row of pictures, a row of errors).
+  std::filesystem::path picture_dir;
   void validate() const;              // throws OptionsError
 };
 
