@@ -27,6 +27,8 @@ namespace {
 
 // Views warped together: one RayModel::map call per source for all of them.
 constexpr std::size_t kViewBatch = 6;
+// The widest margin of sources beyond the frame (px each side).
+constexpr int kMaxMarginPx = 256;
 
 
 // A source pixel as the views see it.
@@ -106,21 +108,44 @@ Image render_lightfield(const Image& image, const DepthMap& depth, const RayMode
   }
   const double wavelength = camera.reference_wavelength_nm();
 
-  // The sources, and the mipmap their colours are read from.
-  std::vector<Source> sources(pixels);
+  // The sources: every pixel, and beyond the frame a margin of half the largest blur where the
+  // picture continues as its edge pixels (as multiview's layers do): without them a view that moves
+  // the picture inwards leaves the frame's edge pixels holes, and an object the frame cuts fell off
+  // over its last pixels (a disc cut by the right edge: 0.33 of full scale in the last column where
+  // the truth has 0.43).
   const double lambda = std::sqrt(kPi / (4.0 * static_cast<double>(n_views)));
   std::size_t clamped = 0;
-#pragma omp parallel for schedule(static) num_threads(threads) reduction(+ : clamped)
+  std::vector<double> inverse(pixels);
+  double max_coc_px = 0.0;
+#pragma omp parallel for schedule(static) num_threads(threads) reduction(+ : clamped) reduction(max : max_coc_px)
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      const Tangents t = camera.frame().tangents_at({x + 0.5, y + 0.5});
-      const double inverse = render_detail::clamp_inverse_depth(camera, inverse_depth_per_mm(depth.at(x, y)), options.max_blur_px, clamped);
-      Source& s = sources[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)];
-      s.point = {t.x, t.y, inverse};
-      s.cone_px = static_cast<float>(lambda * std::abs(camera.signed_coc_px(inverse)));
+      const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+      inverse[p] = render_detail::clamp_inverse_depth(camera, inverse_depth_per_mm(depth.at(x, y)), options.max_blur_px, clamped);
+      max_coc_px = std::max(max_coc_px, std::abs(camera.signed_coc_px(inverse[p])));
     }
   }
   stats.clamped_depths = clamped;
+  const int margin = static_cast<int>(std::min(std::ceil(0.5 * max_coc_px) + 2.0, static_cast<double>(kMaxMarginPx)));
+  const int sw = w + 2 * margin, sh = h + 2 * margin;
+  const std::size_t n_sources = static_cast<std::size_t>(sw) * static_cast<std::size_t>(sh);
+  // The picture's pixel a source stands for (clamped to the frame).
+  auto source_pixel = [&](std::size_t index) {
+    const int ex = static_cast<int>(index % static_cast<std::size_t>(sw)), ey = static_cast<int>(index / static_cast<std::size_t>(sw));
+    return std::array<int, 2>{std::clamp(ex - margin, 0, w - 1), std::clamp(ey - margin, 0, h - 1)};
+  };
+  std::vector<Source> sources(n_sources);
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (int y = 0; y < sh; ++y) {
+    for (int x = 0; x < sw; ++x) {
+      const std::size_t index = static_cast<std::size_t>(y) * static_cast<std::size_t>(sw) + static_cast<std::size_t>(x);
+      const std::array<int, 2> q = source_pixel(index);
+      const double w_per_mm = inverse[static_cast<std::size_t>(q[1]) * static_cast<std::size_t>(w) + static_cast<std::size_t>(q[0])];
+      const Tangents t = camera.frame().tangents_at({x - margin + 0.5, y - margin + 0.5});
+      sources[index].point = {t.x, t.y, w_per_mm};
+      sources[index].cone_px = static_cast<float>(lambda * std::abs(camera.signed_coc_px(w_per_mm)));
+    }
+  }
   render_detail::MipPyramid mip;
   if (options.mip_filter) {
     std::vector<std::array<float, 4>> base(pixels);
@@ -132,8 +157,8 @@ Image render_lightfield(const Image& image, const DepthMap& depth, const RayMode
   // call per source and view cost 2.5 times as much through the Seidel model).
   const std::size_t batch = std::min(n_views, kViewBatch);
   LargeVector<ZEntry> zbuffer(pixels * batch), fill(pixels);
-  LargeVector<std::array<float, 2>> landing(pixels * batch);  // per view of the batch and source: where it lands (NaN: nowhere)
-  LargeVector<float> landed_weight(pixels * batch);  // ... and its ray's radiometric weight (0: stopped)
+  LargeVector<std::array<float, 2>> landing(n_sources * batch);  // per view of the batch and source: where it lands (NaN: nowhere)
+  LargeVector<float> landed_weight(n_sources * batch);  // ... and its ray's radiometric weight (0: stopped)
   LargeVector<std::array<float, 4>> sum(pixels, std::array<float, 4>{});  // RGB and the views' weight
   std::size_t warps = 0, stopped = 0, holes = 0;
   for (std::size_t k0 = 0; k0 < n_views; k0 += batch) {
@@ -143,17 +168,17 @@ Image render_lightfield(const Image& image, const DepthMap& depth, const RayMode
     // the pixel it lands in. A ray the lens stops still claims its pixel, dark (what is behind it
     // is hidden from that pupil point all the same).
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads) reduction(+ : warps, stopped)
-    for (int y = 0; y < h; ++y) {
+    for (int y = 0; y < sh; ++y) {
       std::array<SensorHit, kViewBatch> hits;
-      for (int x = 0; x < w; ++x) {
-        const auto index = static_cast<std::uint32_t>(y * w + x);
+      for (int x = 0; x < sw; ++x) {
+        const auto index = static_cast<std::uint32_t>(y * sw + x);
         const Source& s = sources[index];
         model.map(s.point, wavelength, std::span<const PupilPoint>(pupil.data() + k0, count), std::span<SensorHit>(hits.data(), count));
         warps += count;
         const ZEntry entry = z_entry(static_cast<float>(s.point.inverse_depth_per_mm), index);
         for (std::size_t j = 0; j < count; ++j) {
           const SensorHit& hit = hits[j];
-          const std::size_t slot = j * pixels + index;
+          const std::size_t slot = j * n_sources + index;
           landing[slot] = {std::numeric_limits<float>::quiet_NaN(), 0.0f};
           if (!hit.ok) ++stopped;
           landed_weight[slot] = hit.ok ? static_cast<float>(options.vignetting ? hit.weight : 1.0) : 0.0f;
@@ -171,17 +196,17 @@ Image render_lightfield(const Image& image, const DepthMap& depth, const RayMode
     for (std::size_t j = 0; j < count; ++j) {
       const std::size_t k = k0 + j;
       ZEntry* const z = zbuffer.data() + j * pixels;
-      const std::array<float, 2>* const lands = landing.data() + j * pixels;
-      const float* const weights = landed_weight.data() + j * pixels;
+      const std::array<float, 2>* const lands = landing.data() + j * n_sources;
+      const float* const weights = landed_weight.data() + j * n_sources;
       // Cracks, as the paper fills them: each source also claims the 2 x 2 pixels around where it
       // lands, but only those no source landed in (nearest wins among those): the grown support
       // over pixels some source lands in would move a sloping surface's colours by up to a pixel
       // and tie a plane in focus to its neighbours.
       std::fill(fill.begin(), fill.end(), ZEntry{0});
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
-      for (int y = 0; y < h; ++y) {
-        for (int x = 0; x < w; ++x) {
-          const auto index = static_cast<std::uint32_t>(y * w + x);
+      for (int y = 0; y < sh; ++y) {
+        for (int x = 0; x < sw; ++x) {
+          const auto index = static_cast<std::uint32_t>(y * sw + x);
           const std::array<float, 2> q = lands[index];
           if (!std::isfinite(q[0])) continue;
           const int x0 = static_cast<int>(std::floor(q[0] - 0.5f)), y0 = static_cast<int>(std::floor(q[1] - 0.5f));
@@ -208,7 +233,7 @@ Image render_lightfield(const Image& image, const DepthMap& depth, const RayMode
             continue;
           }
           const auto index = static_cast<std::size_t>((e & 0xffffffffu) - 1);
-          const int sx = static_cast<int>(index % static_cast<std::size_t>(w)), sy = static_cast<int>(index / static_cast<std::size_t>(w));
+          const auto [sx, sy] = source_pixel(index);
           std::array<float, 3> c{image.at(sx, sy, 0), image.at(sx, sy, 1), image.at(sx, sy, 2)};
           if (options.mip_filter && sources[index].cone_px > 1.0f) {
             const std::array<float, 4> m = mip.window(static_cast<float>(sx) + 0.5f, static_cast<float>(sy) + 0.5f, sources[index].cone_px);

@@ -22,6 +22,9 @@
 //     surface's colours or dilating a foreground. Pixels no source reaches in a view
 //     (disocclusions, the frame's edge) are left out of that pixel's average, as the paper
 //     discards invalid rays. A pixel no view reaches keeps its input colour (counted).
+//   - Beyond the frame the picture continues as its edge pixels (as the multiview method's layers),
+//     over a margin of half the largest blur: views that move the picture inwards would otherwise
+//     leave the frame's edge pixels holes.
 //   - Sampling (sec. 4.2): Halton points over the pupil (bases 2 and 3: radius^2 and angle, uniform
 //     in area), as the paper's jittered camera positions; a bladed iris weights each point by its
 //     share of the area. Masks (pictures of an aperture) are not implemented here.
