@@ -302,13 +302,10 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   const auto model = make_ray_model(kind, *cam, model_options);
   const Aperture aperture = make_aperture(o);
 
-  if (multiview && o.other_channels == "defocus" && !other.names.empty()) {
-    throw UsageError("--other-channels defocus with --method multiview: not implemented (use keep or drop, or --method scatter)");
+  if (o.method != "scatter" && o.other_channels == "defocus" && !other.names.empty()) {
+    throw UsageError("--other-channels defocus with --method " + o.method + ": not implemented (use keep or drop, or --method scatter)");
   }
   if (lightfield) {
-    if (other.names.size() > 0 && o.other_channels == "defocus") {
-      throw UsageError("--other-channels defocus with --method lightfield: not implemented (use keep or drop, or --method scatter)");
-    }
     if (layered) throw UsageError("--method lightfield warps one surface per pixel: a deep (layered) input is not implemented; use --method multiview or scatter");
     if (alpha) throw UsageError("--method lightfield: a picture with transparent pixels (alpha) is not implemented; use --method scatter or multiview");
     LightfieldOptions options;
