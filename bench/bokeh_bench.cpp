@@ -8,6 +8,7 @@
 #include "lensmith/core/units.h"
 #include "lensmith/prescription/lens_library.h"
 #include "lensmith/render/bokeh_renderer.h"
+#include "lensmith/render/ewa_renderer.h"
 #include "lensmith/render/lightfield_renderer.h"
 
 using namespace lensmith;
@@ -93,6 +94,29 @@ void run_lightfield(benchmark::State& state, RayModelKind kind) {
                                                   benchmark::Counter::kIsIterationInvariantRate);
 }
 
+// Křivánek et al.'s EWA splatting on the same scene: with the level of detail its cost should stay
+// nearly flat as the blur grows (their table 1), without it grow with the blur's area.
+void run_ewa(benchmark::State& state, RayModelKind kind) {
+  const double blur = static_cast<double>(state.range(0));
+  const BenchScene scene = make_scene(blur);
+  const auto model = bench_model(kind);
+  EwaOptions options;
+  options.threads = static_cast<int>(state.range(1));
+  options.level_of_detail = state.range(2) != 0;
+  for (auto _ : state) {
+    Image out = render_ewa(scene.image, scene.depth, *model, Aperture::circular(), options);
+    benchmark::DoNotOptimize(out.data.data());
+  }
+  state.counters["Mpixel/s"] = benchmark::Counter(static_cast<double>(kWidth) * kHeight * 1e-6,
+                                                  benchmark::Counter::kIsIterationInvariantRate);
+}
+
+void ewa_args(benchmark::internal::Benchmark* b) {
+  for (int blur : {4, 16, 48, 128}) b->Args({blur, 2, 1});
+  for (int blur : {4, 16, 48}) b->Args({blur, 2, 0});
+  b->ArgNames({"blur_px", "threads", "lod"})->Unit(benchmark::kSecond)->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true)->UseRealTime();
+}
+
 void lightfield_args(benchmark::internal::Benchmark* b) {
   for (int blur : {4, 16, 48, 128}) b->Args({blur, 2, 36});
   b->Args({16, 2, 12});
@@ -113,5 +137,7 @@ BENCHMARK_CAPTURE(run, paraxial, RayModelKind::Paraxial)->Apply(args);
 BENCHMARK_CAPTURE(run, seidel, RayModelKind::Seidel)->Apply(args);
 BENCHMARK_CAPTURE(run_lightfield, thin, RayModelKind::Thin)->Apply(lightfield_args);
 BENCHMARK_CAPTURE(run_lightfield, seidel, RayModelKind::Seidel)->Apply(lightfield_args);
+BENCHMARK_CAPTURE(run_ewa, thin, RayModelKind::Thin)->Apply(ewa_args);
+BENCHMARK_CAPTURE(run_ewa, seidel, RayModelKind::Seidel)->Apply(ewa_args);
 
 BENCHMARK_MAIN();

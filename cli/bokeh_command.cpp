@@ -21,6 +21,7 @@
 #include "lensmith/render/bokeh_renderer.h"
 #include "lensmith/render/deep_image.h"
 #include "lensmith/render/image_io.h"
+#include "lensmith/render/ewa_renderer.h"
 #include "lensmith/render/lightfield_renderer.h"
 #include "lensmith/render/multiview_renderer.h"
 
@@ -122,12 +123,13 @@ void write_bokeh_output(Image out, OutputMetadata& meta, const BokehCommandOptio
 
 int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   const auto started = std::chrono::steady_clock::now();
-  const bool multiview = o.method == "multiview", lightfield = o.method == "lightfield";
+  const bool multiview = o.method == "multiview", lightfield = o.method == "lightfield", ewa = o.method == "ewa";
   if (o.method != "scatter" && !o.scatter_options.empty()) {
     throw UsageError(o.scatter_options.front() + " is an option of --method scatter, not of --method " + o.method);
   }
   if (!multiview && !o.multiview_options.empty()) throw UsageError(o.multiview_options.front() + " is an option of --method multiview");
   if (!lightfield && !o.lightfield_options.empty()) throw UsageError(o.lightfield_options.front() + " is an option of --method lightfield");
+  if (!ewa && !o.ewa_options.empty()) throw UsageError(o.ewa_options.front() + " is an option of --method ewa");
   // Inputs.
   const std::filesystem::path output = o.output;
   const DepthSource depth_source = DepthSource::parse(o.depth.empty() ? o.image : o.depth);
@@ -333,6 +335,38 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
          << " nm (spectral colour is not implemented for lightfield); " << stats.stopped
          << " warped rays stopped by the lens; " << format_rounded(100.0 * static_cast<double>(stats.holes) / pixel_views, 3)
          << " % of pixel views holes (no source landed), " << stats.unfilled_pixels << " pixels no view reached (input colour kept)";
+    report_written(what.str(), global);
+    return kExitOk;
+  }
+  if (ewa) {
+    if (layered) throw UsageError("--method ewa splats one surface per pixel: a deep (layered) input is not implemented; use --method multiview or scatter");
+    if (alpha) throw UsageError("--method ewa: a picture with transparent pixels (alpha) is not implemented; use --method scatter or multiview");
+    EwaOptions options;
+    options.threads = o.threads;
+    options.vignetting = !o.no_vignetting;
+    options.lens_psf = !o.circular_splats;
+    options.level_of_detail = !o.no_level_of_detail;
+    ProgressBar bar("bokeh", !global.quiet);
+    options.progress = [&bar](double f) { bar.update(f); };
+    EwaStatistics stats;
+    const auto render_started = std::chrono::steady_clock::now();
+    const Image out = render_ewa(*flat, depth, *model, aperture, options, &stats);
+    const double render_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - render_started).count();
+    bar.finish();
+    OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture);
+    meta.extra.insert(meta.extra.end(), {{"splat_kernel", options.lens_psf ? "lens psf" : "circular coc"},
+                                         {"level_of_detail", options.level_of_detail ? "on" : "off"}});
+    write_bokeh_output(out, meta, o, depth, other);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    std::ostringstream what;
+    what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds
+         << " s (rendering " << render_seconds << " s)\n  " << lens_name << ", model " << to_string(kind) << ", method ewa, f/"
+         << format_rounded(cam->f_number(), 3) << ", focus " << format_rounded(camera.focus_distance_m, 4) << " m, " << aperture.to_string()
+         << " aperture\n  " << stats.splats << " splats ("
+         << (options.lens_psf ? "the lens's PSF covariance" : "circular Gaussians of the CoC") << ", at "
+         << format_rounded(cam->reference_wavelength_nm(), 4) << " nm: spectral colour is not implemented for ewa), "
+         << format_rounded(static_cast<double>(stats.pixel_writes) / (static_cast<double>(out.width) * out.height), 3)
+         << " pixel writes per pixel, " << stats.unfilled_pixels << " pixels no splat reached (input colour kept)";
     report_written(what.str(), global);
     return kExitOk;
   }

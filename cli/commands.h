@@ -177,6 +177,9 @@ struct BokehCommandOptions {
   std::vector<std::string> scatter_options;     // scatter-only options given on the command line
   std::vector<std::string> multiview_options;   // multiview-only options given
   std::vector<std::string> lightfield_options;  // lightfield-only options given
+  bool circular_splats = false;              // --circular-splats (ewa)
+  bool no_level_of_detail = false;           // --no-level-of-detail (ewa)
+  std::vector<std::string> ewa_options;         // ewa-only options given
 };
 int run_bokeh(const BokehCommandOptions& options, const GlobalOptions& global);
 
@@ -197,7 +200,7 @@ struct ValidateCommandOptions {
   int image_height_px = 180;
   int image_spp = 64;                             // --image-spp: ground-truth samples per pixel
   int image_layers = 4;                           // --image-layers: the scenes also as layered input (0: flat only)
-  std::vector<std::string> image_methods{"scatter", "multiview", "lightfield"};  // --image-methods
+  std::vector<std::string> image_methods{"scatter", "multiview", "lightfield", "ewa"};  // --image-methods
   int image_samples = 32;                         // --image-samples: multiview lens rays per pixel
   int image_views = 36;                           // --image-views: lightfield views
   std::optional<double> min_edge_psnr_db;         // --min-edge-psnr: fail when a model's edge-band PSNR is lower

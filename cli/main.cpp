@@ -284,8 +284,9 @@ int main(int argc, char** argv) {
   bokeh_cmd->add_option("--method", bokeh.method,
                         "scatter (default: every pixel scattered through the ray model, depth-layered) | multiview (Lee et al. 2009: "
                         "per pixel --samples lens rays traced through the layered scene; for deep input) | lightfield (Yu et al. "
-                        "2010: the picture warped to --views pupil points through the ray model, nearest wins, views averaged)")
-      ->check(CLI::IsMember({"scatter", "multiview", "lightfield"}));
+                        "2010: the picture warped to --views pupil points through the ray model, nearest wins, views averaged) | ewa "
+                        "(Krivanek et al. 2003: every pixel a Gaussian splat widened by the lens's blur, level of detail, A-buffer)")
+      ->check(CLI::IsMember({"scatter", "multiview", "lightfield", "ewa"}));
   CLI::Option* bokeh_samples =
       bokeh_cmd->add_option("--samples", bokeh.samples, "multiview: lens rays per output pixel (1-4096, default 32)")->check(range(1, 4096));
   CLI::Option* bokeh_layers =
@@ -302,6 +303,11 @@ int main(int argc, char** argv) {
   CLI::Option* bokeh_mip = bokeh_cmd->add_flag(
       "--no-mip-filter", bokeh.no_mip_filter,
       "lightfield: read each view's colour from its pixel, not from the mipmap window of its share of the blur (Yu et al.'s pre-filter, on by default)");
+  CLI::Option* bokeh_circular = bokeh_cmd->add_flag(
+      "--circular-splats", bokeh.circular_splats,
+      "ewa: circular Gaussians of the circle of confusion at the pinhole position (Krivanek et al.'s kernel), not the lens's PSF covariance, centroid and vignetting");
+  CLI::Option* bokeh_lod = bokeh_cmd->add_flag(
+      "--no-level-of-detail", bokeh.no_level_of_detail, "ewa: every pixel its own splat (no coarser surfels where the blur is large: slower as blur grows)");
   std::vector<CLI::Option*> bokeh_scatter_only;
   bokeh_scatter_only.push_back(bokeh_cmd->add_option("--hidden", bokeh.hidden, "Background hidden behind foreground edges: extend (default) | stretch")
       ->check(CLI::IsMember({"extend", "stretch"})));
@@ -355,8 +361,8 @@ int main(int argc, char** argv) {
                             "Also score each model on the scene as layered (deep) input of this many peeled layers (default 4; 0: the flat picture only)")
       ->check(range(0, 16));
   validate_cmd->add_option("--image-methods", validate.image_methods,
-                           "Depth-of-field methods scored on each scene: scatter, multiview, lightfield (default all three)")
-      ->check(CLI::IsMember({"scatter", "multiview", "lightfield"}));
+                           "Depth-of-field methods scored on each scene: scatter, multiview, lightfield, ewa (default all four)")
+      ->check(CLI::IsMember({"scatter", "multiview", "lightfield", "ewa"}));
   validate_cmd->add_option("--image-views", validate.image_views, "Views of the lightfield method (default 36)")->check(range(1, 1024));
   validate_cmd->add_option("--image-samples", validate.image_samples, "Lens rays per pixel of the multiview method (default 32)")
       ->check(range(1, 4096));
@@ -505,6 +511,9 @@ int main(int argc, char** argv) {
       }
       for (CLI::Option* option : {bokeh_views, bokeh_mip}) {
         if (option->count() > 0) bokeh.lightfield_options.push_back(option->get_name());
+      }
+      for (CLI::Option* option : {bokeh_circular, bokeh_lod}) {
+        if (option->count() > 0) bokeh.ewa_options.push_back(option->get_name());
       }
       return run_bokeh(bokeh, global);
     }

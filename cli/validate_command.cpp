@@ -77,7 +77,7 @@ int run_validate(const ValidateCommandOptions& o, const GlobalOptions& global) {
     image_options.picture_dir = dir;
     images = validate_images(lens, camera_options, image_options);
     report << "`lensmith bokeh` with each model and method (scatter; multiview with " << o.image_samples
-           << " lens rays per pixel; lightfield with " << o.image_views << " views, flat input only) on the pinhole render of each scene"
+           << " lens rays per pixel; lightfield with " << o.image_views << " views and ewa, flat input only) on the pinhole render of each scene"
            << (o.image_layers > 0 ? " (flat: picture and depth) and on its " + std::to_string(o.image_layers) +
                                         " depth-peeled layers as a deep image (layered)"
                                   : std::string())

@@ -371,3 +371,36 @@ TEST_CASE("lensmith bokeh --method lightfield warps the picture to its views, sa
   const auto zero = run_lensmith(base + "--method lightfield --views 0");
   CHECK(zero.exit_code == 2);
 }
+
+TEST_CASE("lensmith bokeh --method ewa splats the picture through the lens's blur, says how it was made and refuses what it cannot do",
+          "[cli][bokeh][ewa]") {
+  const fs::path out = scratch("ewa-out.exr");
+  const auto r = run_lensmith("bokeh --image " + kScene + " --lens sasian-triplet --focus 3 --method ewa --threads 2 -o " + out.string());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.err.find("method ewa") != std::string::npos);
+  CHECK(r.err.find("the lens's PSF covariance") != std::string::npos);
+  CHECK(r.err.find("spectral colour is not implemented") != std::string::npos);
+  const auto meta = lensmith::read_image_metadata(out);
+  CHECK(value_of(meta, "lensmith:method") == "ewa");
+  CHECK(value_of(meta, "lensmith:splat_kernel") == "lens psf");
+  const std::string base = "bokeh --image " + kScene + " --lens sasian-triplet --focus 3 -o " + scratch("ewa.exr").string() + " ";
+  const auto paper = run_lensmith(base + "--method ewa --circular-splats --no-level-of-detail");
+  CHECK(paper.exit_code == 0);
+  CHECK(paper.err.find("circular Gaussians of the CoC") != std::string::npos);
+  const auto circular = run_lensmith(base + "--circular-splats");
+  CHECK(circular.exit_code == 2);
+  CHECK(circular.err.find("--circular-splats is an option of --method ewa") != std::string::npos);
+  const auto hidden = run_lensmith(base + "--method ewa --hidden stretch");
+  CHECK(hidden.exit_code == 2);
+  CHECK(hidden.err.find("--hidden is an option of --method scatter") != std::string::npos);
+  const auto views = run_lensmith(base + "--method ewa --views 8");
+  CHECK(views.exit_code == 2);
+  CHECK(views.err.find("--views is an option of --method lightfield") != std::string::npos);
+  const fs::path deep = write_deep_element("element-deep-ewa.exr");
+  const auto layered = run_lensmith("bokeh --image " + deep.string() + " --thin-lens --focal-length 50 --fstop 1.4 --focus 0.5 --method ewa -o " +
+                                    scratch("ewa-deep.exr").string());
+  CHECK(layered.exit_code == 2);
+  CHECK(layered.err.find("not implemented") != std::string::npos);
+  CHECK_FALSE(fs::exists(scratch("ewa-deep.exr")));
+}

@@ -14,6 +14,7 @@
 #include "lensmith/render/bokeh_renderer.h"
 #include "lensmith/render/deep_image.h"
 #include "lensmith/render/image_io.h"
+#include "lensmith/render/ewa_renderer.h"
 #include "lensmith/render/lightfield_renderer.h"
 #include "lensmith/render/multiview_renderer.h"
 #include "lensmith/scene/lens_render.h"
@@ -30,8 +31,8 @@ void ImageValidationOptions::validate() const {
     throw OptionsError("layered input needs 1.." + std::to_string(kMaxPeeledLayers) + " layers (0: flat only), got " + std::to_string(layers));
   }
   for (const std::string& m : methods) {
-    if (m != "scatter" && m != "multiview" && m != "lightfield") {
-      throw OptionsError("image validation methods are scatter, multiview and lightfield, not " + m);
+    if (m != "scatter" && m != "multiview" && m != "lightfield" && m != "ewa") {
+      throw OptionsError("image validation methods are scatter, multiview, lightfield and ewa, not " + m);
     }
   }
   if (multiview_samples < 1 || multiview_samples > 4096) throw OptionsError("multiview samples must be 1 to 4096");
@@ -182,15 +183,19 @@ ImageValidation validate_images(const Prescription& lens, const CameraOptions& c
       LightfieldOptions lightfield;
       lightfield.threads = options.threads;
       lightfield.views = options.lightfield_views;
+      EwaOptions ewa;
+      ewa.threads = options.threads;
       for (const std::string& method : options.methods) {
-        const bool lee = method == "multiview", yu = method == "lightfield";
+        const bool lee = method == "multiview", yu = method == "lightfield", krivanek = method == "ewa";
         if (lee && !flat_scene) flat_scene = deep_image_from_flat(pinhole.rgb, pinhole.depth);
         for (const bool deep : {false, true}) {
-          if (deep && (!layered || yu)) continue;  // lightfield: one surface per pixel
+          if (deep && (!layered || yu || krivanek)) continue;  // lightfield, ewa: one surface per pixel
           const auto started = std::chrono::steady_clock::now();
           Image result;
           if (yu) {
             result = render_lightfield(pinhole.rgb, pinhole.depth, *model, Aperture::circular(), lightfield);
+          } else if (krivanek) {
+            result = render_ewa(pinhole.rgb, pinhole.depth, *model, Aperture::circular(), ewa);
           } else if (lee) {
             result = render_multiview(deep ? *layered : *flat_scene, *model, Aperture::circular(), multiview).leading_channels(3);
           } else {

@@ -31,9 +31,9 @@ struct ImageValidationOptions {
   int layers = 4;
   // The depth-of-field methods scored, each on the flat and the layered input: "scatter"
   // (render_bokeh), "multiview" (render_multiview, `multiview_samples` lens rays per pixel) and
-  // "lightfield" (render_lightfield, `lightfield_views` views; the flat input only: it warps one
-  // surface per pixel).
-  std::vector<std::string> methods{"scatter", "multiview", "lightfield"};
+  // "lightfield" (render_lightfield, `lightfield_views` views) and "ewa" (render_ewa); those two on
+  // the flat input only: they take one surface per pixel.
+  std::vector<std::string> methods{"scatter", "multiview", "lightfield", "ewa"};
   int multiview_samples = 32;
   int lightfield_views = 36;
   // When set: <scene>-truth.png, <scene>-<model>[-<method>][-layered].png and -error.png, and
@@ -45,7 +45,7 @@ struct ImageValidationOptions {
 struct ImageValidationEntry {
   std::string scene;
   RayModelKind model = RayModelKind::Seidel;
-  std::string method = "scatter";  // "scatter", "multiview" or "lightfield"
+  std::string method = "scatter";  // "scatter", "multiview", "lightfield" or "ewa"
   std::string input = "flat";  // "flat" (picture and depth) or "layered N" (deep, N peeled layers)
   ImageComparison comparison;
   // PSNR over the pixels where hidden surfaces can show: within half the largest blur of a hidden
