@@ -56,6 +56,15 @@ struct FootprintScratch {
   std::vector<double> pupil_areas;
   std::vector<double> ring_weights;
   std::vector<std::span<const Point2f>> ring_spans;
+  // One footprint's maps at each of its wavelengths, kept from the check whether its rings nest at
+  // all of them to their deposit (set 0: the mesh by map, 1: the clipped rings by map_passing).
+  struct CachedMap {
+    double wavelength_nm = 0.0;
+    int set = 0;
+    std::vector<SensorHit> hits;
+  };
+  std::vector<CachedMap> cached_maps;
+  std::size_t cached_count = 0;
 };
 
 // Everything a footprint depends on besides its source; one per render, shared by the threads.
@@ -76,10 +85,19 @@ class FootprintScatter {
   // y), as the triangles between them into `fine` (adding them to `triangles`).
   bool clip_rings(const FootprintPlan& p, FootprintScratch& scratch) const;  // into scratch.ring_pupil; false: do not nest
   // `passing` (> 0) is the share of the aperture that passes, measured on a dense outline: the rings'
-  // own outline may be coarse (16 vertices cut a cat's eye's cusps by chords).
+  // own outline may be coarse (16 vertices cut a cat's eye's cusps by chords). `allow_rings` false:
+  // the triangles whether or not the rings nest (another wavelength of the footprint's did not).
   void deposit_clipped_rings(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p, double passing,
-                             const std::array<float, 4>& value, SplatBuffer& buffer, SplatBuffer& fine,
+                             bool allow_rings, const std::array<float, 4>& value, SplatBuffer& buffer, SplatBuffer& fine,
                              FootprintScratch& scratch, std::size_t& triangles) const;
+  // model.map (set 0) or map_passing (set 1) of `pupil` at one wavelength into `hits`, from
+  // scratch.cached_maps when this footprint mapped them there already, else mapped (and kept when
+  // `keep`).
+  void map_cached(const ScenePoint& point, double wavelength_nm, int set, std::span<const PupilPoint> pupil,
+                  std::vector<SensorHit>& hits, FootprintScratch& scratch, bool keep) const;
+  // The clipped rings (clip_rings) mapped at one wavelength: scratch.hits, points, ring_spans, ring_weights.
+  void map_clipped_rings(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p, FootprintScratch& scratch,
+                         bool keep = false) const;
   // FootprintPlan::passing for `discs` and a footprint drawn with `own_step`'s sector count.
   double disc_passing_share(const std::vector<PupilDisc>& discs, int own_step, FootprintScratch& scratch) const;
   // `value` with its light (not its coverage) scaled by a ray's radiometric weight (SensorHit), when
