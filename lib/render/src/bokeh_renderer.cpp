@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cstdint>
 #include <cmath>
 #include <optional>
 #include <sstream>
@@ -72,7 +73,7 @@ int thread_count(const BokehOptions& options) { return options.threads > 0 ? opt
 
 // The stages after the sources: layers, and per layer hidden surfaces, planning, deposit and
 // compositing. `sources` are the parts of the pixels of a w x h picture.
-Image render_sources(const ScatterSources& sources, const DepthLayers& layers, int w, int h, const RayModel& model,
+Image render_sources(const ScatterSources& sources, const DepthLayers& layers, int w, int h, int margin, const RayModel& model,
                      const Aperture& aperture, const BokehOptions& options, BokehStatistics& stats) {
   const Camera& camera = model.camera();
   const int threads = thread_count(options);
@@ -114,7 +115,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
     if (layer.empty()) continue;
     ++stats.layers;
     // Level of detail: sources whose footprints go to a coarse grid, merged by its cells.
-    render_detail::merge_coarse_sources(layer, w, h, merge_scratch);
+    render_detail::merge_coarse_sources(layer, w, h, merge_scratch, margin);
 
     plans.resize(layer.size());
 #pragma omp parallel num_threads(threads)
@@ -201,6 +202,73 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   return render_detail::finish_composite(result, w, h);
 }
 
+// The margin beyond the frame where a flat picture continues as its edge pixels (px each side): half
+// the largest blur, plus how far the lens moves the frame's edges from the pinhole's (distortion,
+// at the reference wavelength and the focus distance), plus the 2 px tent; at most kMaxMarginPx.
+// Without it a lens whose distortion moved the edges inwards left the last columns covered only by
+// the blur of inner points: renormalised, and with wavelength groups their colour drifted (the
+// README's main job through the Canon 35 mm: the second column from each side blue, R 0.04 where
+// its neighbours read 0.11).
+constexpr double kMaxMarginPx = 256.0;
+int frame_margin_px(const RayModel& model, double max_blur_px) {
+  const Camera& camera = model.camera();
+  const double w = camera.frame().width_px(), h = camera.frame().height_px();
+  const double inverse = camera.focus_distance_mm() > 0.0 && std::isfinite(camera.focus_distance_mm()) ? 1.0 / camera.focus_distance_mm() : 0.0;
+  double shift = 0.0;
+  static constexpr std::array<PupilPoint, 1> kCentre{{{0.0, 0.0}}};
+  std::array<SensorHit, 1> hit;
+  for (const PixelPoint at : {PixelPoint{0.0, 0.5 * h}, PixelPoint{w, 0.5 * h}, PixelPoint{0.5 * w, 0.0}, PixelPoint{0.5 * w, h},
+                              PixelPoint{0.0, 0.0}, PixelPoint{w, 0.0}, PixelPoint{0.0, h}, PixelPoint{w, h}}) {
+    const Tangents t = camera.frame().tangents_at(at);
+    model.map({t.x, t.y, inverse}, camera.reference_wavelength_nm(), kCentre, hit);
+    if (!(hit[0].ok || hit[0].unclipped)) continue;
+    const PixelPoint q = camera.output_pixel(hit[0].x_mm, hit[0].y_mm);
+    if (std::isfinite(q.x) && std::isfinite(q.y)) shift = std::max(shift, std::hypot(q.x - at.x, q.y - at.y));
+  }
+  return static_cast<int>(std::min(std::ceil(0.5 * max_blur_px + shift) + 2.0, kMaxMarginPx));
+}
+
+// Sources beyond a w x h frame over `margin` px each side, copies of the nearest edge pixel's parts
+// (every source of that pixel: a split pixel's two parts, a layered input's samples) at their own
+// positions.
+void add_margin_sources(ScatterSources& sources, int w, int h, int margin) {
+  if (margin <= 0) return;
+  const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+  auto pixel_of = [w](const ScatterSource& s) { return static_cast<std::size_t>(s.y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(s.x); };
+  // The sources of each pixel: counted, then placed.
+  std::vector<std::uint32_t> begin(pixels + 1, 0);
+  for (const ScatterSource& s : sources) ++begin[pixel_of(s) + 1];
+  for (std::size_t p = 0; p < pixels; ++p) begin[p + 1] += begin[p];
+  std::vector<std::uint32_t> of_pixel(sources.size());
+  {
+    std::vector<std::uint32_t> next(begin.begin(), begin.end() - 1);
+    for (std::size_t i = 0; i < sources.size(); ++i) of_pixel[next[pixel_of(sources[i])]++] = static_cast<std::uint32_t>(i);
+  }
+  std::size_t count = 0;
+  for (int y = -margin; y < h + margin; ++y) {
+    for (int x = -margin; x < w + margin; ++x) {
+      if (x >= 0 && y >= 0 && x < w && y < h) continue;
+      const std::size_t p = static_cast<std::size_t>(std::clamp(y, 0, h - 1)) * static_cast<std::size_t>(w) +
+                            static_cast<std::size_t>(std::clamp(x, 0, w - 1));
+      count += begin[p + 1] - begin[p];
+    }
+  }
+  sources.reserve(sources.size() + count);
+  for (int y = -margin; y < h + margin; ++y) {
+    for (int x = -margin; x < w + margin; ++x) {
+      if (x >= 0 && y >= 0 && x < w && y < h) continue;
+      const std::size_t p = static_cast<std::size_t>(std::clamp(y, 0, h - 1)) * static_cast<std::size_t>(w) +
+                            static_cast<std::size_t>(std::clamp(x, 0, w - 1));
+      for (std::uint32_t k = begin[p]; k < begin[p + 1]; ++k) {
+        ScatterSource s = sources[of_pixel[k]];
+        s.x = x;
+        s.y = y;
+        sources.push_back(s);
+      }
+    }
+  }
+}
+
 // Checks that the picture has the camera's framing.
 void check_framing(const RayModel& model, int width, int height, const std::string& what) {
   const PinholeFrame& frame = model.camera().frame();
@@ -280,8 +348,10 @@ Image render_bokeh(const Image& image, const DepthMap& depth, const RayModel& mo
   const int w = image.width, h = image.height, threads = thread_count(options);
   ScatterSources sources = render_detail::make_scatter_sources(image, depth, camera, options, threads, stats);
   if (options.split_edge_pixels) render_detail::split_mixed_pixels(sources, w, h, camera, threads, stats);
+  const int margin = frame_margin_px(model, stats.max_abs_coc_px);
+  add_margin_sources(sources, w, h, margin);
   const DepthLayers layers = render_detail::make_depth_layers(sources, w, h, options.layer_spacing_px, options.max_layers);
-  return render_sources(sources, layers, w, h, model, aperture, options, stats);
+  return render_sources(sources, layers, w, h, margin, model, aperture, options, stats);
 }
 
 Image render_bokeh(const DeepImage& deep, const RayModel& model, const Aperture& aperture, const BokehOptions& options,
@@ -295,11 +365,14 @@ Image render_bokeh(const DeepImage& deep, const RayModel& model, const Aperture&
   BokehStatistics local;
   BokehStatistics& stats = statistics ? *statistics : local;
   // Edge pixels need no split: a layered input has each surface of a pixel as its own sample.
-  const render_detail::DeepSources deep_sources = render_detail::make_deep_sources(deep, model.camera(), options, stats);
+  render_detail::DeepSources deep_sources = render_detail::make_deep_sources(deep, model.camera(), options, stats);
   stats.deep_samples = deep_sources.samples;
   stats.volume_slabs = deep_sources.volume_slabs;
-  const DepthLayers layers = render_detail::make_depth_layers(deep_sources.sources, deep.width, deep.height, deep_sources.spacing);
-  return render_sources(deep_sources.sources, layers, deep.width, deep.height, model, aperture, options, stats);
+  const int margin = frame_margin_px(model, stats.max_abs_coc_px);
+  ScatterSources sources = std::move(deep_sources.sources);
+  add_margin_sources(sources, deep.width, deep.height, margin);
+  const DepthLayers layers = render_detail::make_depth_layers(sources, deep.width, deep.height, deep_sources.spacing);
+  return render_sources(sources, layers, deep.width, deep.height, margin, model, aperture, options, stats);
 }
 
 }  // namespace lensmith

@@ -28,17 +28,23 @@ DepthLayers make_depth_layers(const ScatterSources& sources, int width, int heig
   // Parts grouped by pixel: counted, then placed (a split pixel's second part comes at the end of
   // the sources).
   l.part_begin.assign(pixel_count + 1, 0);
-  for (const ScatterSource& s : sources) ++l.part_begin[static_cast<std::size_t>(s.y) * width + s.x + 1];
+  // Sources beyond the frame (the scatter's margin) are no pixel's parts: they only scatter.
+  auto inside = [&](const ScatterSource& s) { return s.x >= 0 && s.y >= 0 && s.x < width && s.y < height; };
+  for (const ScatterSource& s : sources) {
+    if (inside(s)) ++l.part_begin[static_cast<std::size_t>(s.y) * width + s.x + 1];
+  }
   for (std::size_t p = 0; p < pixel_count; ++p) l.part_begin[p + 1] += l.part_begin[p];
-  l.parts.resize(sources.size());
+  l.parts.resize(l.part_begin[pixel_count]);
   LargeVector<std::uint32_t> next(l.part_begin.begin(), l.part_begin.end() - 1);
   for (std::size_t i = 0; i < sources.size(); ++i) {
     const ScatterSource& s = sources[i];
     const int k = spacing.layer_at(s.coc_px);
-    PixelPart& part = l.parts[next[static_cast<std::size_t>(s.y) * width + s.x]++];
-    part.layer = k;
-    part.visible = s.coverage - s.hidden;
-    part.hidden = s.hidden;
+    if (inside(s)) {
+      PixelPart& part = l.parts[next[static_cast<std::size_t>(s.y) * width + s.x]++];
+      part.layer = k;
+      part.visible = s.coverage - s.hidden;
+      part.hidden = s.hidden;
+    }
     l.members[static_cast<std::size_t>(k)].push_back(static_cast<int>(i));
     l.max_blur_px[static_cast<std::size_t>(k)] = std::max(l.max_blur_px[static_cast<std::size_t>(k)], std::abs(s.coc_px));
   }

@@ -5,7 +5,8 @@
 
 namespace lensmith::render_detail {
 
-void merge_coarse_sources(ScatterSources& layer, int width, int height, MergeScratch& scratch) {
+void merge_coarse_sources(ScatterSources& layer, int frame_width, int frame_height, MergeScratch& scratch, int margin) {
+  const int width = frame_width + 2 * margin, height = frame_height + 2 * margin;
   // Slots per level (1, 2) and kind (light, coverage only), over blocks of 2^level px.
   const int bw1 = (width + 1) / 2, bh1 = (height + 1) / 2, bw2 = (width + 3) / 4, bh2 = (height + 3) / 4;
   const std::size_t level1 = static_cast<std::size_t>(bw1) * static_cast<std::size_t>(bh1);
@@ -19,8 +20,9 @@ void merge_coarse_sources(ScatterSources& layer, int width, int height, MergeScr
   scratch.slots.assign(2 * (level1 + level2), -1);
   auto slot_of = [&](const ScatterSource& s, int level) -> std::int32_t& {
     const std::size_t kind = s.coverage_only ? 1 : 0;
-    if (level == 1) return scratch.slots[kind * level1 + static_cast<std::size_t>(s.y / 2) * bw1 + static_cast<std::size_t>(s.x / 2)];
-    return scratch.slots[2 * level1 + kind * level2 + static_cast<std::size_t>(s.y / 4) * bw2 + static_cast<std::size_t>(s.x / 4)];
+    const auto x = static_cast<std::size_t>(s.x + margin), y = static_cast<std::size_t>(s.y + margin);
+    if (level == 1) return scratch.slots[kind * level1 + (y / 2) * bw1 + x / 2];
+    return scratch.slots[2 * level1 + kind * level2 + (y / 4) * bw2 + x / 4];
   };
 
   std::vector<BlockSum>& blocks = scratch.blocks;

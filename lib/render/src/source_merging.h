@@ -42,7 +42,9 @@ struct MergeScratch {
 // Merges the sources of `layer` (of an image width x height px) whose blur puts their footprints on
 // a coarse grid (grid_level of |coc_px| >= 1) by blocks of 2^level px, light sources and
 // coverage-only ones apart; a source alone in its block is kept as it is. The layer is rewritten in
-// the order of the blocks' first members (row-major stays row-major), before planning.
-void merge_coarse_sources(ScatterSources& layer, int width, int height, MergeScratch& scratch);
+// the order of the blocks' first members (row-major stays row-major), before planning. Sources
+// beyond the frame (a margin of `margin` px each side, where the picture continues) are merged on
+// the same blocks, counted from the margin's corner.
+void merge_coarse_sources(ScatterSources& layer, int width, int height, MergeScratch& scratch, int margin = 0);
 
 }  // namespace lensmith::render_detail
