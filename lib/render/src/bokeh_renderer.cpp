@@ -202,32 +202,6 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   return render_detail::finish_composite(result, w, h);
 }
 
-// The margin beyond the frame where a flat picture continues as its edge pixels (px each side): half
-// the largest blur, plus how far the lens moves the frame's edges from the pinhole's (distortion,
-// at the reference wavelength and the focus distance), plus the 2 px tent; at most kMaxMarginPx.
-// Without it a lens whose distortion moved the edges inwards left the last columns covered only by
-// the blur of inner points: renormalised, and with wavelength groups their colour drifted (the
-// README's main job through the Canon 35 mm: the second column from each side blue, R 0.04 where
-// its neighbours read 0.11).
-constexpr double kMaxMarginPx = 256.0;
-int frame_margin_px(const RayModel& model, double max_blur_px) {
-  const Camera& camera = model.camera();
-  const double w = camera.frame().width_px(), h = camera.frame().height_px();
-  const double inverse = camera.focus_distance_mm() > 0.0 && std::isfinite(camera.focus_distance_mm()) ? 1.0 / camera.focus_distance_mm() : 0.0;
-  double shift = 0.0;
-  static constexpr std::array<PupilPoint, 1> kCentre{{{0.0, 0.0}}};
-  std::array<SensorHit, 1> hit;
-  for (const PixelPoint at : {PixelPoint{0.0, 0.5 * h}, PixelPoint{w, 0.5 * h}, PixelPoint{0.5 * w, 0.0}, PixelPoint{0.5 * w, h},
-                              PixelPoint{0.0, 0.0}, PixelPoint{w, 0.0}, PixelPoint{0.0, h}, PixelPoint{w, h}}) {
-    const Tangents t = camera.frame().tangents_at(at);
-    model.map({t.x, t.y, inverse}, camera.reference_wavelength_nm(), kCentre, hit);
-    if (!(hit[0].ok || hit[0].unclipped)) continue;
-    const PixelPoint q = camera.output_pixel(hit[0].x_mm, hit[0].y_mm);
-    if (std::isfinite(q.x) && std::isfinite(q.y)) shift = std::max(shift, std::hypot(q.x - at.x, q.y - at.y));
-  }
-  return static_cast<int>(std::min(std::ceil(0.5 * max_blur_px + shift) + 2.0, kMaxMarginPx));
-}
-
 // Sources beyond a w x h frame over `margin` px each side, copies of the nearest edge pixel's parts
 // (every source of that pixel: a split pixel's two parts, a layered input's samples) at their own
 // positions.
@@ -348,7 +322,7 @@ Image render_bokeh(const Image& image, const DepthMap& depth, const RayModel& mo
   const int w = image.width, h = image.height, threads = thread_count(options);
   ScatterSources sources = render_detail::make_scatter_sources(image, depth, camera, options, threads, stats);
   if (options.split_edge_pixels) render_detail::split_mixed_pixels(sources, w, h, camera, threads, stats);
-  const int margin = frame_margin_px(model, stats.max_abs_coc_px);
+  const int margin = render_detail::frame_margin_px(model, 0.5 * stats.max_abs_coc_px);
   add_margin_sources(sources, w, h, margin);
   const DepthLayers layers = render_detail::make_depth_layers(sources, w, h, options.layer_spacing_px, options.max_layers);
   return render_sources(sources, layers, w, h, margin, model, aperture, options, stats);
@@ -368,7 +342,7 @@ Image render_bokeh(const DeepImage& deep, const RayModel& model, const Aperture&
   render_detail::DeepSources deep_sources = render_detail::make_deep_sources(deep, model.camera(), options, stats);
   stats.deep_samples = deep_sources.samples;
   stats.volume_slabs = deep_sources.volume_slabs;
-  const int margin = frame_margin_px(model, stats.max_abs_coc_px);
+  const int margin = render_detail::frame_margin_px(model, 0.5 * stats.max_abs_coc_px);
   ScatterSources sources = std::move(deep_sources.sources);
   add_margin_sources(sources, deep.width, deep.height, margin);
   const DepthLayers layers = render_detail::make_depth_layers(sources, deep.width, deep.height, deep_sources.spacing);

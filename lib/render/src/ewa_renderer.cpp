@@ -61,9 +61,6 @@ constexpr double kDiscreteNormVariance = 0.5;
 constexpr int kGridX = 33, kGridY = 19, kRings = 32, kSpokes = 16;
 constexpr double kDepthStepPx = 8.0;
 constexpr int kMaxDepthSamples = 32;
-// The margin beyond the frame: px for the centroids' shift on top of the blur's reach, and at most.
-constexpr double kMarginShiftPx = 4.0;
-constexpr int kMaxMarginPx = 256;
 // Bands of rows per thread.
 constexpr int kBandsPerThread = 4;
 
@@ -392,10 +389,12 @@ Image render_ewa(const Image& image, const DepthMap& depth, const RayModel& mode
   // pixels (as the multiview and lightfield methods' layers do), so that splats from outside the
   // frame reach in as the scene's light would: without it a lens whose centroids move inwards
   // (distortion) left the frame's last column unreached, and blur near the edge had only half its
-  // sources. The margin: how far a splat reaches (3 sigma of the L2 Gaussian: 0.9 blur diameters)
-  // and a few pixels for the centroid's shift.
-  const int margin = static_cast<int>(std::min(std::ceil(kCutoffSigmas * std::sqrt(kL2Scale / 4.0) * 0.5 * max_blur) + kMarginShiftPx,
-                                               static_cast<double>(kMaxMarginPx)));
+  // sources. The margin (frame_margin_px): how far a splat reaches (3 sigma of the L2 Gaussian: 0.9
+  // blur diameters) and the lens's shift of the frame's edges.
+  // (+2 px for the surfel's own kernel and the coarse levels' filters.) The blocks of the coarse
+  // levels start at the margin's corner: their phase against the frame changes how a fine periodic
+  // texture aliases (tests/render/ewa_test.cpp: 0.0076 at this margin, 0.0129 two pixels less).
+  const int margin = render_detail::frame_margin_px(model, kCutoffSigmas * std::sqrt(kL2Scale / 4.0) * 0.5 * max_blur) + 2;
   const int sw = w + 2 * margin, sh = h + 2 * margin;
   const PsfTable psf(model, aperture, w_min, w_max, margin, options, threads);
   std::vector<LargeVector<Node>> levels(1, LargeVector<Node>(static_cast<std::size_t>(sw) * static_cast<std::size_t>(sh)));

@@ -27,8 +27,6 @@ namespace {
 
 // Views warped together: one RayModel::map call per source for all of them.
 constexpr std::size_t kViewBatch = 6;
-// The widest margin of sources beyond the frame (px each side).
-constexpr int kMaxMarginPx = 256;
 
 
 // A source pixel as the views see it.
@@ -108,8 +106,8 @@ Image render_lightfield(const Image& image, const DepthMap& depth, const RayMode
   }
   const double wavelength = camera.reference_wavelength_nm();
 
-  // The sources: every pixel, and beyond the frame a margin of half the largest blur where the
-  // picture continues as its edge pixels (as multiview's layers do): without them a view that moves
+  // The sources: every pixel, and beyond the frame a margin of half the largest blur and the lens's
+  // shift of the frame's edges (frame_margin_px) where the picture continues as its edge pixels (as multiview's layers do): without them a view that moves
   // the picture inwards leaves the frame's edge pixels holes, and an object the frame cuts fell off
   // over its last pixels (a disc cut by the right edge: 0.33 of full scale in the last column where
   // the truth has 0.43).
@@ -126,7 +124,7 @@ Image render_lightfield(const Image& image, const DepthMap& depth, const RayMode
     }
   }
   stats.clamped_depths = clamped;
-  const int margin = static_cast<int>(std::min(std::ceil(0.5 * max_coc_px) + 2.0, static_cast<double>(kMaxMarginPx)));
+  const int margin = render_detail::frame_margin_px(model, 0.5 * max_coc_px);
   const int sw = w + 2 * margin, sh = h + 2 * margin;
   const std::size_t n_sources = static_cast<std::size_t>(sw) * static_cast<std::size_t>(sh);
   // The picture's pixel a source stands for (clamped to the frame).

@@ -15,6 +15,26 @@ constexpr double kNearestObjectMm = 1.0;
 constexpr int kClampBisections = 60;
 }  // namespace
 
+int frame_margin_px(const RayModel& model, double reach_px) {
+  constexpr double kMaxFrameMarginPx = 256.0, kTentPx = 2.0;
+  const Camera& camera = model.camera();
+  const double w = camera.frame().width_px(), h = camera.frame().height_px();
+  const double inverse = inverse_per_mm(camera.focus_distance_mm());
+  double shift = 0.0;
+  static constexpr std::array<PupilPoint, 1> kCentre{{{0.0, 0.0}}};
+  std::array<SensorHit, 1> hit;
+  for (const PixelPoint at : {PixelPoint{0.0, 0.5 * h}, PixelPoint{w, 0.5 * h}, PixelPoint{0.5 * w, 0.0}, PixelPoint{0.5 * w, h},
+                              PixelPoint{0.0, 0.0}, PixelPoint{w, 0.0}, PixelPoint{0.0, h}, PixelPoint{w, h}}) {
+    const Tangents t = camera.frame().tangents_at(at);
+    model.map({t.x, t.y, inverse}, camera.reference_wavelength_nm(), kCentre, hit);
+    if (!(hit[0].ok || hit[0].unclipped)) continue;
+    const PixelPoint q = camera.output_pixel(hit[0].x_mm, hit[0].y_mm);
+    if (std::isfinite(q.x) && std::isfinite(q.y)) shift = std::max(shift, std::hypot(q.x - at.x, q.y - at.y));
+  }
+  // (A shift of rounding size, a thin lens's, is none.)
+  return static_cast<int>(std::min(std::ceil(std::max(0.0, reach_px + shift - 1e-6)) + kTentPx, kMaxFrameMarginPx));
+}
+
 double clamp_inverse_depth(const Camera& camera, double w, double max_blur_px, std::size_t& clamped) {
   const double nearest_mm = std::max(camera.z_perspective_mm(), 0.0) + kNearestObjectMm;
   if (w > 1.0 / nearest_mm) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "lensmith/camera/camera.h"
+#include "lensmith/camera/ray_model.h"
 #include "lensmith/core/huge_page_allocator.h"
 #include "layer_spacing.h"
 #include "lensmith/render/bokeh_renderer.h"
@@ -39,6 +40,15 @@ using ScatterSources = LargeVector<ScatterSource>;
 inline PixelPoint source_centre(const ScatterSource& s) {
   return {s.x + 0.5 + static_cast<double>(s.offset_x_px), s.y + 0.5 + static_cast<double>(s.offset_y_px)};
 }
+
+// The margin beyond the frame where a method continues the picture as its edge pixels, px each
+// side, so that the scene beyond the frame sends its light in: how far a point's light reaches from
+// where it is (`reach_px`), plus how far the lens moves the frame's edges from the pinhole's
+// (distortion, focus breathing: the chief rays at the edges' midpoints and corners, reference
+// wavelength, focus distance), plus the 2 px tent; at most 256 px. Without the lens's shift, where
+// the Canon 35 mm's distortion moves the edges 4.4 px inwards at 640 px, the last columns were
+// covered only by inner points' blur (scatter: renormalised, their colour drifted to blue).
+int frame_margin_px(const RayModel& model, double reach_px);
 
 // Inverse depth (1/mm) clamped to 1 mm in front of the lens and to `max_blur_px`; `clamped` counts
 // the changed ones.

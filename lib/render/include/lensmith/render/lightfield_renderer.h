@@ -23,7 +23,8 @@
 //     (disocclusions, the frame's edge) are left out of that pixel's average, as the paper
 //     discards invalid rays. A pixel no view reaches keeps its input colour (counted).
 //   - Beyond the frame the picture continues as its edge pixels (as the multiview method's layers),
-//     over a margin of half the largest blur: views that move the picture inwards would otherwise
+//     over a margin of half the largest blur and the lens's shift of the frame's edges (distortion):
+//     views that move the picture inwards would otherwise
 //     leave the frame's edge pixels holes.
 //   - Sampling (sec. 4.2): Halton points over the pupil (bases 2 and 3: radius^2 and angle, uniform
 //     in area), as the paper's jittered camera positions; a bladed iris weights each point by its
