@@ -9,6 +9,7 @@
 #include "lensmith/prescription/lens_library.h"
 #include "lensmith/render/bokeh_renderer.h"
 #include "lensmith/render/ewa_renderer.h"
+#include "lensmith/render/gather_renderer.h"
 #include "lensmith/render/lightfield_renderer.h"
 
 using namespace lensmith;
@@ -111,6 +112,29 @@ void run_ewa(benchmark::State& state, RayModelKind kind) {
                                                   benchmark::Counter::kIsIterationInvariantRate);
 }
 
+// Jimenez's half-resolution gather on the same scene: a fixed number of taps per pixel (49 or 81),
+// so its cost should not grow with the blur, as in the real-time engines it comes from.
+void run_gather(benchmark::State& state, RayModelKind kind) {
+  const double blur = static_cast<double>(state.range(0));
+  const BenchScene scene = make_scene(blur);
+  const auto model = bench_model(kind);
+  GatherOptions options;
+  options.threads = static_cast<int>(state.range(1));
+  options.rings = static_cast<int>(state.range(2));
+  for (auto _ : state) {
+    Image out = render_gather(scene.image, scene.depth, *model, Aperture::circular(), options);
+    benchmark::DoNotOptimize(out.data.data());
+  }
+  state.counters["Mpixel/s"] = benchmark::Counter(static_cast<double>(kWidth) * kHeight * 1e-6,
+                                                  benchmark::Counter::kIsIterationInvariantRate);
+}
+
+void gather_args(benchmark::internal::Benchmark* b) {
+  for (int blur : {4, 16, 48, 128}) b->Args({blur, 2, 3});
+  b->Args({48, 2, 4});
+  b->ArgNames({"blur_px", "threads", "rings"})->Unit(benchmark::kSecond)->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true)->UseRealTime();
+}
+
 void ewa_args(benchmark::internal::Benchmark* b) {
   for (int blur : {4, 16, 48, 128}) b->Args({blur, 2, 1});
   for (int blur : {4, 16, 48}) b->Args({blur, 2, 0});
@@ -139,5 +163,7 @@ BENCHMARK_CAPTURE(run_lightfield, thin, RayModelKind::Thin)->Apply(lightfield_ar
 BENCHMARK_CAPTURE(run_lightfield, seidel, RayModelKind::Seidel)->Apply(lightfield_args);
 BENCHMARK_CAPTURE(run_ewa, thin, RayModelKind::Thin)->Apply(ewa_args);
 BENCHMARK_CAPTURE(run_ewa, seidel, RayModelKind::Seidel)->Apply(ewa_args);
+BENCHMARK_CAPTURE(run_gather, thin, RayModelKind::Thin)->Apply(gather_args);
+BENCHMARK_CAPTURE(run_gather, seidel, RayModelKind::Seidel)->Apply(gather_args);
 
 BENCHMARK_MAIN();

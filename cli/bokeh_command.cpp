@@ -22,6 +22,9 @@
 #include "lensmith/render/deep_image.h"
 #include "lensmith/render/image_io.h"
 #include "lensmith/render/ewa_renderer.h"
+#include "lensmith/render/gather_renderer.h"
+#include "lensmith/scene/lens_render.h"
+#include "lensmith/scene/scene_json.h"
 #include "lensmith/render/lightfield_renderer.h"
 #include "lensmith/render/multiview_renderer.h"
 
@@ -123,13 +126,26 @@ void write_bokeh_output(Image out, OutputMetadata& meta, const BokehCommandOptio
 
 int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   const auto started = std::chrono::steady_clock::now();
-  const bool multiview = o.method == "multiview", lightfield = o.method == "lightfield", ewa = o.method == "ewa";
+  const bool multiview = o.method == "multiview", lightfield = o.method == "lightfield", ewa = o.method == "ewa", gather = o.method == "gather";
   if (o.method != "scatter" && !o.scatter_options.empty()) {
     throw UsageError(o.scatter_options.front() + " is an option of --method scatter, not of --method " + o.method);
   }
   if (!multiview && !o.multiview_options.empty()) throw UsageError(o.multiview_options.front() + " is an option of --method multiview");
   if (!lightfield && !o.lightfield_options.empty()) throw UsageError(o.lightfield_options.front() + " is an option of --method lightfield");
   if (!ewa && !o.ewa_options.empty()) throw UsageError(o.ewa_options.front() + " is an option of --method ewa");
+  if (!gather && o.hidden == "trace") throw UsageError("--hidden trace is for --method gather (Tan et al.'s hybrid), with --scene FILE");
+  if (!gather && !o.gather_options.empty()) throw UsageError(o.gather_options.front() + " is an option of --method gather");
+  // --hidden: scatter's extend or stretch, gather's trace (Tan et al.'s hybrid, which needs the scene).
+  const bool traced = gather && o.hidden == "trace";
+  if (gather && o.hidden != "trace" && o.hidden != "extend") {
+    throw UsageError("--hidden " + o.hidden + " is for --method scatter; --method gather takes --hidden trace (with --scene FILE)");
+  }
+  if (traced && o.scene.empty()) {
+    throw UsageError("--hidden trace needs --scene FILE: the analytic scene (lensmith-scene JSON) that the picture is the pinhole render of");
+  }
+  for (const std::string& name : o.gather_options) {
+    if (!traced && (name == "--scene" || name == "--trace-rays")) throw UsageError(name + " is for --method gather --hidden trace");
+  }
   // Inputs.
   const std::filesystem::path output = o.output;
   const DepthSource depth_source = DepthSource::parse(o.depth.empty() ? o.image : o.depth);
@@ -367,6 +383,50 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
          << format_rounded(cam->reference_wavelength_nm(), 4) << " nm: spectral colour is not implemented for ewa), "
          << format_rounded(static_cast<double>(stats.pixel_writes) / (static_cast<double>(out.width) * out.height), 3)
          << " pixel writes per pixel, " << stats.unfilled_pixels << " pixels no splat reached (input colour kept)";
+    report_written(what.str(), global);
+    return kExitOk;
+  }
+  if (gather) {
+    if (layered) throw UsageError("--method gather gathers one surface per pixel: a deep (layered) input is not implemented; use --method multiview or scatter");
+    if (alpha) throw UsageError("--method gather: a picture with transparent pixels (alpha) is not implemented; use --method scatter or multiview");
+    GatherOptions options;
+    options.threads = o.threads;
+    options.vignetting = !o.no_vignetting;
+    options.rings = o.rings;
+    options.median = !o.no_median;
+    options.trace_rays = o.trace_rays;
+    std::optional<Scene> scene;
+    if (traced) {
+      scene = load_scene(o.scene);
+      options.trace = [&](std::vector<GatherTraceRequest>& requests) {
+        LensRenderOptions rays;
+        rays.threads = o.threads;
+        rays.spectral = !o.no_spectral;
+        rays.spectral_samples = o.spectral_samples;
+        trace_regions(*scene, *cam, requests, rays);
+      };
+    }
+    ProgressBar bar("bokeh", !global.quiet);
+    options.progress = [&bar](double f) { bar.update(f); };
+    GatherStatistics stats;
+    const auto render_started = std::chrono::steady_clock::now();
+    const Image out = render_gather(*flat, depth, *model, aperture, options, &stats);
+    const double render_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - render_started).count();
+    bar.finish();
+    OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture);
+    meta.extra.insert(meta.extra.end(), {{"rings", std::to_string(options.rings)}, {"median", options.median ? "on" : "off"},
+                                         {"hidden_surfaces", traced ? "trace " + o.scene : std::string("none")}});
+    write_bokeh_output(out, meta, o, depth, other);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    std::ostringstream what;
+    what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds
+         << " s (rendering " << render_seconds << " s)\n  " << lens_name << ", model " << to_string(kind) << ", method gather, f/"
+         << format_rounded(cam->f_number(), 3) << ", focus " << format_rounded(camera.focus_distance_m, 4) << " m, " << aperture.to_string()
+         << " aperture\n  " << stats.half_width << " x " << stats.half_height << " half resolution, " << stats.taps << " taps ("
+         << options.rings << " rings), largest kernel radius " << format_rounded(stats.max_kernel_radius_px, 3) << " px, "
+         << stats.gathered_pixels << " half-resolution pixels gathered, at " << format_rounded(cam->reference_wavelength_nm(), 4)
+         << " nm (spectral colour is not implemented for gather)";
+    if (traced) what << "; " << stats.traced_pixels << " half-resolution pixels traced into " << o.scene << " with " << stats.traced_rays << " rays";
     report_written(what.str(), global);
     return kExitOk;
   }

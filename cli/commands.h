@@ -167,7 +167,7 @@ struct BokehCommandOptions {
   int subrows = 4;                           // --subrows
   double max_blur_px = 1000.0;               // --max-blur
   int threads = 0;                           // --threads (0 = all)
-  std::string method = "scatter";            // --method scatter|multiview|lightfield
+  std::string method = "scatter";            // --method scatter|multiview|lightfield|ewa|gather
   int samples = 32;                          // --samples (multiview)
   int layers = 8;                            // --layers (multiview)
   int ray_grid_px = 16;                      // --ray-grid (multiview)
@@ -180,6 +180,11 @@ struct BokehCommandOptions {
   bool circular_splats = false;              // --circular-splats (ewa)
   bool no_level_of_detail = false;           // --no-level-of-detail (ewa)
   std::vector<std::string> ewa_options;         // ewa-only options given
+  int rings = 3;                             // --rings (gather): 3 (Jimenez, 48 taps) or 4 (Tan et al., 80)
+  bool no_median = false;                    // --no-median (gather)
+  std::string scene;                         // --scene FILE (gather --hidden trace): the analytic scene the picture shows
+  int trace_rays = 256;                       // --trace-rays (gather --hidden trace)
+  std::vector<std::string> gather_options;      // gather-only options given
 };
 int run_bokeh(const BokehCommandOptions& options, const GlobalOptions& global);
 
@@ -200,9 +205,10 @@ struct ValidateCommandOptions {
   int image_height_px = 180;
   int image_spp = 64;                             // --image-spp: ground-truth samples per pixel
   int image_layers = 4;                           // --image-layers: the scenes also as layered input (0: flat only)
-  std::vector<std::string> image_methods{"scatter", "multiview", "lightfield", "ewa"};  // --image-methods
+  std::vector<std::string> image_methods{"scatter", "multiview", "lightfield", "ewa", "gather"};  // --image-methods
   int image_samples = 32;                         // --image-samples: multiview lens rays per pixel
   int image_views = 36;                           // --image-views: lightfield views
+  int image_trace_rays = 256;                     // --image-trace-rays: gather's hybrid, rays per half-resolution pixel
   std::optional<double> min_edge_psnr_db;         // --min-edge-psnr: fail when a model's edge-band PSNR is lower
   std::string fit;                                // --fit FILE: the poly model's fit (default: fitted in the run)
 };

@@ -285,8 +285,10 @@ int main(int argc, char** argv) {
                         "scatter (default: every pixel scattered through the ray model, depth-layered) | multiview (Lee et al. 2009: "
                         "per pixel --samples lens rays traced through the layered scene; for deep input) | lightfield (Yu et al. "
                         "2010: the picture warped to --views pupil points through the ray model, nearest wins, views averaged) | ewa "
-                        "(Krivanek et al. 2003: every pixel a Gaussian splat widened by the lens's blur, level of detail, A-buffer)")
-      ->check(CLI::IsMember({"scatter", "multiview", "lightfield", "ewa"}));
+                        "(Krivanek et al. 2003: every pixel a Gaussian splat widened by the lens's blur, level of detail, A-buffer) | gather (Jimenez 2014: "
+                        "half-resolution ring gather over tiles of nearest depth and largest blur, foreground over background; with "
+                        "--hidden trace --scene FILE, Tan et al. 2022's rays traced into the scene where a ray mask says)")
+      ->check(CLI::IsMember({"scatter", "multiview", "lightfield", "ewa", "gather"}));
   CLI::Option* bokeh_samples =
       bokeh_cmd->add_option("--samples", bokeh.samples, "multiview: lens rays per output pixel (1-4096, default 32)")->check(range(1, 4096));
   CLI::Option* bokeh_layers =
@@ -308,9 +310,22 @@ int main(int argc, char** argv) {
       "ewa: circular Gaussians of the circle of confusion at the pinhole position (Krivanek et al.'s kernel), not the lens's PSF covariance, centroid and vignetting");
   CLI::Option* bokeh_lod = bokeh_cmd->add_flag(
       "--no-level-of-detail", bokeh.no_level_of_detail, "ewa: every pixel its own splat (no coarser surfels where the blur is large: slower as blur grows)");
+  CLI::Option* bokeh_rings =
+      bokeh_cmd->add_option("--rings", bokeh.rings, "gather: rings of taps, 3 (default: Jimenez's 48 taps) or 4 (Tan et al.'s 80)")
+          ->check(CLI::IsMember({3, 4}));
+  CLI::Option* bokeh_median = bokeh_cmd->add_flag("--no-median", bokeh.no_median, "gather: leave out the 3 x 3 median postfilter");
+  CLI::Option* bokeh_scene = bokeh_cmd->add_option("--scene", bokeh.scene,
+                                                   "gather --hidden trace: the lensmith-scene JSON file the picture is the pinhole render of")
+                                 ->check(CLI::ExistingFile);
+  CLI::Option* bokeh_trace_rays =
+      bokeh_cmd->add_option("--trace-rays", bokeh.trace_rays, "gather --hidden trace: most rays per half-resolution pixel, a quarter through each of its pixels (1-4096, default 256)")
+          ->check(range(1, 4096));
   std::vector<CLI::Option*> bokeh_scatter_only;
-  bokeh_scatter_only.push_back(bokeh_cmd->add_option("--hidden", bokeh.hidden, "Background hidden behind foreground edges: extend (default) | stretch")
-      ->check(CLI::IsMember({"extend", "stretch"})));
+  CLI::Option* bokeh_hidden =
+      bokeh_cmd->add_option("--hidden", bokeh.hidden,
+                            "Background hidden behind foreground edges: extend (default) | stretch (scatter); trace (gather: Tan et al.'s "
+                            "hybrid, exact rays into --scene where the picture cannot know)")
+          ->check(CLI::IsMember({"extend", "stretch", "trace"}));
   bokeh_scatter_only.push_back(bokeh_cmd->add_option("--edge-pixels", bokeh.edge_pixels,
                         "Anti-aliased depth-edge pixels: split (default: between their two surfaces by colour) | keep (at their depth)")
       ->check(CLI::IsMember({"split", "keep"})));
@@ -361,9 +376,12 @@ int main(int argc, char** argv) {
                             "Also score each model on the scene as layered (deep) input of this many peeled layers (default 4; 0: the flat picture only)")
       ->check(range(0, 16));
   validate_cmd->add_option("--image-methods", validate.image_methods,
-                           "Depth-of-field methods scored on each scene: scatter, multiview, lightfield, ewa (default all four)")
-      ->check(CLI::IsMember({"scatter", "multiview", "lightfield", "ewa"}));
+                           "Depth-of-field methods scored on each scene: scatter, multiview, lightfield, ewa, gather (default all five)")
+      ->check(CLI::IsMember({"scatter", "multiview", "lightfield", "ewa", "gather"}));
   validate_cmd->add_option("--image-views", validate.image_views, "Views of the lightfield method (default 36)")->check(range(1, 1024));
+  validate_cmd->add_option("--image-trace-rays", validate.image_trace_rays,
+                           "Most rays per half-resolution pixel of the gather method's hybrid run (Tan et al.; default 256)")
+      ->check(range(1, 4096));
   validate_cmd->add_option("--image-samples", validate.image_samples, "Lens rays per pixel of the multiview method (default 32)")
       ->check(range(1, 4096));
   validate_cmd->add_option("--image-spp", validate.image_spp, "Samples per pixel of the ground truth (default 64)")
@@ -515,6 +533,11 @@ int main(int argc, char** argv) {
       for (CLI::Option* option : {bokeh_circular, bokeh_lod}) {
         if (option->count() > 0) bokeh.ewa_options.push_back(option->get_name());
       }
+      for (CLI::Option* option : {bokeh_rings, bokeh_median, bokeh_scene, bokeh_trace_rays}) {
+        if (option->count() > 0) bokeh.gather_options.push_back(option->get_name());
+      }
+      // --hidden is scatter's (extend, stretch) and gather's (trace).
+      if (bokeh_hidden->count() > 0 && bokeh.method != "gather") bokeh.scatter_options.push_back(bokeh_hidden->get_name());
       return run_bokeh(bokeh, global);
     }
     if (*validate_cmd) return run_validate(validate, global);

@@ -74,17 +74,20 @@ int run_validate(const ValidateCommandOptions& o, const GlobalOptions& global) {
     image_options.methods = o.image_methods;
     image_options.multiview_samples = o.image_samples;
     image_options.lightfield_views = o.image_views;
+    image_options.gather_trace_rays = o.image_trace_rays;
     image_options.picture_dir = dir;
     images = validate_images(lens, camera_options, image_options);
     report << "`lensmith bokeh` with each model and method (scatter; multiview with " << o.image_samples
-           << " lens rays per pixel; lightfield with " << o.image_views << " views and ewa, flat input only) on the pinhole render of each scene"
+           << " lens rays per pixel; lightfield with " << o.image_views << " views and ewa, flat input only; gather on the flat input and as "
+           << "Tan et al.'s hybrid, with up to " << o.image_trace_rays
+           << " exact rays per half-resolution pixel traced into the scene where its ray mask says, input `flat + traced rays`) on the pinhole render of each scene"
            << (o.image_layers > 0 ? " (flat: picture and depth) and on its " + std::to_string(o.image_layers) +
                                         " depth-peeled layers as a deep image (layered)"
                                   : std::string())
            << ", against the scene rendered through the lens by the exact tracer (" << o.image_spp << " samples per pixel), "
            << o.image_width_px << " x " << o.image_height_px << " px; PSNR and SSIM on x/(1+x) values, "
            << "over the frame and within " << image_options.band_radius_px << " px of depth edges. Pictures: "
-           << "`<scene>-truth.png`, `<scene>-<model>[-<method>][-layered].png` and its `-error.png`; time: the render alone.\n\n"
+           << "`<scene>-truth.png`, `<scene>-<model>[-<method>][-layered|-traced].png` and its `-error.png`; time: the render alone.\n\n"
            << images.to_markdown();
   }
   const std::string text = report.str();

@@ -404,3 +404,59 @@ TEST_CASE("lensmith bokeh --method ewa splats the picture through the lens's blu
   CHECK(layered.err.find("not implemented") != std::string::npos);
   CHECK_FALSE(fs::exists(scratch("ewa-deep.exr")));
 }
+
+TEST_CASE("lensmith bokeh --method gather gathers at half resolution, traces holes into a known scene, and refuses what it cannot do",
+          "[cli][bokeh][gather]") {
+  const fs::path out = scratch("gather-out.exr");
+  const auto r = run_lensmith("bokeh --image " + kScene + " --lens sasian-triplet --focus 3 --method gather --threads 2 -o " + out.string());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.err.find("method gather") != std::string::npos);
+  CHECK(r.err.find("half resolution, 49 taps (3 rings)") != std::string::npos);
+  CHECK(r.err.find("spectral colour is not implemented") != std::string::npos);
+  const auto meta = lensmith::read_image_metadata(out);
+  CHECK(value_of(meta, "lensmith:method") == "gather");
+  CHECK(value_of(meta, "lensmith:rings") == "3");
+  CHECK(value_of(meta, "lensmith:hidden_surfaces") == "none");
+  const std::string base = "bokeh --image " + kScene + " --lens sasian-triplet --focus 3 -o " + scratch("gather.exr").string() + " ";
+  const auto tan = run_lensmith(base + "--method gather --rings 4 --no-median");
+  CHECK(tan.exit_code == 0);
+  CHECK(tan.err.find("81 taps (4 rings)") != std::string::npos);
+  // Tan et al.'s hybrid: the pinhole render of an analytic scene, and the scene to trace.
+  const std::string scene = std::string(LENSMITH_SOURCE_DIR) + "/examples/scenes/occluder.json";
+  const fs::path pinhole = scratch("gather-occluder.exr"), depth = scratch("gather-occluder-z.exr");
+  REQUIRE(run_lensmith("scene render " + scene + " --pinhole --width 160 --height 90 --depth " + depth.string() + " -o " + pinhole.string())
+              .exit_code == 0);
+  const fs::path traced = scratch("gather-traced.exr");
+  const auto hybrid = run_lensmith("bokeh --image " + pinhole.string() + " --depth " + depth.string() +
+                                   " --lens sasian-triplet --focus 1 --fstop 2 --method gather --hidden trace --scene " + scene +
+                                   " --trace-rays 32 -o " + traced.string());
+  INFO(hybrid.err);
+  REQUIRE(hybrid.exit_code == 0);
+  CHECK(hybrid.err.find("pixels traced into") != std::string::npos);
+  CHECK(value_of(lensmith::read_image_metadata(traced), "lensmith:hidden_surfaces") == "trace " + scene);
+  // What it refuses, each with the reason (exit 2) and no output.
+  const auto no_scene = run_lensmith(base + "--method gather --hidden trace");
+  CHECK(no_scene.exit_code == 2);
+  CHECK(no_scene.err.find("--hidden trace needs --scene FILE") != std::string::npos);
+  const auto stretch = run_lensmith(base + "--method gather --hidden stretch");
+  CHECK(stretch.exit_code == 2);
+  CHECK(stretch.err.find("--method gather takes --hidden trace") != std::string::npos);
+  const auto scatter_trace = run_lensmith(base + "--hidden trace --scene " + scene);
+  CHECK(scatter_trace.exit_code == 2);
+  CHECK(scatter_trace.err.find("--hidden trace is for --method gather") != std::string::npos);
+  const auto rings = run_lensmith(base + "--rings 4");
+  CHECK(rings.exit_code == 2);
+  CHECK(rings.err.find("--rings is an option of --method gather") != std::string::npos);
+  const auto five = run_lensmith(base + "--method gather --rings 5");
+  CHECK(five.exit_code == 2);
+  const auto rays_alone = run_lensmith(base + "--method gather --trace-rays 8");
+  CHECK(rays_alone.exit_code == 2);
+  CHECK(rays_alone.err.find("--trace-rays is for --method gather --hidden trace") != std::string::npos);
+  const fs::path deep = write_deep_element("element-deep-gather.exr");
+  const auto layered = run_lensmith("bokeh --image " + deep.string() + " --thin-lens --focal-length 50 --fstop 1.4 --focus 0.5 --method gather -o " +
+                                    scratch("gather-deep.exr").string());
+  CHECK(layered.exit_code == 2);
+  CHECK(layered.err.find("not implemented") != std::string::npos);
+  CHECK_FALSE(fs::exists(scratch("gather-deep.exr")));
+}

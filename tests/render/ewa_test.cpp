@@ -21,21 +21,6 @@ using namespace lensmith;
 
 using test::thin_camera;
 
-namespace {
-
-// The planar depth (m) in front of the focus plane at `focus_m` where the test thin lens blurs a
-// point to `blur_px` (its circle of confusion's diameter, output px).
-double depth_for_blur(const Camera& camera, double focus_m, double blur_px) {
-  double near = 0.05, far = focus_m;  // blur grows as the depth nears the lens
-  for (int k = 0; k < 100; ++k) {
-    const double mid = 0.5 * (near + far);
-    (std::abs(camera.signed_coc_px(inverse_depth_per_mm(mid))) > blur_px ? near : far) = mid;
-  }
-  return 0.5 * (near + far);
-}
-
-}  // namespace
-
 TEST_CASE("EWA: a textured plane in focus comes back nearly as it went in", "[render][ewa]") {
   const int w = 48, h = 32;
   const Camera camera = thin_camera(w, h, 2.0);
@@ -61,7 +46,7 @@ TEST_CASE("EWA: one bright pixel on a defocused plane keeps its light and spread
           "[render][ewa]") {
   const int w = 101, h = 101, cx = 50, cy = 50;
   const Camera camera = thin_camera(w, h, 3.0);
-  const double z_m = depth_for_blur(camera, 3.0, 16.0);
+  const double z_m = test::near_depth_for_blur(camera, 3.0, 16.0);
   const double radius = 0.5 * std::abs(camera.signed_coc_px(inverse_depth_per_mm(z_m)));
   const auto model = make_ray_model(RayModelKind::Thin, camera);
   Image image(w, h, 3, 0.0f);
@@ -115,7 +100,7 @@ TEST_CASE("EWA: the level of detail keeps the work per pixel nearly flat as the 
     o.threads = 2;
     o.level_of_detail = lod;
     EwaStatistics stats;
-    const DepthMap depth(w, h, static_cast<float>(depth_for_blur(camera, 3.0, blur_px)));
+    const DepthMap depth(w, h, static_cast<float>(test::near_depth_for_blur(camera, 3.0, blur_px)));
     const Image out = render_ewa(image, depth, *model, Aperture::circular(), o, &stats);
     if (picture) *picture = out;
     return static_cast<double>(stats.pixel_writes) / (w * h);

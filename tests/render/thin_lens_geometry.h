@@ -22,6 +22,17 @@ inline Camera thin_camera(int w, int h, double focus_m) {
   return Camera::thin_lens(kThinFocalLengthMm, o, w, h);
 }
 
+// The planar depth (m) in front of the focus plane at `focus_m` where `camera` blurs a point to
+// `blur_px` (its circle of confusion's diameter, output px), by bisection.
+inline double near_depth_for_blur(const Camera& camera, double focus_m, double blur_px) {
+  double near = 0.05, far = focus_m;  // blur grows as the depth nears the lens
+  for (int k = 0; k < 100; ++k) {
+    const double mid = 0.5 * (near + far);
+    (std::abs(camera.signed_coc_px(inverse_depth_per_mm(mid))) > blur_px ? near : far) = mid;
+  }
+  return 0.5 * (near + far);
+}
+
 // Share of the unit disc left of the line x = c.
 inline double disc_share_left_of(double c) {
   if (c <= -1.0) return 0.0;

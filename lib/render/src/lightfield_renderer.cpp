@@ -79,14 +79,7 @@ Image render_lightfield(const Image& image, const DepthMap& depth, const RayMode
   options.validate();
   const Camera& camera = model.camera();
   const int w = camera.frame().width_px(), h = camera.frame().height_px();
-  if (image.width != w || image.height != h || image.channels != 3 || depth.width != w || depth.height != h) {
-    throw OptionsError("render_lightfield: the picture " + image.to_string() + " and its depth (" + std::to_string(depth.width) +
-                       " x " + std::to_string(depth.height) + ") must both be the camera's " + std::to_string(w) + " x " +
-                       std::to_string(h) + " px, the picture with 3 channels");
-  }
-  if (!aperture.is_uniform_convex()) {
-    throw OptionsError("--method lightfield: an aperture picture (mask) is not implemented; use a circular or bladed iris");
-  }
+  render_detail::check_flat_input(image, depth, camera, aperture, "render_lightfield", "lightfield");
   const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
   const auto n_views = static_cast<std::size_t>(options.views);
   const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);

@@ -52,6 +52,43 @@ double clamp_inverse_depth(const Camera& camera, double w, double max_blur_px, s
   return in;
 }
 
+void check_flat_input(const Image& image, const DepthMap& depth, const Camera& camera, const Aperture& aperture,
+                      const std::string& function, const std::string& method) {
+  const int w = camera.frame().width_px(), h = camera.frame().height_px();
+  if (image.width != w || image.height != h || image.channels != 3 || depth.width != w || depth.height != h) {
+    throw OptionsError(function + ": the picture " + image.to_string() + " and its depth (" + std::to_string(depth.width) + " x " +
+                       std::to_string(depth.height) + ") must both be the camera's " + std::to_string(w) + " x " + std::to_string(h) +
+                       " px, the picture with 3 channels");
+  }
+  if (!aperture.is_uniform_convex()) {
+    throw OptionsError("--method " + method + ": an aperture picture (mask) is not implemented; use a circular or bladed iris");
+  }
+}
+
+ClampedDepths clamped_inverse_depths(const Camera& camera, const DepthMap& depth, double max_blur_px, int threads) {
+  const int w = depth.width, h = depth.height;
+  ClampedDepths out;
+  out.inverse.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+  std::size_t clamped = 0;
+  double w_min = kInfinity, w_max = -kInfinity, max_blur = 0.0;
+#pragma omp parallel for schedule(static) num_threads(threads) reduction(+ : clamped) reduction(min : w_min) reduction(max : w_max, max_blur)
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+      const double inverse = clamp_inverse_depth(camera, inverse_depth_per_mm(depth.at(x, y)), max_blur_px, clamped);
+      out.inverse[p] = inverse;
+      w_min = std::min(w_min, inverse);
+      w_max = std::max(w_max, inverse);
+      max_blur = std::max(max_blur, std::abs(camera.signed_coc_px(inverse)));
+    }
+  }
+  out.w_min = w_min;
+  out.w_max = w_max;
+  out.max_blur_px = max_blur;
+  out.clamped = clamped;
+  return out;
+}
+
 ScatterSources make_scatter_sources(const Image& image, const DepthMap& depth, const Camera& camera,
                                                 const BokehOptions& options, int threads, BokehStatistics& stats) {
   const int w = image.width, h = image.height;

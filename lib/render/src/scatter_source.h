@@ -6,8 +6,10 @@
 
 #include <array>
 #include <cstddef>
+#include <string>
 #include <vector>
 
+#include "lensmith/camera/aperture.h"
 #include "lensmith/camera/camera.h"
 #include "lensmith/camera/ray_model.h"
 #include "lensmith/core/huge_page_allocator.h"
@@ -53,6 +55,21 @@ int frame_margin_px(const RayModel& model, double reach_px);
 // Inverse depth (1/mm) clamped to 1 mm in front of the lens and to `max_blur_px`; `clamped` counts
 // the changed ones.
 double clamp_inverse_depth(const Camera& camera, double inverse_depth_per_mm, double max_blur_px, std::size_t& clamped);
+
+// The one-surface-per-pixel methods' inputs checked: the picture (3 channels) and its depth both the
+// camera's size, and an aperture they can draw (no mask). OptionsError naming `function` and
+// `method` otherwise.
+void check_flat_input(const Image& image, const DepthMap& depth, const Camera& camera, const Aperture& aperture,
+                      const std::string& function, const std::string& method);
+
+// Every pixel's inverse depth (1/mm, row-major) clamped as above, their range, the largest blur
+// diameter among them (px) and how many were clamped: the one-surface-per-pixel methods' input.
+struct ClampedDepths {
+  std::vector<double> inverse;
+  double w_min = 0.0, w_max = 0.0, max_blur_px = 0.0;
+  std::size_t clamped = 0;
+};
+ClampedDepths clamped_inverse_depths(const Camera& camera, const DepthMap& depth, double max_blur_px, int threads);
 
 // Sources of a layered picture and the layers they were merged for. Per pixel, front to back: a
 // volume is cut into slabs of at most kVolumeSlabPx of blur each (alpha and colour by the OpenEXR

@@ -200,12 +200,11 @@ std::string LensRender::to_string() const {
          format_number(estimated_relative_error) + ", " + rays.to_string() + ")";
 }
 
-LensRender render_through_lens(const Scene& scene, const Camera& camera, const LensRenderOptions& options) {
-  options.validate();
-  scene.validate();
-  if (camera.is_thin_lens()) {
-    throw OptionsError("render_through_lens needs a camera made from a prescription; use render_through_thin_lens");
-  }
+namespace {
+
+// Calls use(sample) with the sampler of render_through_lens: sample(x_px, y_px, node_u, rng).
+template <class Use>
+auto with_lens_sampler(const Scene& scene, const Camera& camera, const LensRenderOptions& options, Use&& use) {
   // The wavelengths sampled: the quadrature's nodes, or the reference wavelength.
   std::optional<SpectralQuadrature> quadrature;
   std::vector<double> wavelengths;
@@ -250,15 +249,12 @@ LensRender render_through_lens(const Scene& scene, const Camera& camera, const L
     if (!spectrum) return {s.ray.weight * radiance, SampleFate::ReachedScene};
     return {(s.ray.weight * spectrum->spectrum_value(radiance, wavelengths[node])) * rgb_weights[node], SampleFate::ReachedScene};
   };
-  return render_progressive(camera, options, sample);
+  return use(sample);
 }
 
-LensRender render_through_thin_lens(const Scene& scene, const Camera& camera, const LensRenderOptions& options) {
-  options.validate();
-  scene.validate();
-  if (!camera.is_thin_lens()) {
-    throw OptionsError("render_through_thin_lens needs a Camera::thin_lens camera; use render_through_lens for a prescription");
-  }
+// Calls use(sample) with the sampler of render_through_thin_lens.
+template <class Use>
+auto with_thin_lens_sampler(const Scene& scene, const Camera& camera, Use&& use) {
   const double lens_radius_mm = camera.first_order(camera.reference_wavelength_nm()).entrance_pupil_radius_mm;
   const double image_distance_mm = camera.z_sensor_mm();  // the thin lens sits at z = 0
   const double focus_mm = camera.focus_distance_mm();
@@ -283,7 +279,61 @@ LensRender render_through_thin_lens(const Scene& scene, const Camera& camera, co
     const std::optional<SceneHit> hit = intersect(scene, SceneRay{origin_m, direction});
     return {hit ? hit->radiance : scene.background, SampleFate::ReachedScene};
   };
-  return render_progressive(camera, options, sample);
+  return use(sample);
+}
+
+}  // namespace
+
+LensRender render_through_lens(const Scene& scene, const Camera& camera, const LensRenderOptions& options) {
+  options.validate();
+  scene.validate();
+  if (camera.is_thin_lens()) {
+    throw OptionsError("render_through_lens needs a camera made from a prescription; use render_through_thin_lens");
+  }
+  return with_lens_sampler(scene, camera, options, [&](const auto& sample) { return render_progressive(camera, options, sample); });
+}
+
+LensRender render_through_thin_lens(const Scene& scene, const Camera& camera, const LensRenderOptions& options) {
+  options.validate();
+  scene.validate();
+  if (!camera.is_thin_lens()) {
+    throw OptionsError("render_through_thin_lens needs a Camera::thin_lens camera; use render_through_lens for a prescription");
+  }
+  return with_thin_lens_sampler(scene, camera, [&](const auto& sample) { return render_progressive(camera, options, sample); });
+}
+
+void trace_regions(const Scene& scene, const Camera& camera, std::vector<GatherTraceRequest>& requests, const LensRenderOptions& options) {
+  options.validate();
+  scene.validate();
+  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  auto run = [&](const auto& sample) {
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 16)
+    for (std::size_t k = 0; k < requests.size(); ++k) {
+      GatherTraceRequest& r = requests[k];
+      Pcg32 rng(options.seed, k, 0);
+      // Stratified wavelength, as render_progressive's pixels.
+      const double offset = rng.uniform();
+      double sum[3] = {0.0, 0.0, 0.0};
+      int reached = 0;
+      for (int i = 0; i < r.rays; ++i) {
+        double node_u = (offset * r.rays + i) / r.rays;
+        if (node_u >= 1.0) node_u -= 1.0;
+        const SampleResult s = sample(r.x_px + r.size_px * rng.uniform(), r.y_px + r.size_px * rng.uniform(), node_u, rng);
+        if (s.fate != SampleFate::ReachedScene) continue;
+        ++reached;
+        for (int c = 0; c < 3; ++c) sum[c] += s.value[c];
+      }
+      // The rays the lens stops carry no light: the mean over all rays (as a pixel's estimate).
+      for (int c = 0; c < 3; ++c) r.rgb[static_cast<std::size_t>(c)] = static_cast<float>(r.rays > 0 ? sum[c] / r.rays : 0.0);
+      r.reached = reached;
+    }
+    return 0;
+  };
+  if (camera.is_thin_lens()) {
+    with_thin_lens_sampler(scene, camera, run);
+  } else {
+    with_lens_sampler(scene, camera, options, run);
+  }
 }
 
 }  // namespace lensmith

@@ -15,6 +15,7 @@
 #include "lensmith/render/deep_image.h"
 #include "lensmith/render/image_io.h"
 #include "lensmith/render/ewa_renderer.h"
+#include "lensmith/render/gather_renderer.h"
 #include "lensmith/render/lightfield_renderer.h"
 #include "lensmith/render/multiview_renderer.h"
 #include "lensmith/scene/lens_render.h"
@@ -31,12 +32,13 @@ void ImageValidationOptions::validate() const {
     throw OptionsError("layered input needs 1.." + std::to_string(kMaxPeeledLayers) + " layers (0: flat only), got " + std::to_string(layers));
   }
   for (const std::string& m : methods) {
-    if (m != "scatter" && m != "multiview" && m != "lightfield" && m != "ewa") {
-      throw OptionsError("image validation methods are scatter, multiview, lightfield and ewa, not " + m);
+    if (m != "scatter" && m != "multiview" && m != "lightfield" && m != "ewa" && m != "gather") {
+      throw OptionsError("image validation methods are scatter, multiview, lightfield, ewa and gather, not " + m);
     }
   }
   if (multiview_samples < 1 || multiview_samples > 4096) throw OptionsError("multiview samples must be 1 to 4096");
   if (lightfield_views < 1 || lightfield_views > 1024) throw OptionsError("lightfield views must be 1 to 1024");
+  if (gather_trace_rays < 1 || gather_trace_rays > 4096) throw OptionsError("gather trace rays must be 1 to 4096 per pixel");
   for (RayModelKind k : models) {
     if (k == RayModelKind::Exact || k == RayModelKind::Thin) {
       throw OptionsError("image validation scores paraxial, seidel or poly, not " + std::string(to_string(k)));
@@ -45,6 +47,9 @@ void ImageValidationOptions::validate() const {
 }
 
 namespace {
+
+// The input of gather's hybrid run (Tan et al.): the flat picture and rays into the scene.
+constexpr const char* kTracedInput = "flat + traced rays";
 
 // Pixels where hidden surfaces can show in the picture through the lens: those whose first surface
 // hides most of another (two or more samples, the first of alpha >= 0.5), widened by half the
@@ -185,17 +190,32 @@ ImageValidation validate_images(const Prescription& lens, const CameraOptions& c
       lightfield.views = options.lightfield_views;
       EwaOptions ewa;
       ewa.threads = options.threads;
+      GatherOptions gather;
+      gather.threads = options.threads;
       for (const std::string& method : options.methods) {
-        const bool lee = method == "multiview", yu = method == "lightfield", krivanek = method == "ewa";
+        const bool lee = method == "multiview", yu = method == "lightfield", krivanek = method == "ewa", jimenez = method == "gather";
         if (lee && !flat_scene) flat_scene = deep_image_from_flat(pinhole.rgb, pinhole.depth);
         for (const bool deep : {false, true}) {
-          if (deep && (!layered || yu || krivanek)) continue;  // lightfield, ewa: one surface per pixel
+          // lightfield, ewa: one surface per pixel; gather's second run is Tan et al.'s hybrid, the
+          // flat picture with rays traced into the scene where the ray mask says.
+          if (deep && (yu || krivanek || (!layered && !jimenez))) continue;
           const auto started = std::chrono::steady_clock::now();
           Image result;
           if (yu) {
             result = render_lightfield(pinhole.rgb, pinhole.depth, *model, Aperture::circular(), lightfield);
           } else if (krivanek) {
             result = render_ewa(pinhole.rgb, pinhole.depth, *model, Aperture::circular(), ewa);
+          } else if (jimenez) {
+            GatherOptions run = gather;
+            if (deep) {
+              run.trace_rays = options.gather_trace_rays;
+              run.trace = [&](std::vector<GatherTraceRequest>& requests) {
+                LensRenderOptions rays;
+                rays.threads = options.threads;
+                trace_regions(scene, camera, requests, rays);
+              };
+            }
+            result = render_gather(pinhole.rgb, pinhole.depth, *model, Aperture::circular(), run);
           } else if (lee) {
             result = render_multiview(deep ? *layered : *flat_scene, *model, Aperture::circular(), multiview).leading_channels(3);
           } else {
@@ -205,13 +225,14 @@ ImageValidation validate_images(const Prescription& lens, const CameraOptions& c
           const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
           // Both scored on the same band: the flat picture's depth edges.
           const double hidden_psnr = hidden_count > 0 ? psnr(result, truth.rgb, &hidden_region) : std::numeric_limits<double>::quiet_NaN();
-          out.entries.push_back({name, kind, method, deep ? layered_input : "flat",
+          const std::string input = !deep ? std::string("flat") : jimenez ? std::string(kTracedInput) : layered_input;
+          out.entries.push_back({name, kind, method, input,
                                  compare_images(result, truth.rgb, pinhole.depth, options.band_radius_px), hidden_psnr, seconds});
           if (!options.picture_dir.empty()) {
             const std::string method_tag = method == "scatter" ? std::string() : "-" + method;
             meta.model = std::string(to_string(kind)) + (method == "scatter" ? std::string() : ", " + method) +
-                         (deep ? ", " + layered_input : std::string());
-            const std::string stem = name + "-" + std::string(to_string(kind)) + method_tag + (deep ? "-layered" : "");
+                         (deep ? ", " + input : std::string());
+            const std::string stem = name + "-" + std::string(to_string(kind)) + method_tag + (deep ? (jimenez ? "-traced" : "-layered") : "");
             write_output_image(options.picture_dir / (stem + ".png"), result, meta);
             write_output_image(options.picture_dir / (stem + "-error.png"), error_map(result, truth.rgb), meta);
             stems.push_back(stem);

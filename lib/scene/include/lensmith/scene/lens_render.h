@@ -25,8 +25,10 @@
 #include <optional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "lensmith/camera/camera.h"
+#include "lensmith/render/gather_renderer.h"
 #include "lensmith/render/image.h"
 #include "lensmith/scene/scene.h"
 
@@ -95,5 +97,12 @@ LensRender render_through_lens(const Scene& scene, const Camera& camera, const L
 // point images to (the pinhole ray through the same output position), as pbrt's and Cycles' thin
 // lens cameras do. Every ray reaches the scene; RGB is carried as it is (no dispersion).
 LensRender render_through_thin_lens(const Scene& scene, const Camera& camera, const LensRenderOptions& options);
+
+// The rays of Tan et al.'s hybrid (render_gather's GatherTracer, `--hidden trace`): per request,
+// its rays sampled as render_through_lens (or, for a Camera::thin_lens camera,
+// render_through_thin_lens) samples a pixel's, each through a uniform point of the request's
+// square; fills in their mean radiance (a ray the lens stops adds black, as in a pixel's estimate)
+// and how many reached the scene. Uses options' seed, threads and spectral settings (not spp).
+void trace_regions(const Scene& scene, const Camera& camera, std::vector<GatherTraceRequest>& requests, const LensRenderOptions& options);
 
 }  // namespace lensmith

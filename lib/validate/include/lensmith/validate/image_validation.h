@@ -31,11 +31,15 @@ struct ImageValidationOptions {
   int layers = 4;
   // The depth-of-field methods scored, each on the flat and the layered input: "scatter"
   // (render_bokeh), "multiview" (render_multiview, `multiview_samples` lens rays per pixel) and
-  // "lightfield" (render_lightfield, `lightfield_views` views) and "ewa" (render_ewa); those two on
-  // the flat input only: they take one surface per pixel.
-  std::vector<std::string> methods{"scatter", "multiview", "lightfield", "ewa"};
+  // "lightfield" (render_lightfield, `lightfield_views` views), "ewa" (render_ewa) and "gather"
+  // (render_gather); lightfield and ewa on the flat input only (they take one surface per pixel),
+  // gather on the flat input and as Tan et al.'s hybrid, the flat input with up to
+  // `gather_trace_rays` exact rays per half-resolution pixel traced into the scene where its ray
+  // mask says (input "flat + traced rays").
+  std::vector<std::string> methods{"scatter", "multiview", "lightfield", "ewa", "gather"};
   int multiview_samples = 32;
   int lightfield_views = 36;
+  int gather_trace_rays = 256;
   // When set: <scene>-truth.png, <scene>-<model>[-<method>][-layered].png and -error.png, and
   // <scene>-methods.png, all of them side by side (per model a row of pictures, a row of errors).
   std::filesystem::path picture_dir;
@@ -45,8 +49,10 @@ struct ImageValidationOptions {
 struct ImageValidationEntry {
   std::string scene;
   RayModelKind model = RayModelKind::Seidel;
-  std::string method = "scatter";  // "scatter", "multiview", "lightfield" or "ewa"
-  std::string input = "flat";  // "flat" (picture and depth) or "layered N" (deep, N peeled layers)
+  std::string method = "scatter";  // "scatter", "multiview", "lightfield", "ewa" or "gather"
+  // "flat" (picture and depth), "layered N" (deep, N peeled layers) or "flat + traced rays" (gather's
+  // hybrid)
+  std::string input = "flat";
   ImageComparison comparison;
   // PSNR over the pixels where hidden surfaces can show: within half the largest blur of a hidden
   // surface from a pixel whose first surface hides another (from the layered render; NaN without).
