@@ -331,6 +331,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     options.views = o.views;
     options.mip_filter = !o.no_mip_filter;
     options.vignetting = !o.no_vignetting;
+    options.spectral = !o.no_spectral;
     ProgressBar bar("bokeh", !global.quiet);
     options.progress = [&bar](double f) { bar.update(f); };
     LightfieldStatistics stats;
@@ -339,7 +340,8 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     const double render_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - render_started).count();
     bar.finish();
     OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture);
-    meta.extra.insert(meta.extra.end(), {{"views", std::to_string(options.views)}, {"mip_filter", options.mip_filter ? "on" : "off"}});
+    meta.extra.insert(meta.extra.end(), {{"views", std::to_string(options.views)}, {"mip_filter", options.mip_filter ? "on" : "off"},
+                                         {"lightfield_colour", options.spectral ? "three wavelengths" : "reference wavelength"}});
     write_bokeh_output(out, meta, o, depth, other);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     const double pixel_views = static_cast<double>(out.width) * out.height * options.views;
@@ -347,8 +349,10 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds
          << " s (rendering " << render_seconds << " s)\n  " << lens_name << ", model " << to_string(kind) << ", method lightfield, f/"
          << format_rounded(cam->f_number(), 3) << ", focus " << format_rounded(camera.focus_distance_m, 4) << " m, " << aperture.to_string()
-         << " aperture\n  " << options.views << " views, each at " << format_rounded(cam->reference_wavelength_nm(), 4)
-         << " nm (spectral colour is not implemented for lightfield); " << stats.stopped
+         << " aperture\n  " << options.views << " views, "
+         << (options.spectral ? std::string("each warped at three wavelengths, one per RGB channel")
+                              : "each at " + format_rounded(cam->reference_wavelength_nm(), 4) + " nm (--no-spectral)")
+         << "; " << stats.stopped
          << " warped rays stopped by the lens; " << format_rounded(100.0 * static_cast<double>(stats.holes) / pixel_views, 3)
          << " % of pixel views holes (no source landed), " << stats.unfilled_pixels << " pixels no view reached (input colour kept)";
     report_written(what.str(), global);

@@ -346,7 +346,7 @@ TEST_CASE("lensmith bokeh --method lightfield warps the picture to its views, sa
   REQUIRE(r.exit_code == 0);
   CHECK(r.err.find("method lightfield") != std::string::npos);
   CHECK(r.err.find("12 views") != std::string::npos);
-  CHECK(r.err.find("spectral colour is not implemented") != std::string::npos);
+  CHECK(r.err.find("three wavelengths, one per RGB channel") != std::string::npos);
   const auto meta = lensmith::read_image_metadata(out);
   CHECK(value_of(meta, "lensmith:method") == "lightfield");
   CHECK(value_of(meta, "lensmith:views") == "12");

@@ -18,6 +18,7 @@
 #include "lensmith/core/halton.h"
 #include "lensmith/core/huge_page_allocator.h"
 #include "lensmith/core/units.h"
+#include "lensmith/color/spectral_quadrature.h"
 #include "mip_pyramid.h"
 #include "scatter_source.h"
 
@@ -27,6 +28,23 @@ namespace {
 
 // Views warped together: one RayModel::map call per source for all of them.
 constexpr std::size_t kViewBatch = 6;
+
+// Per RGB channel, the centroid of its weights over lensmith's spectral quadrature (380-780 nm, 64
+// nodes; negative weights left out): the wavelength whose rays carry that channel's light.
+std::vector<double> channel_wavelengths_nm() {
+  const SpectralQuadrature quadrature;
+  std::vector<double> out(3);
+  for (std::size_t c = 0; c < 3; ++c) {
+    double sum = 0.0, weighted = 0.0;
+    for (std::size_t i = 0; i < quadrature.size(); ++i) {
+      const double weight = std::max(0.0, quadrature.rgb_weights(i)[static_cast<int>(c)]);
+      sum += weight;
+      weighted += weight * quadrature.wavelengths_nm()[i];
+    }
+    out[c] = weighted / sum;
+  }
+  return out;
+}
 
 
 // A source pixel as the views see it.
@@ -97,7 +115,12 @@ Image render_lightfield(const Image& image, const DepthMap& depth, const RayMode
     pupil[k] = {r * std::cos(theta), r * std::sin(theta)};
     view_weight[k] = edge * edge;
   }
-  const double wavelength = camera.reference_wavelength_nm();
+  // The wavelengths the views are warped at: the reference, or with colour one per channel, each
+  // the centroid of that channel's weights in lensmith's spectral quadrature (the scatter's, 380 to
+  // 780 nm), so that each channel's light lands where the lens puts light of its colour.
+  std::vector<double> band_nm{camera.reference_wavelength_nm()};
+  if (options.spectral) band_nm = channel_wavelengths_nm();
+  const std::size_t bands = band_nm.size();
 
   // The sources: every pixel, and beyond the frame a margin of half the largest blur and the lens's
   // shift of the frame's edges (frame_margin_px) where the picture continues as its edge pixels (as multiview's layers do): without them a view that moves
@@ -105,18 +128,10 @@ Image render_lightfield(const Image& image, const DepthMap& depth, const RayMode
   // over its last pixels (a disc cut by the right edge: 0.33 of full scale in the last column where
   // the truth has 0.43).
   const double lambda = std::sqrt(kPi / (4.0 * static_cast<double>(n_views)));
-  std::size_t clamped = 0;
-  std::vector<double> inverse(pixels);
-  double max_coc_px = 0.0;
-#pragma omp parallel for schedule(static) num_threads(threads) reduction(+ : clamped) reduction(max : max_coc_px)
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-      inverse[p] = render_detail::clamp_inverse_depth(camera, inverse_depth_per_mm(depth.at(x, y)), options.max_blur_px, clamped);
-      max_coc_px = std::max(max_coc_px, std::abs(camera.signed_coc_px(inverse[p])));
-    }
-  }
-  stats.clamped_depths = clamped;
+  const render_detail::ClampedDepths depths = render_detail::clamped_inverse_depths(camera, depth, options.max_blur_px, threads);
+  const std::vector<double>& inverse = depths.inverse;
+  const double max_coc_px = depths.max_blur_px;
+  stats.clamped_depths = depths.clamped;
   const int margin = render_detail::frame_margin_px(model, 0.5 * max_coc_px);
   const int sw = w + 2 * margin, sh = h + 2 * margin;
   const std::size_t n_sources = static_cast<std::size_t>(sw) * static_cast<std::size_t>(sh);
@@ -151,110 +166,120 @@ Image render_lightfield(const Image& image, const DepthMap& depth, const RayMode
   LargeVector<ZEntry> zbuffer(pixels * batch), fill(pixels);
   LargeVector<std::array<float, 2>> landing(n_sources * batch);  // per view of the batch and source: where it lands (NaN: nowhere)
   LargeVector<float> landed_weight(n_sources * batch);  // ... and its ray's radiometric weight (0: stopped)
-  LargeVector<std::array<float, 4>> sum(pixels, std::array<float, 4>{});  // RGB and the views' weight
+  // Per channel the views' light and their weight (the views that reached the pixel at that
+  // channel's wavelength).
+  LargeVector<std::array<float, 6>> sum(pixels, std::array<float, 6>{});
   std::size_t warps = 0, stopped = 0, holes = 0;
-  for (std::size_t k0 = 0; k0 < n_views; k0 += batch) {
-    const std::size_t count = std::min(batch, n_views - k0);
-    std::fill(zbuffer.begin(), zbuffer.end(), ZEntry{0});
-    // Warp: every source to where its ray through each view's pupil point lands, nearest wins on
-    // the pixel it lands in. A ray the lens stops still claims its pixel, dark (what is behind it
-    // is hidden from that pupil point all the same).
-#pragma omp parallel for schedule(dynamic, 4) num_threads(threads) reduction(+ : warps, stopped)
-    for (int y = 0; y < sh; ++y) {
-      std::array<SensorHit, kViewBatch> hits;
-      for (int x = 0; x < sw; ++x) {
-        const auto index = static_cast<std::uint32_t>(y * sw + x);
-        const Source& s = sources[index];
-        model.map(s.point, wavelength, std::span<const PupilPoint>(pupil.data() + k0, count), std::span<SensorHit>(hits.data(), count));
-        warps += count;
-        const ZEntry entry = z_entry(static_cast<float>(s.point.inverse_depth_per_mm), index);
-        for (std::size_t j = 0; j < count; ++j) {
-          const SensorHit& hit = hits[j];
-          const std::size_t slot = j * n_sources + index;
-          landing[slot] = {std::numeric_limits<float>::quiet_NaN(), 0.0f};
-          if (!hit.ok) ++stopped;
-          landed_weight[slot] = hit.ok ? static_cast<float>(options.vignetting ? hit.weight : 1.0) : 0.0f;
-          // Without a landing, or without vignetting a stopped ray is no ray.
-          if ((!hit.ok && !hit.unclipped) || (!hit.ok && !options.vignetting)) continue;
-          const PixelPoint q = camera.output_pixel(hit.x_mm, hit.y_mm);
-          if (!(std::isfinite(q.x) && std::isfinite(q.y)) || q.x < -1.0 || q.y < -1.0 || q.x > w + 1.0 || q.y > h + 1.0) continue;
-          landing[slot] = {static_cast<float>(q.x), static_cast<float>(q.y)};
-          const int px = static_cast<int>(std::floor(q.x)), py = static_cast<int>(std::floor(q.y));
-          if (px < 0 || py < 0 || px >= w || py >= h) continue;
-          claim(zbuffer, j * pixels + static_cast<std::size_t>(py) * static_cast<std::size_t>(w) + static_cast<std::size_t>(px), entry);
-        }
-      }
-    }
-    for (std::size_t j = 0; j < count; ++j) {
-      const std::size_t k = k0 + j;
-      ZEntry* const z = zbuffer.data() + j * pixels;
-      const std::array<float, 2>* const lands = landing.data() + j * n_sources;
-      const float* const weights = landed_weight.data() + j * n_sources;
-      // Cracks, as the paper fills them: each source also claims the 2 x 2 pixels around where it
-      // lands, but only those no source landed in (nearest wins among those): the grown support
-      // over pixels some source lands in would move a sloping surface's colours by up to a pixel
-      // and tie a plane in focus to its neighbours.
-      std::fill(fill.begin(), fill.end(), ZEntry{0});
-#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
+  for (std::size_t band = 0; band < bands; ++band) {
+    const double wavelength = band_nm[band];
+    // The channels this band carries: all three at one wavelength, else its own.
+    const std::size_t c0 = bands == 1 ? 0 : band, c1 = bands == 1 ? 3 : band + 1;
+    for (std::size_t k0 = 0; k0 < n_views; k0 += batch) {
+      const std::size_t count = std::min(batch, n_views - k0);
+      std::fill(zbuffer.begin(), zbuffer.end(), ZEntry{0});
+      // Warp: every source to where its ray through each view's pupil point lands, nearest wins on
+      // the pixel it lands in. A ray the lens stops still claims its pixel, dark (what is behind it
+      // is hidden from that pupil point all the same).
+  #pragma omp parallel for schedule(dynamic, 4) num_threads(threads) reduction(+ : warps, stopped)
       for (int y = 0; y < sh; ++y) {
+        std::array<SensorHit, kViewBatch> hits;
         for (int x = 0; x < sw; ++x) {
           const auto index = static_cast<std::uint32_t>(y * sw + x);
-          const std::array<float, 2> q = lands[index];
-          if (!std::isfinite(q[0])) continue;
-          const int x0 = static_cast<int>(std::floor(q[0] - 0.5f)), y0 = static_cast<int>(std::floor(q[1] - 0.5f));
-          const ZEntry entry = z_entry(static_cast<float>(sources[index].point.inverse_depth_per_mm), index);
-          for (int dy = 0; dy < 2; ++dy) {
-            for (int dx = 0; dx < 2; ++dx) {
-              const int px = x0 + dx, py = y0 + dy;
-              if (px < 0 || py < 0 || px >= w || py >= h) continue;
-              const std::size_t p = static_cast<std::size_t>(py) * static_cast<std::size_t>(w) + static_cast<std::size_t>(px);
-              if (z[p] == 0) claim(fill, p, entry);
+          const Source& s = sources[index];
+          model.map(s.point, wavelength, std::span<const PupilPoint>(pupil.data() + k0, count), std::span<SensorHit>(hits.data(), count));
+          warps += count;
+          const ZEntry entry = z_entry(static_cast<float>(s.point.inverse_depth_per_mm), index);
+          for (std::size_t j = 0; j < count; ++j) {
+            const SensorHit& hit = hits[j];
+            const std::size_t slot = j * n_sources + index;
+            landing[slot] = {std::numeric_limits<float>::quiet_NaN(), 0.0f};
+            if (!hit.ok) ++stopped;
+            landed_weight[slot] = hit.ok ? static_cast<float>(options.vignetting ? hit.weight : 1.0) : 0.0f;
+            // Without a landing, or without vignetting a stopped ray is no ray.
+            if ((!hit.ok && !hit.unclipped) || (!hit.ok && !options.vignetting)) continue;
+            const PixelPoint q = camera.output_pixel(hit.x_mm, hit.y_mm);
+            if (!(std::isfinite(q.x) && std::isfinite(q.y)) || q.x < -1.0 || q.y < -1.0 || q.x > w + 1.0 || q.y > h + 1.0) continue;
+            landing[slot] = {static_cast<float>(q.x), static_cast<float>(q.y)};
+            const int px = static_cast<int>(std::floor(q.x)), py = static_cast<int>(std::floor(q.y));
+            if (px < 0 || py < 0 || px >= w || py >= h) continue;
+            claim(zbuffer, j * pixels + static_cast<std::size_t>(py) * static_cast<std::size_t>(w) + static_cast<std::size_t>(px), entry);
+          }
+        }
+      }
+      for (std::size_t j = 0; j < count; ++j) {
+        const std::size_t k = k0 + j;
+        ZEntry* const z = zbuffer.data() + j * pixels;
+        const std::array<float, 2>* const lands = landing.data() + j * n_sources;
+        const float* const weights = landed_weight.data() + j * n_sources;
+        // Cracks, as the paper fills them: each source also claims the 2 x 2 pixels around where it
+        // lands, but only those no source landed in (nearest wins among those): the grown support
+        // over pixels some source lands in would move a sloping surface's colours by up to a pixel
+        // and tie a plane in focus to its neighbours.
+        std::fill(fill.begin(), fill.end(), ZEntry{0});
+  #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
+        for (int y = 0; y < sh; ++y) {
+          for (int x = 0; x < sw; ++x) {
+            const auto index = static_cast<std::uint32_t>(y * sw + x);
+            const std::array<float, 2> q = lands[index];
+            if (!std::isfinite(q[0])) continue;
+            const int x0 = static_cast<int>(std::floor(q[0] - 0.5f)), y0 = static_cast<int>(std::floor(q[1] - 0.5f));
+            const ZEntry entry = z_entry(static_cast<float>(sources[index].point.inverse_depth_per_mm), index);
+            for (int dy = 0; dy < 2; ++dy) {
+              for (int dx = 0; dx < 2; ++dx) {
+                const int px = x0 + dx, py = y0 + dy;
+                if (px < 0 || py < 0 || px >= w || py >= h) continue;
+                const std::size_t p = static_cast<std::size_t>(py) * static_cast<std::size_t>(w) + static_cast<std::size_t>(px);
+                if (z[p] == 0) claim(fill, p, entry);
+              }
             }
           }
         }
-      }
-      // Gather: each pixel's winner's colour and its ray's weight.
-      const auto share = static_cast<float>(view_weight[k]);
-#pragma omp parallel for schedule(static) num_threads(threads) reduction(+ : holes)
-      for (int y = 0; y < h; ++y) {
-        for (int x = 0; x < w; ++x) {
-          const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-          const ZEntry e = z[p] != 0 ? z[p] : fill[p];
-          if (e == 0) {
-            ++holes;
-            continue;
+        // Gather: each pixel's winner's colour and its ray's weight.
+        const auto share = static_cast<float>(view_weight[k]);
+  #pragma omp parallel for schedule(static) num_threads(threads) reduction(+ : holes)
+        for (int y = 0; y < h; ++y) {
+          for (int x = 0; x < w; ++x) {
+            const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+            const ZEntry e = z[p] != 0 ? z[p] : fill[p];
+            if (e == 0) {
+              ++holes;
+              continue;
+            }
+            const auto index = static_cast<std::size_t>((e & 0xffffffffu) - 1);
+            const auto [sx, sy] = source_pixel(index);
+            std::array<float, 3> c{image.at(sx, sy, 0), image.at(sx, sy, 1), image.at(sx, sy, 2)};
+            if (options.mip_filter && sources[index].cone_px > 1.0f) {
+              const std::array<float, 4> m = mip.window(static_cast<float>(sx) + 0.5f, static_cast<float>(sy) + 0.5f, sources[index].cone_px);
+              c = {m[0], m[1], m[2]};
+            }
+            const float light = weights[index] * share;
+            std::array<float, 6>& acc = sum[p];
+            for (std::size_t o = c0; o < c1; ++o) {
+              acc[o] += light * c[o];
+              acc[3 + o] += share;
+            }
           }
-          const auto index = static_cast<std::size_t>((e & 0xffffffffu) - 1);
-          const auto [sx, sy] = source_pixel(index);
-          std::array<float, 3> c{image.at(sx, sy, 0), image.at(sx, sy, 1), image.at(sx, sy, 2)};
-          if (options.mip_filter && sources[index].cone_px > 1.0f) {
-            const std::array<float, 4> m = mip.window(static_cast<float>(sx) + 0.5f, static_cast<float>(sy) + 0.5f, sources[index].cone_px);
-            c = {m[0], m[1], m[2]};
-          }
-          const float light = weights[index] * share;
-          std::array<float, 4>& acc = sum[p];
-          for (std::size_t o = 0; o < 3; ++o) acc[o] += light * c[o];
-          acc[3] += share;
         }
+        if (options.progress) options.progress(static_cast<double>(band * n_views + k + 1) / static_cast<double>(bands * n_views));
       }
-      if (options.progress) options.progress(static_cast<double>(k + 1) / static_cast<double>(n_views));
     }
   }
   stats.warps = warps;
   stats.stopped = stopped;
   stats.holes = holes;
 
-  // The views' mean; a pixel no view reached keeps its input colour.
+  // The views' mean per channel; a channel no view reached keeps its input value (a pixel none
+  // reached in any channel is counted).
   Image out(w, h, 3);
   std::size_t unfilled = 0;
   for (std::size_t p = 0; p < pixels; ++p) {
-    const std::array<float, 4>& acc = sum[p];
-    if (!(acc[3] > 0.0f)) {
-      for (std::size_t c = 0; c < 3; ++c) out.data[3 * p + c] = image.data[3 * p + c];
-      ++unfilled;
-      continue;
+    const std::array<float, 6>& acc = sum[p];
+    bool reached = false;
+    for (std::size_t c = 0; c < 3; ++c) {
+      reached = reached || acc[3 + c] > 0.0f;
+      out.data[3 * p + c] = acc[3 + c] > 0.0f ? std::max(0.0f, acc[c] / acc[3 + c]) : image.data[3 * p + c];
     }
-    for (std::size_t c = 0; c < 3; ++c) out.data[3 * p + c] = std::max(0.0f, acc[c] / acc[3]);
+    if (!reached) ++unfilled;
   }
   stats.unfilled_pixels = unfilled;
   if (statistics) *statistics = stats;

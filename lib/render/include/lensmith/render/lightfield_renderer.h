@@ -10,11 +10,14 @@
 //     source pixel through the ray model (RayModel::map at u), so each view carries the lens's
 //     aberrations, distortion and vignetting; the sensor is where the views are compared, so no
 //     focal-disparity re-indexing (eq. 7) is needed.
-//   - Colour: not implemented. Every view is warped at the reference wavelength and carries the
-//     picture's RGB as it is, so the lens's axial and lateral colour are missing. (Views cycling
-//     through wavelength bands, tried first, put each highlight's bokeh down as dots of different
-//     colours: with 36 views, one view per band point is colour noise. Tracing every view in every
-//     band costs the bands' count in time.)
+//   - Colour (beyond the paper, which has one wavelength): with LightfieldOptions::spectral every
+//     view is warped three times, once per RGB channel at that channel's centroid wavelength in
+//     lensmith's spectral quadrature, each warp carrying its own channel, so the lens's axial and
+//     lateral colour come with the views (three times the time; --no-spectral: one warp at the
+//     reference wavelength carrying RGB as it is). Three wavelengths, not a spectrum: the scatter
+//     method integrates 16; a channel's colour fringe is its centroid's. (Views cycling through
+//     wavelength bands, tried first, put each highlight's bokeh down as dots of different colours:
+//     with 36 views, one view per band point is colour noise.)
 //   - Visibility (sec. 3.2): as the paper's atomic min on disparity, nearest wins per pixel and view.
 //   - Holes (sec. 3.2): as the paper, a warped pixel's support is grown to the 2 x 2 pixels whose
 //     centres surround where it lands, so rounding leaves no cracks; but only over pixels no source
@@ -53,6 +56,7 @@ struct LightfieldOptions {
   int views = 36;             // lens-plane views (1..1024; the paper's default 36)
   bool vignetting = true;     // as BokehOptions::vignetting
   bool mip_filter = true;     // Yu et al.'s pre-filter against undersampling (sec. 4.2)
+  bool spectral = true;       // each RGB channel warped at its own wavelength (3x the time); false: one warp at the reference
   double max_blur_px = 1000.0;  // nearer points are clamped to this blur diameter (output px)
   std::function<void(double)> progress;  // fraction done, from one thread at a time
   void validate() const;  // throws OptionsError naming the option
