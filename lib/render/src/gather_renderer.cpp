@@ -59,6 +59,9 @@ double smoothstep01(double t) {
   return t * t * (3.0 - 2.0 * t);
 }
 double saturate(double t) { return std::clamp(t, 0.0, 1.0); }
+// How blurred a point of signed blur diameter `blur_px` counts: 0 (sharp) below kSharpBlurPx, 1
+// from kSharpBlurPx + kBlendBlurPx (the composite, the layers' sums and the ray mask all use it).
+double blurriness(double blur_px) { return saturate((std::abs(blur_px) - kSharpBlurPx) / kBlendBlurPx); }
 
 // A half-resolution sample: its footprint's centroid (output px), the inverse of its covariance
 // (x^T V^-1 x = a x^2 + 2 b x y + c y^2), its reach (output px: half the footprint's longer axis),
@@ -346,7 +349,7 @@ Image render_gather(const Image& image, const DepthMap& depth, const RayModel& m
         // Each layer's sums count its blurred samples only: a sharp sample is the sharp picture's
         // already (as a half-resolution sample, upsampled into its blurred neighbours, an in-focus
         // light behind blurred branches became an 8 px blob).
-        const double blurry = saturate((std::abs(s.blur) - kSharpBlurPx) / kBlendBlurPx);
+        const double blurry = blurriness(s.blur);
         const double weight = s.alpha * spread;
         const double wb = weight * s.background * blurry, wf = weight * (1.0 - s.background);
         const double wbf = wf * blurry;
@@ -444,7 +447,7 @@ Image render_gather(const Image& image, const DepthMap& depth, const RayModel& m
         // (A sloping surface's blur changes smoothly, by less than kRampBlurPerPx per px unless
         // seen at grazing angles: its gradient is no edge. Without this the crossing planes were
         // traced all over, and their rays' noise cost 5 dB.)
-        const double x = std::max(0.0, gradient - kRampBlurPerPx) * kMaskScale * saturate((widest - kSharpBlurPx) / kBlendBlurPx);
+        const double x = std::max(0.0, gradient - kRampBlurPerPx) * kMaskScale * blurriness(widest);
         edge[static_cast<std::size_t>(j) * hw + i] = static_cast<float>(saturate(1.0 - 1.0 / (x + 1.0)));
       }
     }
@@ -526,7 +529,7 @@ Image render_gather(const Image& image, const DepthMap& depth, const RayModel& m
       auto half = [&](const auto& get) { return bilinear(hw, hh, hx, hy, get); };
       const double a = half([&](int i, int j) { return static_cast<double>(coverage[static_cast<std::size_t>(j) * hw + i]); });
       const double share = traced_share[p];
-      const double own_blur = saturate((std::abs(blur[p]) - kSharpBlurPx) / kBlendBlurPx);
+      const double own_blur = blurriness(blur[p]);
       for (int c = 0; c < 3; ++c) {
         const auto channel = static_cast<std::size_t>(c);
         const double sharp = e.throughput * bilinear(w, h, qx - e.dx, qy - e.dy, [&](int i, int j) {
