@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "lensmith/paraxial/paraxial_system.h"
 #include "lensmith/prescription/lens_library.h"
 #include "lensmith/trace/ray_aiming.h"
 #include "lensmith/trace/sequential_tracer.h"
@@ -85,6 +86,42 @@ void BM_TraceBatch(benchmark::State& state, const std::string& id) {
       benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
+// A million rays of beams at five field angles (0 to 20 deg along y) through 95 % of the paraxial
+// entrance pupil (a golden-angle spiral), from the plane z = -10 mm: the work bench/python_trace_bench.py
+// gives the Python module, so that the two figures compare (docs/performance.md, "Python").
+// Only trace_batch is timed, on every core.
+void BM_TraceBatchBeams(benchmark::State& state, const std::string& id) {
+  const Prescription lens = LensLibrary::load(id).prescription;
+  const SequentialTracer tracer(lens);
+  const ParaxialSystem paraxial(lens);
+  constexpr std::size_t kRays = 1000000;
+  const double z_pupil = paraxial.entrance_pupil().z_mm, radius = 0.95 * paraxial.entrance_pupil().diameter_mm / 2.0;
+  constexpr double kGoldenAngle = 2.39996322972865332, kPi = 3.14159265358979323846;
+  RayBatch input;
+  input.resize(kRays);
+  for (std::size_t i = 0; i < kRays; ++i) {
+    const double angle = 20.0 * static_cast<double>(i % 5) / 4.0 * kPi / 180.0;
+    const double r = radius * std::sqrt((static_cast<double>(i) + 0.5) / static_cast<double>(kRays));
+    const double px = r * std::cos(kGoldenAngle * static_cast<double>(i)), py = r * std::sin(kGoldenAngle * static_cast<double>(i));
+    const double m = std::sin(angle), n = std::cos(angle), t = (z_pupil + 10.0) / n;
+    input.set(i, Ray{{px, py - m * t, -10.0}, {0.0, m, n}, lens.primary_wavelength_nm()});
+  }
+  omp_set_num_threads(omp_get_num_procs());
+  RayBatch batch = input;
+  for (auto _ : state) {
+    state.PauseTiming();
+    batch = input;
+    state.ResumeTiming();
+    tracer.trace_batch(batch, TraceDirection::Forward);
+    benchmark::DoNotOptimize(batch.x_mm.data());
+  }
+  std::size_t passed = 0;
+  for (RayStatus s : batch.status) passed += s == RayStatus::Ok;
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(kRays));
+  state.counters["passed"] = static_cast<double>(passed);
+  state.counters["surfaces"] = static_cast<double>(lens.surfaces.size());
+}
+
 // RayAimer::make_ray for Smith's triplet over the field and pupil, paraxial or real-stop aiming.
 void BM_AimRay(benchmark::State& state, RayAiming aiming) {
   const Prescription lens = LensLibrary::load("smith-cooke-triplet").prescription;
@@ -120,6 +157,12 @@ const int kRegistered = [] {
         ->Repetitions(5)
         ->ReportAggregatesOnly(true);
   }
+  benchmark::RegisterBenchmark("BM_TraceBatchBeams/angenieux-double-gauss-1953", BM_TraceBatchBeams,
+                               std::string("angenieux-double-gauss-1953"))
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime()
+      ->Repetitions(5)
+      ->ReportAggregatesOnly(true);
   benchmark::RegisterBenchmark("BM_AimRay/smith-cooke-triplet/paraxial_pupil", BM_AimRay,
                                RayAiming::ParaxialEntrancePupil)
       ->Unit(benchmark::kNanosecond)

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "lensmith/report/json_report.h"
 #include "json_output.h"
 #include "lensmith/analysis/chromatic_focal_shift.h"
 #include "lensmith/analysis/distortion_curve.h"
@@ -22,78 +23,6 @@ namespace lensmith::cli {
 namespace {
 
 
-
-ojson distortion_json(const DistortionCurve& d) {
-  ojson points = ojson::array();
-  for (const auto& p : d.points) {
-    points.push_back({{"relative_field", p.relative_field}, {"field_value", p.field_value}, {"real_height_mm", p.real_height_mm},
-                      {"paraxial_height_mm", p.paraxial_height_mm}, {"distortion_percent", p.distortion_percent}});
-  }
-  return {{"analysis", "distortion"}, {"lens", d.lens_name}, {"wavelength_nm", d.wavelength_nm}, {"field_unit", d.field_unit},
-          {"image_plane_z_mm", d.image_plane_z_mm}, {"paraxial_reference", d.paraxial_reference}, {"points", points}};
-}
-
-ojson field_curves_json(const FieldCurves& f) {
-  ojson curves = ojson::array();
-  for (const auto& c : f.curves) {
-    ojson points = ojson::array();
-    for (const auto& p : c.points) {
-      points.push_back({{"relative_field", p.relative_field}, {"field_value", p.field_value},
-                        {"tangential_mm", number_or_null(p.tangential_mm)}, {"sagittal_mm", number_or_null(p.sagittal_mm)}});
-    }
-    curves.push_back({{"wavelength_nm", c.wavelength_nm}, {"points", points}});
-  }
-  return {{"analysis", "field-curves"}, {"lens", f.lens_name}, {"field_unit", f.field_unit}, {"image_plane_z_mm", f.image_plane_z_mm},
-          {"paraxial_focus_z_mm", f.paraxial_focus_z_mm}, {"pupil_step", f.pupil_step}, {"curves", curves}};
-}
-
-ojson focal_shift_json(const ChromaticFocalShift& c) {
-  ojson points = ojson::array();
-  for (const auto& p : c.points) {
-    points.push_back({{"wavelength_nm", p.wavelength_nm}, {"image_distance_mm", p.image_distance_mm}, {"shift_mm", p.shift_mm},
-                      {"extrapolated", p.extrapolated}});
-  }
-  return {{"analysis", "focal-shift"}, {"lens", c.lens_name}, {"reference_wavelength_nm", c.reference_wavelength_nm},
-          {"reference_image_distance_mm", c.reference_image_distance_mm}, {"range_mm", c.range_mm()}, {"points", points}};
-}
-
-ojson illumination_json(const RelativeIllumination& r) {
-  ojson points = ojson::array();
-  for (const auto& p : r.points) {
-    points.push_back({{"relative_field", p.relative_field}, {"field_value", p.field_value}, {"rays_in_pupil", p.rays_in_pupil},
-                      {"rays_passed", p.rays_passed}, {"vignetting_factor", p.vignetting_factor},
-                      {"projected_solid_angle_sr", p.projected_solid_angle_sr}, {"relative_illumination", p.relative_illumination},
-                      {"chief_ray_angle_deg", p.chief_ray_angle_deg}, {"cos4_estimate", p.cos4_estimate}});
-  }
-  return {{"analysis", "illumination"}, {"lens", r.lens_name}, {"wavelength_nm", r.wavelength_nm}, {"field_unit", r.field_unit},
-          {"pupil_grid", r.pupil_grid}, {"points", points}};
-}
-
-ojson pupil_json(const PupilShape& s) {
-  ojson fields = ojson::array();
-  for (const auto& f : s.fields) {
-    // One string per grid row, top (py = +1) first: '#' passes, 'x' lost, '.' outside the pupil.
-    ojson rows = ojson::array();
-    for (int r = 0; r < f.grid; ++r) {
-      std::string row;
-      for (int c = 0; c < f.grid; ++c) {
-        const PupilCell& cell = f.cell(r, c);
-        row += !cell.inside ? '.' : cell.status == RayStatus::Ok ? '#' : 'x';
-      }
-      rows.push_back(row);
-    }
-    ojson outline = ojson::array();
-    for (const auto& p : f.outline) outline.push_back({p.px, p.py});
-    ojson losses = ojson::array();
-    for (const auto& l : f.losses) losses.push_back({{"surface", l.surface}, {"status", std::string(to_string(l.status))}, {"rays", l.rays}});
-    fields.push_back({{"relative_field", f.relative_field}, {"field_value", f.field_value}, {"grid", f.grid},
-                      {"rays_in_pupil", f.rays_in_pupil}, {"rays_passed", f.rays_passed}, {"area_fraction", f.area_fraction},
-                      {"centroid", {{"px", f.centroid.px}, {"py", f.centroid.py}}}, {"outline", outline}, {"losses", losses},
-                      {"mask", rows}});
-  }
-  return {{"analysis", "pupil"}, {"lens", s.lens_name}, {"wavelength_nm", s.wavelength_nm}, {"field_unit", s.field_unit},
-          {"fields", fields}};
-}
 
 // Prints the result, writes the picture: the same three steps for every analysis.
 template <typename Result, typename Json, typename Plot>

@@ -298,18 +298,9 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   } else {
     camera.focus_distance_m = *o.focus_m;
   }
-  std::optional<Camera> cam;
-  if (o.thin_lens) {
-    cam = Camera::thin_lens(*o.focal_length_mm, camera, width, height);
-  } else if (kind == RayModelKind::Thin) {
-    // The ideal thin lens with this lens's focal length and f-number.
-    const ParaxialSystem p(*lens);
-    if (!camera.f_number) camera.f_number = p.f_number();
-    cam = Camera::thin_lens(p.efl_mm(), camera, width, height);
-  } else {
-    cam = Camera::from_lens(*lens, camera, width, height);
-    warn_about_aperture(*cam, global);
-  }
+  std::optional<Camera> cam = camera_for_model(kind, lens ? &*lens : nullptr, o.thin_lens ? o.focal_length_mm : std::nullopt, camera,
+                                               width, height);
+  if (!cam->is_thin_lens()) warn_about_aperture(*cam, global);
   float nearest_m = std::numeric_limits<float>::infinity();
   for (float z : depth.z_m) nearest_m = std::min(nearest_m, z);
   RayModelOptions model_options;

@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "commands.h"
+#include "lensmith/report/json_report.h"
 #include "json_output.h"
 #include "lensmith/core/errors.h"
 #include "lensmith/polyfit/lens_fit.h"
@@ -53,29 +54,7 @@ int run_fit(const FitCommandOptions& o, const GlobalOptions& global) {
   const LensFitTiming& t = fit.timing();
   const double speedup = t.exact_ns_per_ray / t.poly_ns_per_ray;
   if (o.json) {
-    ojson j;
-    j["lens"] = lens.name;
-    j["prescription_hash"] = fit.lens_hash();
-    j["degree"] = options.degree;
-    j["terms"] = fit.term_budget();
-    j["terms_sensor_to_outer"] = fit.sensor_to_outer().size();
-    j["terms_outer_to_sensor"] = fit.outer_to_sensor().size();
-    j["clip_surfaces"] = ojson::array();
-    for (const ClipSurface& c : fit.clip_surfaces()) j["clip_surfaces"].push_back(c.surface);
-    j["test_rays"] = e.test_rays;
-    j["position_rms_um"] = e.position_rms_um;
-    j["position_p99_um"] = e.position_p99_um;
-    j["direction_rms_mrad"] = e.direction_rms_mrad;
-    j["stop_rms_um"] = e.stop_rms_um;
-    j["transmittance_rms"] = e.transmittance_rms;
-    j["sensor_position_rms_um"] = e.sensor_position_rms_um;
-    j["sensor_position_p99_um"] = e.sensor_position_p99_um;
-    j["sensor_direction_rms_mrad"] = e.sensor_direction_rms_mrad;
-    j["vignetting_mismatch"] = e.vignetting_mismatch;
-    j["fit_seconds"] = t.fit_seconds;
-    j["exact_ns_per_ray"] = t.exact_ns_per_ray;
-    j["poly_ns_per_ray"] = t.poly_ns_per_ray;
-    j["speedup"] = speedup;
+    ojson j = fit_json(fit);
     if (!o.output.empty()) j["output"] = o.output;
     std::cout << j.dump(2) << "\n";
     return kExitOk;

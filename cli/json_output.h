@@ -1,15 +1,11 @@
-// Small helpers shared by the subcommands' --json output.
+// The subcommands' --json: the library's one schema (lensmith/report/json_report.h).
 #pragma once
 
-#include <cmath>
-
-#include <nlohmann/json.hpp>
+#include "lensmith/report/json_report.h"
 
 namespace lensmith::cli {
 
-using ojson = nlohmann::ordered_json;
-
-// JSON has no infinity or NaN: a non-finite number (a distance at infinity, a ray that died) is null.
-inline ojson number_or_null(double v) { return std::isfinite(v) ? ojson(v) : ojson(nullptr); }
+using lensmith::number_or_null;
+using lensmith::ojson;
 
 }  // namespace lensmith::cli

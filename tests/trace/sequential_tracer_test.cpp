@@ -726,3 +726,75 @@ TEST_CASE("the batch path gives the same bits as the single-ray path, on many ra
   uneven.l.resize(2);
   CHECK_THROWS_AS(SequentialTracer(sasian_triplet()).trace_batch(uneven, TraceDirection::Forward), OptionsError);
 }
+
+TEST_CASE("a batch in rows of the caller's arrays traces to the same bits as a RayBatch, without touching the inputs",
+          "[trace][batch]") {
+  // The Python module's layout: (N, 3) row-major positions and directions, outputs in other arrays,
+  // one wavelength for all rays (stride 0) or one per ray.
+  const Prescription lens = LensLibrary::load("zeiss-biotar-1927").prescription;
+  const SequentialTracer tracer(lens);
+  const RayAimer aimer(tracer);
+  constexpr std::size_t kRays = 3000;
+  std::vector<double> origins(3 * kRays), directions(3 * kRays), wavelengths(kRays);
+  RayBatch batch;
+  batch.resize(kRays);
+  for (std::size_t i = 0; i < kRays; ++i) {
+    const double r = 1.3 * std::sqrt(static_cast<double>(i % 17) / 16.0), a = 0.61 * static_cast<double>(i);
+    wavelengths[i] = i % 2 ? 486.1327 : 656.2725;
+    Ray ray = aimer.make_ray(FieldPoint::angle_deg(4.0 * static_cast<double>(i % 5)), {r * std::cos(a), r * std::sin(a)}, wavelengths[i]).ray;
+    if (i == 7) ray.direction = {0.0, 0.0, 0.0};  // invalid: kept as given
+    for (int c = 0; c < 3; ++c) {
+      origins[3 * i + static_cast<std::size_t>(c)] = ray.position_mm[c];
+      directions[3 * i + static_cast<std::size_t>(c)] = ray.direction[c];
+    }
+    batch.set(i, ray);
+  }
+  const std::vector<double> origins_before = origins, directions_before = directions;
+  tracer.trace_batch(batch, TraceDirection::Forward);
+
+  std::vector<double> positions(3 * kRays), out_directions(3 * kRays);
+  std::vector<RayStatus> status(kRays);
+  std::vector<int> surface(kRays);
+  RayBatchView view;
+  view.count = kRays;
+  view.x_mm = origins.data();
+  view.y_mm = origins.data() + 1;
+  view.z_mm = origins.data() + 2;
+  view.l = directions.data();
+  view.m = directions.data() + 1;
+  view.n = directions.data() + 2;
+  view.stride = 3;
+  view.wavelength_nm = wavelengths.data();
+  view.x_out_mm = positions.data();
+  view.y_out_mm = positions.data() + 1;
+  view.z_out_mm = positions.data() + 2;
+  view.l_out = out_directions.data();
+  view.m_out = out_directions.data() + 1;
+  view.n_out = out_directions.data() + 2;
+  view.out_stride = 3;
+  view.status = status.data();
+  view.surface = surface.data();
+  tracer.trace_batch(view, TraceDirection::Forward);
+  CHECK(origins == origins_before);
+  CHECK(directions == directions_before);
+  for (std::size_t i = 0; i < kRays; ++i) {
+    INFO("ray " << i);
+    REQUIRE(status[i] == batch.status[i]);
+    REQUIRE(surface[i] == batch.surface[i]);
+    REQUIRE(positions[3 * i] == batch.x_mm[i]);
+    REQUIRE(positions[3 * i + 2] == batch.z_mm[i]);
+    REQUIRE(out_directions[3 * i + 1] == batch.m[i]);
+  }
+  CHECK(status[7] == RayStatus::InvalidInput);
+  CHECK(out_directions[3 * 7 + 2] == 0.0);
+
+  // One wavelength for every ray: stride 0.
+  const double blue = 486.1327;
+  view.wavelength_nm = &blue;
+  view.wavelength_stride = 0;
+  tracer.trace_batch(view, TraceDirection::Forward);
+  CHECK(status[1] == batch.status[1]);
+  CHECK(positions[3 * 1] == batch.x_mm[1]);  // ray 1 is blue in both
+  view.stride = 0;
+  CHECK_THROWS_AS(tracer.trace_batch(view, TraceDirection::Forward), OptionsError);
+}

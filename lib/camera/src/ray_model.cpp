@@ -4,6 +4,7 @@
 
 #include "lensmith/core/errors.h"
 #include "lensmith/core/number_parsing.h"
+#include "lensmith/paraxial/paraxial_system.h"
 #include "model_implementations.h"
 
 namespace lensmith {
@@ -73,6 +74,23 @@ LensFitOptions lens_fit_options_for(const Camera& camera) {
       0.5 * std::hypot(camera.frame().width_px(), camera.frame().height_px()) / std::abs(camera.px_per_sensor_mm());
   o.image_radius_mm = std::max(LensFitOptions::kDefaultImageRadiusMm, kFrameMargin * half_diagonal_mm);
   return o;
+}
+
+Camera camera_for_model(RayModelKind kind, const Prescription* lens, std::optional<double> thin_lens_focal_length_mm,
+                        CameraOptions options, int width_px, int height_px) {
+  if (thin_lens_focal_length_mm) {
+    if (kind != RayModelKind::Thin) {
+      throw UsageError("an ideal thin lens has no prescription: only the thin model applies (got " + std::string(to_string(kind)) + ")");
+    }
+    return Camera::thin_lens(*thin_lens_focal_length_mm, options, width_px, height_px);
+  }
+  if (!lens) throw UsageError("a camera needs a lens (a prescription) or a thin lens's focal length");
+  if (kind == RayModelKind::Thin) {
+    const ParaxialSystem paraxial(*lens);
+    if (!options.f_number) options.f_number = paraxial.f_number();
+    return Camera::thin_lens(paraxial.efl_mm(), options, width_px, height_px);
+  }
+  return Camera::from_lens(*lens, options, width_px, height_px);
 }
 
 std::unique_ptr<RayModel> make_ray_model(RayModelKind kind, const Camera& camera, const RayModelOptions& options) {

@@ -335,6 +335,60 @@ double planar_depth_m(double v, const DepthReadOptions& options, const PinholeFr
   return std::numeric_limits<double>::quiet_NaN();
 }
 
+DepthMap depth_map_from_values(std::span<const float> values, const DepthReadOptions& options, const PinholeFrame& frame,
+                               const std::string& where) {
+  if (values.size() != static_cast<std::size_t>(frame.width_px()) * static_cast<std::size_t>(frame.height_px())) {
+    throw ImageFileError(where + ": " + std::to_string(values.size()) + " depth values for a picture of " + std::to_string(frame.width_px()) +
+                         " x " + std::to_string(frame.height_px()) + " pixels: the depth map must have the picture's size");
+  }
+  constexpr float kFar = std::numeric_limits<float>::infinity();
+  DepthMap depth(frame.width_px(), frame.height_px(), kFar);
+  std::vector<bool> invalid(values.size(), false);
+  std::size_t invalid_count = 0;
+  std::size_t first_invalid = 0;
+  float nearest_m = kFar;
+  for (int y = 0; y < depth.height; ++y) {
+    for (int x = 0; x < depth.width; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(depth.width) + static_cast<std::size_t>(x);
+      const float z = static_cast<float>(planar_depth_m(values[i], options, frame, x, y));
+      // z = 0 (also a depth too small for a float) is a point at the pinhole, not in front of it.
+      if (z > 0.0f) {
+        depth.z_m[i] = z;
+        nearest_m = std::min(nearest_m, z);
+      } else {
+        if (invalid_count == 0) first_invalid = i;
+        ++invalid_count;
+        invalid[i] = true;
+      }
+    }
+  }
+  if (invalid_count == 0) return depth;
+
+  const int bad_x = static_cast<int>(first_invalid % static_cast<std::size_t>(depth.width));
+  const int bad_y = static_cast<int>(first_invalid / static_cast<std::size_t>(depth.width));
+  const std::string bad = where + ": " + pixel_text(bad_x, bad_y) + " = " + format_number(values[first_invalid]) +
+                          (invalid_count > 1 ? " (and " + std::to_string(invalid_count - 1) + " more invalid pixels)" : "");
+  const std::string expected = options.kind == DepthKind::Inverse
+                                   ? "inverse depth must be finite and >= 0 (0 = infinitely far)"
+                                   : "depth (" + lensmith::to_string(options.kind) + ") must be > 0 (+inf = infinitely far)";
+  if (options.invalid == InvalidDepth::Error) {
+    throw ImageFileError(bad + ": " + expected +
+                         "; --invalid-depth far treats such pixels as infinitely far, --invalid-depth near gives them "
+                         "the nearest valid depth");
+  }
+  float replacement = kFar;
+  if (options.invalid == InvalidDepth::Near) {
+    if (nearest_m == kFar) {
+      throw ImageFileError(bad + ": " + expected + "; --invalid-depth near needs a finite valid depth, and the map has none: use --invalid-depth far");
+    }
+    replacement = nearest_m;
+  }
+  for (std::size_t i = 0; i < invalid.size(); ++i) {
+    if (invalid[i]) depth.z_m[i] = replacement;
+  }
+  return depth;
+}
+
 DepthMap read_depth(const DepthSource& source, const DepthReadOptions& options, const PinholeFrame& frame) {
   const fs::path& path = source.file;
   const RasterInfo info = read_raster_info(path);
@@ -385,52 +439,7 @@ DepthMap read_depth(const DepthSource& source, const DepthReadOptions& options, 
     }
   }
 
-  constexpr float kFar = std::numeric_limits<float>::infinity();
-  DepthMap depth(info.width, info.height, kFar);
-  std::vector<bool> invalid(values.size(), false);
-  std::size_t invalid_count = 0;
-  std::size_t first_invalid = 0;
-  float nearest_m = kFar;
-  for (int y = 0; y < info.height; ++y) {
-    for (int x = 0; x < info.width; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(info.width) + static_cast<std::size_t>(x);
-      const float z = static_cast<float>(planar_depth_m(values[i], options, frame, x, y));
-      // z = 0 (also a depth too small for a float) is a point at the pinhole, not in front of it.
-      if (z > 0.0f) {
-        depth.z_m[i] = z;
-        nearest_m = std::min(nearest_m, z);
-      } else {
-        if (invalid_count == 0) first_invalid = i;
-        ++invalid_count;
-        invalid[i] = true;
-      }
-    }
-  }
-  if (invalid_count == 0) return depth;
-
-  const int bad_x = static_cast<int>(first_invalid % static_cast<std::size_t>(info.width));
-  const int bad_y = static_cast<int>(first_invalid / static_cast<std::size_t>(info.width));
-  const std::string bad = where + ": " + pixel_text(bad_x, bad_y) + " = " + format_number(values[first_invalid]) +
-                          (invalid_count > 1 ? " (and " + std::to_string(invalid_count - 1) + " more invalid pixels)" : "");
-  const std::string expected = options.kind == DepthKind::Inverse
-                                   ? "inverse depth must be finite and >= 0 (0 = infinitely far)"
-                                   : "depth (" + lensmith::to_string(options.kind) + ") must be > 0 (+inf = infinitely far)";
-  if (options.invalid == InvalidDepth::Error) {
-    throw ImageFileError(bad + ": " + expected +
-                         "; --invalid-depth far treats such pixels as infinitely far, --invalid-depth near gives them "
-                         "the nearest valid depth");
-  }
-  float replacement = kFar;
-  if (options.invalid == InvalidDepth::Near) {
-    if (nearest_m == kFar) {
-      throw ImageFileError(bad + ": " + expected + "; --invalid-depth near needs a finite valid depth, and the map has none: use --invalid-depth far");
-    }
-    replacement = nearest_m;
-  }
-  for (std::size_t i = 0; i < invalid.size(); ++i) {
-    if (invalid[i]) depth.z_m[i] = replacement;
-  }
-  return depth;
+  return depth_map_from_values(values, options, frame, where);
 }
 
 // ---- output --------------------------------------------------------------------------------------

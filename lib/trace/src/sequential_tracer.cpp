@@ -793,19 +793,18 @@ TraceResult trace_one(const Core& impl, const Ray& ray, std::vector<SurfaceHit>*
 constexpr int kLanes = 4;
 
 template <bool kForward>
-void trace_many(const Core& impl, RayBatch& batch) {
-  const auto count = static_cast<std::ptrdiff_t>(batch.size());
+void trace_many(const Core& impl, const RayBatchView& batch) {
+  const auto count = static_cast<std::ptrdiff_t>(batch.count);
   const auto groups = (count + kLanes - 1) / kLanes;
   const int surfaces = static_cast<int>(impl.count());
-  double* const x = batch.x_mm.data();
-  double* const y = batch.y_mm.data();
-  double* const z = batch.z_mm.data();
-  double* const l = batch.l.data();
-  double* const m = batch.m.data();
-  double* const n = batch.n.data();
-  const double* const wavelength = batch.wavelength_nm.data();
-  RayStatus* const status = batch.status.data();
-  int* const surface = batch.surface.data();
+  const double *const x = batch.x_mm, *const y = batch.y_mm, *const z = batch.z_mm;
+  const double *const l = batch.l, *const m = batch.m, *const n = batch.n;
+  double *const x_out = batch.x_out_mm, *const y_out = batch.y_out_mm, *const z_out = batch.z_out_mm;
+  double *const l_out = batch.l_out, *const m_out = batch.m_out, *const n_out = batch.n_out;
+  const std::ptrdiff_t in = batch.stride, out = batch.out_stride, w = batch.wavelength_stride;
+  const double* const wavelength = batch.wavelength_nm;
+  RayStatus* const status = batch.status;
+  int* const surface = batch.surface;
 #pragma omp parallel for schedule(static) if (count >= kParallelBatchThreshold)
   for (std::ptrdiff_t group = 0; group < groups; ++group) {
     const std::ptrdiff_t first = group * kLanes;
@@ -818,10 +817,10 @@ void trace_many(const Core& impl, RayBatch& batch) {
       State s{};
       if (lane >= lanes) {
         lane_status[static_cast<std::size_t>(lane)] = RayStatus::InvalidInput;  // padding, never stored
-      } else if (!load(x[i], y[i], z[i], l[i], m[i], n[i], wavelength[i], s)) {
+      } else if (!load(x[i * in], y[i * in], z[i * in], l[i * in], m[i * in], n[i * in], wavelength[i * w], s)) {
         lane_status[static_cast<std::size_t>(lane)] = RayStatus::InvalidInput;
       } else {
-        walkers[static_cast<std::size_t>(lane)] = start_walk<kForward>(impl, s, wavelength[i], impl.indices(wavelength[i]));
+        walkers[static_cast<std::size_t>(lane)] = start_walk<kForward>(impl, s, wavelength[i * w], impl.indices(wavelength[i * w]));
         lane_status[static_cast<std::size_t>(lane)] = RayStatus::Ok;
       }
     }
@@ -837,6 +836,13 @@ void trace_many(const Core& impl, RayBatch& batch) {
       if (lane_status[lane] == RayStatus::InvalidInput) {
         status[i] = RayStatus::InvalidInput;
         surface[i] = 0;
+        // The ray as given (in place for a RayBatch).
+        x_out[i * out] = x[i * in];
+        y_out[i * out] = y[i * in];
+        z_out[i * out] = z[i * in];
+        l_out[i * out] = l[i * in];
+        m_out[i * out] = m[i * in];
+        n_out[i * out] = n[i * in];
         continue;
       }
       if constexpr (kForward) {
@@ -848,12 +854,12 @@ void trace_many(const Core& impl, RayBatch& batch) {
       const State& s = walkers[lane].r;
       status[i] = lane_status[lane];
       surface[i] = lane_status[lane] == RayStatus::Ok ? 0 : died_at[lane];
-      x[i] = s.x;
-      y[i] = s.y;
-      z[i] = s.z;
-      l[i] = s.l;
-      m[i] = s.m;
-      n[i] = s.n;
+      x_out[i * out] = s.x;
+      y_out[i * out] = s.y;
+      z_out[i * out] = s.z;
+      l_out[i * out] = s.l;
+      m_out[i * out] = s.m;
+      n_out[i * out] = s.n;
     }
   }
 }
@@ -880,10 +886,33 @@ void SequentialTracer::trace_batch(RayBatch& batch, TraceDirection direction) co
     throw OptionsError("RayBatch: arrays of different sizes (x_mm has " + std::to_string(count) +
                        " entries); use RayBatch::resize()");
   }
+  RayBatchView view;
+  view.count = count;
+  view.x_mm = view.x_out_mm = batch.x_mm.data();
+  view.y_mm = view.y_out_mm = batch.y_mm.data();
+  view.z_mm = view.z_out_mm = batch.z_mm.data();
+  view.l = view.l_out = batch.l.data();
+  view.m = view.m_out = batch.m.data();
+  view.n = view.n_out = batch.n.data();
+  view.wavelength_nm = batch.wavelength_nm.data();
+  view.status = batch.status.data();
+  view.surface = batch.surface.data();
+  trace_batch(view, direction);
+}
+
+void SequentialTracer::trace_batch(const RayBatchView& rays, TraceDirection direction) const {
+  if (rays.count == 0) return;
+  if (!rays.x_mm || !rays.y_mm || !rays.z_mm || !rays.l || !rays.m || !rays.n || !rays.wavelength_nm || !rays.status || !rays.surface ||
+      !rays.x_out_mm || !rays.y_out_mm || !rays.z_out_mm || !rays.l_out || !rays.m_out || !rays.n_out) {
+    throw OptionsError("RayBatchView: every array must be given for " + std::to_string(rays.count) + " rays");
+  }
+  if (rays.stride < 1 || rays.out_stride < 1 || rays.wavelength_stride < 0) {
+    throw OptionsError("RayBatchView: strides must be >= 1 (the wavelength's >= 0)");
+  }
   if (direction == TraceDirection::Forward) {
-    trace_many<true>(*impl_, batch);
+    trace_many<true>(*impl_, rays);
   } else {
-    trace_many<false>(*impl_, batch);
+    trace_many<false>(*impl_, rays);
   }
 }
 

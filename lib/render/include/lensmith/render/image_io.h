@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <optional>
 #include <ostream>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -131,6 +132,12 @@ struct DepthReadOptions {
 // what read_depth does per pixel. NaN where the value names no point in front of the camera (z <= 0
 // comes back as it is; the caller decides).
 double planar_depth_m(double value, const DepthReadOptions& options, const PinholeFrame& frame, int x, int y);
+
+// Depth values of `frame`'s pixels (row-major, top row first, as read_depth reads them from a file)
+// as planar depth z in metres (+inf = infinitely far), with invalid values handled as `options` says.
+// `where` names the values in errors ("depth.exr channel Z"). Throws ImageFileError.
+DepthMap depth_map_from_values(std::span<const float> values, const DepthReadOptions& options, const PinholeFrame& frame,
+                               const std::string& where);
 
 // Reads one channel of a depth file as planar depth z in metres (+inf = infinitely far), pixel
 // (x, y) of the map belonging to pixel (x, y) of `frame`; Distance is converted with the frame's

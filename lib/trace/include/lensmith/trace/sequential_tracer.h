@@ -63,6 +63,33 @@ struct RayBatch {
   Ray get(std::size_t i) const;
 };
 
+// A batch in memory the caller owns (the numpy arrays of the Python module, a renderer's buffers):
+// trace_batch() reads ray i from the inputs and writes it to the outputs, without a copy into a
+// RayBatch. Coordinate arrays are strided: ray i's x is x_mm[i * stride], so rows of (x, y, z) are
+// x_mm = p, y_mm = p + 1, z_mm = p + 2 with stride 3, and separate arrays have stride 1. Outputs may
+// be the inputs (traced in place). A wavelength_stride of 0 gives every ray wavelength_nm[0].
+struct RayBatchView {
+  std::size_t count = 0;
+  const double* x_mm = nullptr;  // positions
+  const double* y_mm = nullptr;
+  const double* z_mm = nullptr;
+  const double* l = nullptr;     // directions (normalised when not unit)
+  const double* m = nullptr;
+  const double* n = nullptr;
+  std::ptrdiff_t stride = 1;     // between consecutive rays' inputs, in doubles
+  const double* wavelength_nm = nullptr;
+  std::ptrdiff_t wavelength_stride = 1;
+  double* x_out_mm = nullptr;    // the rays after the lens (as TraceResult::ray; as given when invalid)
+  double* y_out_mm = nullptr;
+  double* z_out_mm = nullptr;
+  double* l_out = nullptr;
+  double* m_out = nullptr;
+  double* n_out = nullptr;
+  std::ptrdiff_t out_stride = 1;
+  RayStatus* status = nullptr;   // count entries each
+  int* surface = nullptr;
+};
+
 class SequentialTracer {
  public:
   // Precomputes surface positions and, per wavelength met, the refractive indices. Throws
@@ -80,6 +107,8 @@ class SequentialTracer {
 
   // Traces every ray of `batch` in `direction`, multi-threaded (OpenMP), without allocating per ray.
   void trace_batch(RayBatch& batch, TraceDirection direction) const;
+  // The same on arrays the caller owns; throws OptionsError for a null pointer or a bad stride.
+  void trace_batch(const RayBatchView& rays, TraceDirection direction) const;
 
   const Prescription& lens() const { return lens_; }
   double vertex_z_mm(int surface) const;  // 1-based

@@ -1,0 +1,49 @@
+// The JSON form of lensmith's results: first-order data, the 64-wavelength table, Seidel sums,
+// spot diagrams, ray fans, distortion, field curves, chromatic focal shift, relative illumination,
+// the unvignetted pupil and polynomial fits. One schema (docs/cli.md), written by the command's
+// --json and read by the Python module, so that both always say the same thing.
+//
+// Units are in the key names (mm, um, nm, deg, sr). JSON has no infinity or NaN: a non-finite
+// number (a distance at infinity, a ray that died) is written as null.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+namespace lensmith {
+
+struct Prescription;
+class ParaxialSystem;
+class ParaxialSpectralTable;
+class SeidelAnalysis;
+struct SpotDiagram;
+struct RayFan;
+struct DistortionCurve;
+struct FieldCurves;
+struct ChromaticFocalShift;
+struct RelativeIllumination;
+struct PupilShape;
+class LensFit;
+
+using ojson = nlohmann::ordered_json;
+
+// `v`, or null when it is not finite.
+ojson number_or_null(double v);
+
+// `lensmith info --json`: the system at one wavelength and object distance.
+ojson info_json(const Prescription& lens, const ParaxialSystem& system);
+// `lensmith info --spectral --json`'s "spectral": one row per tabulated wavelength.
+ojson spectral_json(const ParaxialSpectralTable& table);
+// `lensmith seidel --json`: sums per surface and in total, and every form derived from them.
+ojson seidel_json(const Prescription& lens, const SeidelAnalysis& seidel);
+ojson spot_json(const SpotDiagram& diagram);
+ojson fan_json(const RayFan& fan);
+// `lensmith analyze --what ... --json`.
+ojson distortion_json(const DistortionCurve& curve);
+ojson field_curves_json(const FieldCurves& curves);
+ojson focal_shift_json(const ChromaticFocalShift& shift);
+ojson illumination_json(const RelativeIllumination& illumination);
+ojson pupil_json(const PupilShape& shape);
+// `lensmith fit --json` without the output file name: the fit, its held-out errors and its timing.
+ojson fit_json(const LensFit& fit);
+
+}  // namespace lensmith

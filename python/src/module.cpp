@@ -1,0 +1,95 @@
+// The extension module `lensmith._lensmith`: lensmith's typed errors as Python exceptions, and the
+// bindings of each part of the library (docs/python.md).
+#include <pybind11/pybind11.h>
+
+#include "bindings.h"
+#include "lensmith/core/errors.h"
+#include "lensmith/imageio/raster.h"
+#include "lensmith/polyfit/polynomial.h"
+#include "lensmith/scene/scene_error.h"
+
+namespace lensmith::python {
+
+std::string dump(const ojson& o) { return o.dump(); }
+
+namespace {
+
+// Raises `type` with the message, and, for errors about a place in a file, the attributes
+// `file`, `line` and `column` (0 when unknown) and `detail` (the message without the place).
+void raise(PyObject* type, const char* message, const SourceLocation* where = nullptr, const std::string* detail = nullptr) {
+  py::object exception = py::reinterpret_borrow<py::object>(type)(message);
+  if (where) {
+    exception.attr("file") = where->file;
+    exception.attr("line") = where->line;
+    exception.attr("column") = where->column;
+    exception.attr("detail") = *detail;
+  }
+  PyErr_SetObject(type, exception.ptr());
+}
+
+}  // namespace
+
+}  // namespace lensmith::python
+
+PYBIND11_MODULE(_lensmith, m) {
+  namespace py = pybind11;
+  using namespace lensmith;
+  using namespace lensmith::python;
+  m.doc() = "lensmith's C++ libraries (docs/python.md); use the `lensmith` package, which wraps this module.";
+  m.attr("__version__") = LENSMITH_VERSION;
+
+  // The hierarchy of errors.h: every lensmith error is a lensmith.Error; those about the caller's
+  // values are also ValueError, those of the operating system also OSError.
+  static py::exception<Error> error(m, "Error", PyExc_RuntimeError);
+  static py::exception<LensFileError> lens_file_error(m, "LensFileError", error.ptr());
+  static py::exception<GlassError> glass_error(m, "GlassError", error.ptr());
+  static py::exception<PrescriptionError> prescription_error(m, "PrescriptionError", error.ptr());
+  static py::object options_error_type = py::reinterpret_steal<py::object>(
+      PyErr_NewException("_lensmith.OptionsError", py::make_tuple(error, py::handle(PyExc_ValueError)).ptr(), nullptr));
+  m.attr("OptionsError") = options_error_type;
+  static py::object usage_error_type =
+      py::reinterpret_steal<py::object>(PyErr_NewException("_lensmith.UsageError", options_error_type.ptr(), nullptr));
+  m.attr("UsageError") = usage_error_type;
+  static py::exception<ComputationError> computation_error(m, "ComputationError", error.ptr());
+  static py::object io_error_type = py::reinterpret_steal<py::object>(
+      PyErr_NewException("_lensmith.IoError", py::make_tuple(error, py::handle(PyExc_OSError)).ptr(), nullptr));
+  m.attr("IoError") = io_error_type;
+  static py::exception<ImageFileError> image_file_error(m, "ImageFileError", error.ptr());
+  static py::exception<FitError> fit_error(m, "FitError", error.ptr());
+  static py::exception<SceneError> scene_error(m, "SceneError", error.ptr());
+  static py::exception<SceneFileError> scene_file_error(m, "SceneFileError", error.ptr());
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const LensFileError& e) {
+      raise(lens_file_error.ptr(), e.what(), &e.where(), &e.what_without_location());
+    } catch (const SceneFileError& e) {
+      raise(scene_file_error.ptr(), e.what(), &e.where(), &e.what_without_location());
+    } catch (const GlassError& e) {
+      raise(glass_error.ptr(), e.what());
+    } catch (const PrescriptionError& e) {
+      raise(prescription_error.ptr(), e.what());
+    } catch (const UsageError& e) {
+      raise(usage_error_type.ptr(), e.what());
+    } catch (const OptionsError& e) {
+      raise(options_error_type.ptr(), e.what());
+    } catch (const ComputationError& e) {
+      raise(computation_error.ptr(), e.what());
+    } catch (const IoError& e) {
+      raise(io_error_type.ptr(), e.what());
+    } catch (const ImageFileError& e) {
+      raise(image_file_error.ptr(), e.what());
+    } catch (const FitError& e) {
+      raise(fit_error.ptr(), e.what());
+    } catch (const SceneError& e) {
+      raise(scene_error.ptr(), e.what());
+    } catch (const Error& e) {
+      raise(error.ptr(), e.what());
+    }
+  });
+
+  bind_lens(m);
+  bind_analysis(m);
+  bind_trace(m);
+  bind_render(m);
+}
