@@ -351,19 +351,24 @@ class Lens:
 
     # -- real rays
     def trace(self, origins_mm, directions, wavelengths_nm=None, direction="forward", image="prescribed",
-              image_distance_mm=None, clip_apertures=True):
+              image_distance_mm=None, clip_apertures=True, out=None):
         """Exact rays through the lens, many at once (the batch tracer, on every core, GIL released).
 
         origins_mm, directions: float64 arrays (N, 3) in the lens frame (z = 0 at surface 1, +z toward
         the image; directions unit vectors); wavelengths_nm: a number or a float64 array (N,), default
         the primary wavelength. direction 'forward' (object side to the image plane) or 'backward'
-        (from the image side, travelling -z, to surface 1)."""
+        (from the image side, travelling -z, to surface 1). out: a TraceResult of as many rays whose
+        arrays are reused (written over and returned): in a loop, it saves allocating the outputs."""
         if wavelengths_nm is None:
             wavelengths_nm = self.primary_wavelength_nm
         elif isinstance(wavelengths_nm, (int, float, _np.floating, _np.integer)):
             wavelengths_nm = float(wavelengths_nm)
-        return TraceResult(*_lensmith.trace(self._handle, origins_mm, directions, wavelengths_nm, direction, image,
-                                            _m(image_distance_mm), bool(clip_apertures)))
+        reuse = None if out is None else (out.positions_mm, out.directions, out.status, out.surface)
+        arrays = _lensmith.trace(self._handle, origins_mm, directions, wavelengths_nm, direction, image, _m(image_distance_mm),
+                                 bool(clip_apertures), reuse)
+        if out is not None:
+            return out
+        return TraceResult(*arrays)
 
     def _real(self, fields, wavelengths_nm, field_angle_deg, image, aim):
         return dict(fields=[float(f) for f in fields], wavelengths_nm=[float(w) for w in (wavelengths_nm or [])],

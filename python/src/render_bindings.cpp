@@ -210,6 +210,12 @@ py::array_t<float> render(const py::array& image, const py::array& depth, py::di
     fit->check_matches(*cam->lens());
     model_options.fit = std::move(fit);
   }
+  if (kind == RayModelKind::Poly && !model_options.fit) {
+    // A fit made for this render, as the command makes it: the camera's f-number and a sensor radius
+    // covering its frame.
+    py::gil_scoped_release release;
+    model_options.fit = std::make_shared<const LensFit>(LensFit::fit(*cam->lens(), lens_fit_options_for(*cam)));
+  }
   const Aperture aperture = make_aperture(r);
   const int threads = r.get<int>("threads", 0);
   const bool vignetting = r.get<bool>("vignetting", true);

@@ -101,3 +101,17 @@ def test_invalid_rays_are_reported_not_traced():
     directions = np.array([[0.0, 0.0, 1.0], [0.0, 0.0, 1.0]])
     result = lens.trace(origins, directions)
     assert [lensmith.RAY_STATUS[s] for s in result.status] == ["ok", "invalid_input"]
+
+
+def test_out_reuses_the_arrays_of_an_earlier_result_and_gives_the_same_rays():
+    lens = lensmith.Lens.load("sasian-triplet")
+    origins, directions = parallel_beam(np.linspace(-6, 6, 101))
+    fresh = lens.trace(origins, directions)
+    reused = lens.trace(origins[::-1].copy(), directions)
+    kept = reused.positions_mm
+    again = lens.trace(origins, directions, out=reused)
+    assert again is reused and again.positions_mm is kept
+    assert np.array_equal(again.positions_mm, fresh.positions_mm)
+    assert np.array_equal(again.status, fresh.status)
+    with pytest.raises(ValueError, match="out"):
+        lens.trace(origins[:50], directions[:50], out=reused)  # another number of rays
