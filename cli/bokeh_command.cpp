@@ -16,6 +16,7 @@
 #include "lensmith/core/number_parsing.h"
 #include "lensmith/core/units.h"
 #include "lensmith/imageio/deep_raster.h"
+#include "lensmith/imageio/frame_sequence.h"
 #include "lensmith/imageio/image_file.h"
 #include "lensmith/paraxial/paraxial_system.h"
 #include "lensmith/render/bokeh_renderer.h"
@@ -145,6 +146,12 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   }
   for (const std::string& name : o.gather_options) {
     if (!traced && (name == "--scene" || name == "--trace-rays")) throw UsageError(name + " is for --method gather --hidden trace");
+  }
+  // A sequence's pattern without --frames names no file: say what is missing rather than "cannot open".
+  for (const std::string* path : {&o.image, &o.output}) {
+    if (FramePattern::find(*path) && !std::filesystem::exists(*path)) {
+      throw UsageError(*path + " names a sequence (its frame field): give --frames, e.g. --frames 1001-1100 (docs/sequences.md)");
+    }
   }
   // Inputs.
   const std::filesystem::path output = o.output;

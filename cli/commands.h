@@ -29,6 +29,7 @@ inline constexpr int kExitInput = 3;         // a lens file, glass or option val
 inline constexpr int kExitComputation = 4;   // the lens has no answer (e.g. afocal: no focal length)
 inline constexpr int kExitIo = 5;            // a file could not be read or written
 inline constexpr int kExitThreshold = 6;     // lensmith validate: a declared threshold was missed
+inline constexpr int kExitFrames = 7;        // lensmith bokeh --frames: some frames failed (the others were written)
 inline constexpr int kExitInternal = 70;     // a bug: please report it
 
 struct GlobalOptions {
@@ -185,8 +186,17 @@ struct BokehCommandOptions {
   std::string scene;                         // --scene FILE (gather --hidden trace): the analytic scene the picture shows
   int trace_rays = 256;                       // --trace-rays (gather --hidden trace)
   std::vector<std::string> gather_options;      // gather-only options given
+  // A shot (docs/sequences.md): patterns in --image, --depth and -o, rendered frame by frame.
+  std::string frames;                        // --frames LIST: 1001-1100, 1001-1100x2, 1,5,10-20
+  std::string chunk;                         // --chunk I/N: only the I-th (0-based) of N contiguous chunks of the frames
+  std::string curves;                        // --curves FILE: per-frame focus_m, fstop, focal_length_mm, pinhole_focal_length_mm
+  bool skip_existing = false;                // --skip-existing: frames whose output exists are not rendered again
 };
+// One picture; a sequence when --frames is given (run_bokeh_sequence).
 int run_bokeh(const BokehCommandOptions& options, const GlobalOptions& global);
+// Every frame of a shot through run_bokeh, each on its own: a failing frame is reported with its
+// number and leaves no file, the others go on; a summary at the end; kExitFrames when any failed.
+int run_bokeh_sequence(const BokehCommandOptions& options, const GlobalOptions& global);
 
 struct ValidateCommandOptions {
   std::string lens;

@@ -345,6 +345,18 @@ int main(int argc, char** argv) {
   bokeh_scatter_only.push_back(bokeh_cmd->add_option("--max-blur", bokeh.max_blur_px, "Largest blur diameter, px; nearer points are clamped (default 1000)")
       ->check(range(1.0, 1.0e6)));
   bokeh_cmd->add_option("--threads", bokeh.threads, "Threads (default 0 = all cores)")->check(range(0, 4096));
+  CLI::Option* bokeh_frames = bokeh_cmd->add_option(
+      "--frames", bokeh.frames,
+      "Render a shot: these frames (1001-1100, 1001-1100x2, 1,5,10-20) of the sequences --image, --depth and -o name "
+      "(shot.####.exr, shot.%04d.exr, shot.@@@@.exr; docs/sequences.md)");
+  bokeh_cmd->add_option("--chunk", bokeh.chunk, "With --frames: only chunk I (0-based) of N contiguous chunks of the frames, I/N (a farm task)")
+      ->needs(bokeh_frames);
+  bokeh_cmd->add_option("--curves", bokeh.curves,
+                        "With --frames: per-frame camera values from keyframes, a .json or .csv file of focus_m, fstop, focal_length_mm "
+                        "(thin lens), pinhole_focal_length_mm curves")
+      ->needs(bokeh_frames)->check(CLI::ExistingFile);
+  bokeh_cmd->add_flag("--skip-existing", bokeh.skip_existing, "With --frames: leave frames whose output exists (a resumed shot)")
+      ->needs(bokeh_frames);
 
   ValidateCommandOptions validate;
   CLI::App* validate_cmd = app.add_subcommand(
@@ -538,7 +550,7 @@ int main(int argc, char** argv) {
       }
       // --hidden is scatter's (extend, stretch) and gather's (trace).
       if (bokeh_hidden->count() > 0 && bokeh.method != "gather") bokeh.scatter_options.push_back(bokeh_hidden->get_name());
-      return run_bokeh(bokeh, global);
+      return bokeh.frames.empty() ? run_bokeh(bokeh, global) : run_bokeh_sequence(bokeh, global);
     }
     if (*validate_cmd) return run_validate(validate, global);
     if (*scene_render_cmd) return run_scene_render(scene_render, global);
