@@ -20,6 +20,7 @@
 #include "lensmith/imageio/image_file.h"
 #include "lensmith/paraxial/paraxial_system.h"
 #include "lensmith/render/bokeh_renderer.h"
+#include "lensmith/render/camera_metadata.h"
 #include "lensmith/render/deep_image.h"
 #include "lensmith/render/image_io.h"
 #include "lensmith/render/ewa_renderer.h"
@@ -92,11 +93,23 @@ void note_uncovered_without_alpha(const BokehCommandOptions& o, const GlobalOpti
 OutputMetadata output_metadata(const BokehCommandOptions& o, const std::string& lens_name, RayModelKind kind, const Camera& camera,
                                double focus_m, const Aperture& aperture) {
   OutputMetadata meta;
+  // An OpenEXR input's windows (overscan) are the output's.
+  const RasterInfo input = is_deep_image(o.image) ? RasterInfo{} : read_raster_info(o.image);
+  if (input.has_overscan()) {
+    meta.data_window = input.data_window;
+    meta.display_window = input.display_window;
+  }
   meta.lens = lens_name;
   meta.model = std::string(to_string(kind));
   meta.lensmith_version = LENSMITH_VERSION;
   meta.f_number = camera.f_number();
   meta.focus_m = focus_m;
+  // The lens's real values in OpenEXR's standard attributes: focus from the image plane (mm -> m),
+  // the f-number, the focal length and the image plane to entrance pupil distance (mm).
+  const double pupil_offset_mm = camera.z_sensor_mm() - camera.z_perspective_mm();
+  meta.camera = {{"focus", focus_m + m_from_mm(pupil_offset_mm)}, {"aperture", camera.f_number()},
+                 {"focalLength", camera.first_order(camera.reference_wavelength_nm()).efl_mm}, {"entrancePupilOffset", pupil_offset_mm}};
+  if (!std::isfinite(focus_m)) meta.camera.erase(meta.camera.begin());
   meta.extra = {{"aperture", aperture.to_string()}, {"method", o.method},
                 {"vignetting", o.no_vignetting ? "off" : "natural"},
                 {"spectral", o.no_spectral ? std::string("off") : std::to_string(o.spectral_samples) + " nodes"}};
@@ -241,7 +254,8 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   camera.framing.focal_length_mm = o.pinhole_focal_length_mm;
   camera.framing.horizontal_fov_deg = o.hfov_deg;
   std::vector<std::string> from_file;
-  for (const auto& [key, value] : read_image_metadata(o.image)) {
+  const std::vector<std::pair<std::string, std::string>> attributes = read_image_metadata(o.image);
+  for (const auto& [key, value] : attributes) {
     const std::optional<double> number = parse_finite_number(value);
     if (!number || !(*number > 0.0)) continue;
     if (key == "lensmith:focal_length_mm" && !o.pinhole_focal_length_mm && !o.hfov_deg) {
@@ -258,6 +272,33 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     for (std::size_t i = 0; i < from_file.size(); ++i) std::cerr << (i ? "," : "") << " " << from_file[i];
     std::cerr << " (its lensmith attributes; the flags override them)\n";
   }
+  // The camera the file says made it (OpenEXR's standard attributes, Unreal's keys): what the flags
+  // and lensmith's own attributes leave open.
+  const CameraMetadata metadata = camera_metadata_from(attributes);
+  std::vector<std::string> used;
+  if (!o.f_number && metadata.f_number) {
+    camera.f_number = metadata.f_number;
+    used.push_back("f-number " + format_number(*metadata.f_number));
+  }
+  if (!camera.framing.focal_length_mm && !o.hfov_deg && metadata.focal_length_mm) {
+    camera.framing.focal_length_mm = metadata.focal_length_mm;
+    used.push_back("focal length " + format_number(*metadata.focal_length_mm) + " mm (the framing)");
+  }
+  if (!o.sensor_width_mm && metadata.sensor_width_mm &&
+      std::none_of(attributes.begin(), attributes.end(), [](const auto& a) { return a.first == "lensmith:sensor_width_mm"; })) {
+    camera.framing.sensor_width_mm = *metadata.sensor_width_mm;
+    used.push_back("sensor width " + format_number(*metadata.sensor_width_mm) + " mm");
+  }
+  std::optional<double> thin_focal_mm = o.focal_length_mm;
+  if (o.thin_lens && !thin_focal_mm && metadata.focal_length_mm) {
+    thin_focal_mm = metadata.focal_length_mm;
+    used.push_back("thin-lens focal length " + format_number(*metadata.focal_length_mm) + " mm");
+  }
+  std::optional<int> blades = o.blades;
+  if (!o.blades && o.aperture_image.empty() && metadata.blades) {
+    blades = metadata.blades;
+    used.push_back(std::to_string(*metadata.blades) + " blades");
+  }
   std::string lens_name;
   RayModelKind kind = o.model.empty() ? (o.thin_lens ? RayModelKind::Thin : RayModelKind::Seidel) : parse_ray_model_kind(o.model);
   // The lens (or thin lens) and the focal length the framing defaults to.
@@ -267,22 +308,43 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     if (kind != RayModelKind::Thin) {
       throw UsageError("--thin-lens has no prescription: only --model thin applies (got --model " + o.model + ")");
     }
-    if (!o.focal_length_mm) throw UsageError("--thin-lens needs --focal-length MM");
-    default_focal_mm = *o.focal_length_mm;
-    lens_name = "thin lens f = " + format_rounded(*o.focal_length_mm, 6) + " mm";
+    if (!thin_focal_mm) throw UsageError("--thin-lens needs --focal-length MM (or a focalLength attribute in the picture)");
+    default_focal_mm = *thin_focal_mm;
+    lens_name = "thin lens f = " + format_rounded(*thin_focal_mm, 6) + " mm";
   } else {
     if (o.lens.empty()) throw UsageError("give --lens LENS (a file or shipped lens name) or --thin-lens --focal-length MM");
     lens = load_lens(o.lens, global);
     lens_name = lens->name.empty() ? o.lens : lens->name;
     default_focal_mm = ParaxialSystem(*lens).efl_mm();
   }
-  if (!o.focus_m && o.focus_pixel.empty()) throw UsageError("give --focus M (metres) or --focus-pixel X,Y");
+  if (!o.focus_m && o.focus_pixel.empty() && !metadata.focus_from_pupil_m && !metadata.focus_from_image_plane_m) {
+    throw UsageError("give --focus M (metres) or --focus-pixel X,Y (the picture has no focus attribute)");
+  }
   DepthReadOptions depth_options;
   depth_options.kind = parse_depth_kind(o.depth_kind);
   depth_options.unit = parse_depth_unit(o.depth_unit);
   depth_options.invalid = parse_invalid_depth(o.invalid_depth);
   // The camera's framing is the pinhole frame the depth is read in (Camera::from_lens and thin_lens
   // build the same one).
+  // Overscan: pixels beyond the frame, which light from outside it reaches the frame through. The
+  // framing (sensor width, focal length, field of view) is the display window's; the pictures are
+  // the data window, framed with the same focal length in pixels.
+  const RasterInfo windows = layered ? RasterInfo{} : read_raster_info(o.image);
+  if (windows.has_overscan()) {
+    const PixelBox& data = windows.data_window;
+    const PixelBox& shown = windows.display_window;
+    if (shown.min_x - data.min_x != data.max_x - shown.max_x || shown.min_y - data.min_y != data.max_y - shown.max_y) {
+      throw ImageFileError(o.image + ": data window " + data.to_string() + " around display window " + shown.to_string() +
+                           ": overscan that is not the same on both sides (the lens's axis off the data window's centre) is not implemented");
+    }
+    const double focal_px = PinholeFrame::from_options(shown.width(), shown.height(), camera.framing, default_focal_mm).focal_length_px();
+    camera.framing = PinholeFrameOptions{};
+    camera.framing.focal_length_mm = focal_px * camera.framing.sensor_width_mm / width;
+    if (!global.quiet) {
+      std::cerr << "note: " << o.image << " has overscan: data window " << data.to_string() << " around the frame " << shown.to_string()
+                << "; the pixels outside the frame are photographed too (their light reaches the frame)\n";
+    }
+  }
   const PinholeFrame frame = PinholeFrame::from_options(width, height, camera.framing, default_focal_mm);
   std::optional<DeepImage> deep;
   if (layered) deep = read_deep_image(o.image, depth_options, frame);
@@ -302,10 +364,27 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     const float z = depth.at(static_cast<int>(*x), static_cast<int>(*y));
     camera.focus_distance_m = z;
     if (!global.quiet) std::cerr << "note: focus " << format_rounded(z, 5) << " m, the depth at pixel (" << o.focus_pixel << ")\n";
-  } else {
+  } else if (o.focus_m) {
     camera.focus_distance_m = *o.focus_m;
+  } else if (metadata.focus_from_pupil_m) {
+    camera.focus_distance_m = *metadata.focus_from_pupil_m;
+    used.push_back("focus " + format_number(camera.focus_distance_m) + " m from the camera");
+  } else {
+    // OpenEXR's focus is measured from the image plane; lensmith's from the entrance pupil.
+    const double d = *metadata.focus_from_image_plane_m;
+    camera.focus_distance_m = metadata.entrance_pupil_offset_mm
+                                  ? d - m_from_mm(*metadata.entrance_pupil_offset_mm)
+                                  : pupil_focus_distance_m(kind, lens ? &*lens : nullptr, o.thin_lens ? thin_focal_mm : std::nullopt, camera,
+                                                           width, height, d);
+    used.push_back("focus " + format_number(d) + " m from the image plane = " + format_rounded(camera.focus_distance_m, 6) +
+                   " m from the entrance pupil" + (metadata.entrance_pupil_offset_mm ? " (its entrancePupilOffset)" : " (the lens's)"));
   }
-  std::optional<Camera> cam = camera_for_model(kind, lens ? &*lens : nullptr, o.thin_lens ? o.focal_length_mm : std::nullopt, camera,
+  if (!used.empty() && !global.quiet) {
+    std::cerr << "note: camera from " << o.image << "'s metadata:";
+    for (std::size_t i = 0; i < used.size(); ++i) std::cerr << (i ? "," : "") << " " << used[i];
+    std::cerr << " (the flags override it)\n";
+  }
+  std::optional<Camera> cam = camera_for_model(kind, lens ? &*lens : nullptr, o.thin_lens ? thin_focal_mm : std::nullopt, camera,
                                                width, height);
   if (!cam->is_thin_lens()) warn_about_aperture(*cam, global);
   float nearest_m = std::numeric_limits<float>::infinity();
@@ -316,7 +395,9 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   if (!o.thin_lens) model_options.fit = fit_for_models({kind}, *cam, o.fit, global);
   else if (!o.fit.empty()) throw UsageError("--fit is for --model poly with --lens");
   const auto model = make_ray_model(kind, *cam, model_options);
-  const Aperture aperture = make_aperture(o);
+  BokehCommandOptions aperture_options = o;
+  aperture_options.blades = blades;
+  const Aperture aperture = make_aperture(aperture_options);
 
   if (o.method != "scatter" && o.other_channels == "defocus" && !other.names.empty()) {
     throw UsageError("--other-channels defocus with --method " + o.method + ": not implemented (use keep or drop, or --method scatter)");

@@ -378,3 +378,17 @@ TEST_CASE("An f-number whose stop would be wider than its surface is refused, na
   }
   CHECK_NOTHROW(Camera::from_lens(lens, options(3.0, 0.78), 640, 360));
 }
+
+TEST_CASE("a focus distance from the image plane becomes the thin lens's distance from its pupil: s + f s / (s - f) = D",
+          "[camera][focus]") {
+  // Thin lens (Hecht, Optics, 5.2.3): object at s from the lens images at v = f s / (s - f); the lens is
+  // its own pupil, so the image plane is v behind it and D = s + v.
+  const double f = 50.0, s_m = 1.2;
+  const double d_m = s_m + f * s_m * 1000.0 / (s_m * 1000.0 - f) / 1000.0;
+  lensmith::CameraOptions options;
+  options.f_number = 2.0;
+  const double solved = lensmith::pupil_focus_distance_m(lensmith::RayModelKind::Thin, nullptr, f, options, 64, 36, d_m);
+  CHECK(solved == Approx(s_m).epsilon(1e-10));
+  CHECK_THROWS_AS(lensmith::pupil_focus_distance_m(lensmith::RayModelKind::Thin, nullptr, f, options, 64, 36, 0.1),
+                  lensmith::ComputationError);
+}

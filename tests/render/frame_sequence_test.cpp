@@ -48,3 +48,28 @@ TEST_CASE("chunks cover every frame once, in order, in near-equal parts", "[imag
   CHECK(lensmith::frame_chunk(frames, 4, 20).size() <= 1);
   CHECK_THROWS_AS(lensmith::frame_chunk(frames, 3, 3), lensmith::OptionsError);
 }
+
+#include "lensmith/render/camera_metadata.h"
+
+TEST_CASE("camera metadata: OpenEXR's standard attributes and Unreal's keys, Unreal winning, bad values ignored", "[render][metadata]") {
+  const lensmith::CameraMetadata exr = lensmith::camera_metadata_from(
+      {{"focus", "2.5"}, {"FNumber", "2.8"}, {"focalLength", "35"}, {"pinholeFocalLength", "36"}, {"entrancePupilOffset", "-12"},
+       {"sensorOverallDimensions", "24.9, 18.7"}});
+  CHECK(exr.focus_from_image_plane_m == 2.5);
+  CHECK(exr.f_number == 2.8);
+  CHECK(exr.focal_length_mm == 36.0);  // pinholeFocalLength is the framing's
+  CHECK(exr.entrance_pupil_offset_mm == -12.0);
+  CHECK(exr.sensor_width_mm == 24.9);
+  CHECK_FALSE(exr.focus_from_pupil_m.has_value());
+  const lensmith::CameraMetadata both = lensmith::camera_metadata_from(
+      {{"focus", "2.5"}, {"FNumber", "2.8"}, {"unreal/camera/FinalImage/focalDistance", "300"}, {"unreal/camera/FinalImage/fstop", "4"},
+       {"unreal/camera/FinalImage/dofDiaphragmBladeCount", "7"}, {"unreal/camera/FinalImage/sensorWidth", "23.76"}});
+  CHECK(both.focus_from_pupil_m == 3.0);  // cm
+  CHECK_FALSE(both.focus_from_image_plane_m.has_value());
+  CHECK(both.f_number == 4.0);
+  CHECK(both.blades == 7);
+  CHECK(both.sensor_width_mm == 23.76);
+  const lensmith::CameraMetadata bad = lensmith::camera_metadata_from(
+      {{"focus", "-1"}, {"FNumber", "nan"}, {"unreal/camera/FinalImage/dofDiaphragmBladeCount", "2"}, {"focalLength", "abc"}});
+  CHECK(bad.empty());
+}

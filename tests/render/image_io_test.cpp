@@ -758,7 +758,7 @@ TEST_CASE("half-float OpenEXR channels read as the IEEE 754 binary16 values they
   CHECK(read_depth(DepthSource{dir / "half_z.exr", ""}, {}, small_frame()).at(3, 2) == 2.5f);
 }
 
-TEST_CASE("an OpenEXR whose data window is not its display window is refused", "[render][image_io]") {
+TEST_CASE("an OpenEXR cropped inside its display window is refused (overscan, the other way, is read)", "[render][image_io]") {
   TempDir dir;
   // Display window 4 x 3 at (0, 0); pixels stored for the 2 x 3 columns 1 and 2 only (a crop).
   const Imath::Box2i display(Imath::V2i(0, 0), Imath::V2i(3, 2));
@@ -775,8 +775,22 @@ TEST_CASE("an OpenEXR whose data window is not its display window is refused", "
   }
   CHECK_THROWS_AS(read_radiance_image(dir / "crop.exr"), ImageFileError);
   CHECK_THROWS_WITH(read_radiance_image(dir / "crop.exr"),
-                    Contains("data window 2 x 3 at (1, 0) differs from the display window 4 x 3 at (0, 0)") &&
-                        Contains("without a crop or overscan"));
+                    Contains("data window 2 x 3 at (1, 0) does not cover the display window 4 x 3 at (0, 0)") && Contains("cropped"));
+  // The same pixels as overscan around a 1 x 1 frame: read whole, with both windows known.
+  const Imath::Box2i frame_window(Imath::V2i(1, 1), Imath::V2i(1, 1));
+  Imf::Header overscan(frame_window, data);
+  overscan.channels().insert("Y", Imf::Channel(Imf::FLOAT));
+  {
+    Imf::OutputFile out((dir / "overscan.exr").c_str(), overscan);
+    out.setFrameBuffer(frame);
+    out.writePixels(3);
+  }
+  const lensmith::RasterInfo info = lensmith::read_raster_info(dir / "overscan.exr");
+  CHECK(info.width == 2);
+  CHECK(info.height == 3);
+  CHECK(info.has_overscan());
+  CHECK(info.display_window == lensmith::PixelBox{1, 1, 1, 1});
+  CHECK(read_radiance_image(dir / "overscan.exr").data == std::vector<float>(18, 1.0f));
 }
 
 TEST_CASE("an OpenEXR whose header attribute claims more bytes than the file holds is an IoError naming it, before any allocation",
@@ -1133,4 +1147,14 @@ TEST_CASE("a file in no format lensmith reads is an IoError naming it and listin
                                                   Contains("PNG") && Contains("JPEG") && Contains("Radiance HDR") &&
                                                   Contains("PFM"));
   CHECK_THROWS_AS(read_image_metadata(gif), IoError);
+}
+
+TEST_CASE("a PNM header number too long for stb_image's int is refused before stb reads it", "[render][image_io]") {
+  // Found by tests/fuzz's exr_image target: "P5" and 110 fives overflowed stb_image's header parser.
+  const fs::path file = fs::path(LENSMITH_SOURCE_DIR) / "tests/fuzz/corpus/exr_image/pnm-header-overflow.pnm";
+  CHECK_THROWS_WITH(read_radiance_image(file), Contains("not a picture lensmith can read"));
+  // With whitespace after the magic it is a PNM header, refused by the number's length.
+  TempDir dir;
+  std::ofstream(dir / "long.pnm") << "P5 " << std::string(12, '5') << " 2\n255\n";
+  CHECK_THROWS_WITH(read_radiance_image(dir / "long.pnm"), Contains("more than nine digits"));
 }

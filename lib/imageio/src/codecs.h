@@ -36,7 +36,7 @@ Raster read_exr(const fs::path& path, const RasterInfo& info, std::span<const in
 Metadata read_exr_metadata(const fs::path& path);
 void write_exr_file(const fs::path& path, const std::string& file, const PixelsView<float>& pixels,
                     const std::vector<std::string>& channel_names,
-                    const std::vector<ImageAttribute>& attributes);
+                    const std::vector<ImageAttribute>& attributes, const std::optional<std::pair<PixelBox, PixelBox>>& windows = {});
 
 // TIFF (tiff_codec.cpp).
 RasterInfo read_tiff_info(const fs::path& path);

@@ -76,6 +76,8 @@ void insert_attributes(Imf::Header& header, const std::vector<ImageAttribute>& a
   for (const ImageAttribute& attribute : attributes) {
     if (const auto* text = std::get_if<std::string>(&attribute.value)) {
       header.insert(exr_name(attribute.name), Imf::StringAttribute(*text));
+    } else if (attribute.exr_float) {
+      header.insert(exr_name(attribute.name), Imf::FloatAttribute(static_cast<float>(std::get<double>(attribute.value))));
     } else {
       header.insert(exr_name(attribute.name), Imf::DoubleAttribute(std::get<double>(attribute.value)));
     }
@@ -322,7 +324,15 @@ RasterInfo info_from_header(const fs::path& path, const Imf::Header& header) {
     throw ImageFileError(path.string() + ": image of " + std::to_string(info.width) + " x " + std::to_string(info.height) +
                          " pixels and no channels: not a 2-D picture");
   }
-  check_windows(path, header);
+  info.data_window = {data.min.x, data.min.y, data.max.x, data.max.y};
+  const Imath::Box2i display = header.displayWindow();
+  info.display_window = {display.min.x, display.min.y, display.max.x, display.max.y};
+  if (!info.data_window.contains(info.display_window)) {
+    // A crop (or a window beside the frame): the missing part of the frame has no pixels to photograph.
+    throw ImageFileError(path.string() + ": data window " + info.data_window.to_string() + " does not cover the display window " +
+                         info.display_window.to_string() + ": a cropped image; save it uncropped (overscan, a data window larger "
+                         "than the display window, is read)");
+  }
   check_size(path, info.width, info.height);
   for (const std::string& name : canonical_order(header.channels())) {
     const Imf::Channel& channel = header.channels()[name];
@@ -420,7 +430,8 @@ Metadata read_exr_metadata(const fs::path& path) {
 }
 
 void write_exr_file(const fs::path& path, const std::string& file, const PixelsView<float>& pixels,
-                    const std::vector<std::string>& channel_names, const std::vector<ImageAttribute>& attributes) {
+                    const std::vector<std::string>& channel_names, const std::vector<ImageAttribute>& attributes,
+                    const std::optional<std::pair<PixelBox, PixelBox>>& windows) {
   std::set<std::string> seen;
   for (const std::string& name : channel_names) {
     if (name.empty() || !seen.insert(name).second) {
@@ -430,6 +441,11 @@ void write_exr_file(const fs::path& path, const std::string& file, const PixelsV
   size_codec_pool();
   try {
     Imf::Header header(pixels.width, pixels.height);
+    if (windows) {
+      const auto box = [](const PixelBox& b) { return Imath::Box2i({b.min_x, b.min_y}, {b.max_x, b.max_y}); };
+      header.dataWindow() = box(windows->first);
+      header.displayWindow() = box(windows->second);
+    }
     header.compression() = Imf::ZIP_COMPRESSION;
     insert_attributes(header, attributes);
     Imf::FrameBuffer frame;

@@ -102,7 +102,15 @@ ImageFormat detect_image_format(const fs::path& path) {
                 kReadableImageFormats);
 }
 
-RasterInfo read_raster_info(const fs::path& path) {
+std::string PixelBox::to_string() const {
+  // In 64 bits: a damaged file's window may span more than an int.
+  const long long w = static_cast<long long>(max_x) - min_x + 1, h = static_cast<long long>(max_y) - min_y + 1;
+  return std::to_string(w) + " x " + std::to_string(h) + " at (" + std::to_string(min_x) + ", " + std::to_string(min_y) + ")";
+}
+
+namespace {
+
+RasterInfo read_format_info(const fs::path& path) {
   const ImageFormat format = detect_image_format(path);
   switch (format) {
     case ImageFormat::Exr: return codecs::read_exr_info(path);
@@ -120,6 +128,18 @@ RasterInfo read_raster_info(const fs::path& path) {
     case ImageFormat::Pnm: return codecs::read_stb_info(path, format);
   }
   throw IoError(path.string() + ": unknown image format");
+}
+
+}  // namespace
+
+RasterInfo read_raster_info(const fs::path& path) {
+  RasterInfo info = read_format_info(path);
+  if (info.data_window.width() < 1) {
+    // A format without windows: both are the picture.
+    info.data_window = PixelBox{0, 0, info.width - 1, info.height - 1};
+    info.display_window = info.data_window;
+  }
+  return info;
 }
 
 namespace {
@@ -221,13 +241,17 @@ std::vector<std::pair<std::string, std::string>> read_image_metadata_pairs(const
 }
 
 void write_exr(const fs::path& path, const PixelsView<float>& pixels, const std::vector<std::string>& channel_names,
-               const std::vector<ImageAttribute>& attributes) {
+               const std::vector<ImageAttribute>& attributes, const std::optional<std::pair<PixelBox, PixelBox>>& windows) {
   check_view(path, pixels, 1, 1 << 16);
   if (channel_names.size() != static_cast<std::size_t>(pixels.channels)) {
     throw OptionsError(path.string() + ": " + std::to_string(channel_names.size()) + " channel names for " +
                        std::to_string(pixels.channels) + " channels");
   }
-  write_through_temporary(path, [&](const std::string& file) { codecs::write_exr_file(path, file, pixels, channel_names, attributes); });
+  if (windows && (windows->first.width() != pixels.width || windows->first.height() != pixels.height)) {
+    throw OptionsError(path.string() + ": data window " + windows->first.to_string() + " for an image of " + std::to_string(pixels.width) +
+                       " x " + std::to_string(pixels.height) + " pixels");
+  }
+  write_through_temporary(path, [&](const std::string& file) { codecs::write_exr_file(path, file, pixels, channel_names, attributes, windows); });
 }
 
 void write_png(const fs::path& path, const PixelsView<std::uint8_t>& pixels, const std::vector<ImageAttribute>& attributes) {

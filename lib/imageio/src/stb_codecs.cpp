@@ -16,6 +16,7 @@
 #include <stb_image_write.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstring>
 #include <fstream>
 #include <memory>
@@ -160,15 +161,44 @@ std::string one_line(std::string text) {
 // Radiance's own name for the program that wrote a picture.
 constexpr const char* kRadianceSoftware = "SOFTWARE";
 
+// stb_image reads a PNM header's numbers into an int without checking for overflow (a "P5" followed
+// by ten digits is undefined behaviour, found by the fuzzer): a header number of more than nine digits
+// is refused here first. Other files pass.
+bool pnm_header_is_sane(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  char head[512] = {};
+  in.read(head, sizeof head);
+  const auto n = static_cast<std::size_t>(in.gcount());
+  if (n < 2 || head[0] != 'P' || head[1] < '1' || head[1] > '7') return true;
+  std::size_t i = 2;
+  for (int number = 0; number < 3 && i < n; ++number) {
+    while (i < n && (std::isspace(static_cast<unsigned char>(head[i])) || head[i] == '#')) {
+      if (head[i] == '#') {
+        while (i < n && head[i] != '\n' && head[i] != '\r') ++i;
+      } else {
+        ++i;
+      }
+    }
+    std::size_t digits = 0;
+    while (i < n && std::isdigit(static_cast<unsigned char>(head[i]))) {
+      ++i;
+      ++digits;
+    }
+    if (digits > 9) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 bool stb_can_decode(const fs::path& path) {
   int width = 0, height = 0, channels = 0;
-  return stbi_info(path.c_str(), &width, &height, &channels) == 1;
+  return pnm_header_is_sane(path) && stbi_info(path.c_str(), &width, &height, &channels) == 1;
 }
 
 RasterInfo read_stb_info(const fs::path& path, ImageFormat format) {
   int width = 0, height = 0, channels = 0;
+  if (!pnm_header_is_sane(path)) throw ImageFileError(path.string() + ": a PNM header number of more than nine digits: not a picture lensmith reads");
   if (stbi_info(path.c_str(), &width, &height, &channels) != 1) {
     throw IoError(path.string() + ": cannot read the " + to_string(format) + " image: " + stbi_failure_reason());
   }

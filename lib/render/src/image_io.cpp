@@ -466,6 +466,7 @@ std::vector<ImageAttribute> output_attributes(const OutputMetadata& meta) {
   if (meta.f_number > 0.0) attributes.push_back({"lensmith:f_number", meta.f_number});
   if (meta.focus_m > 0.0) attributes.push_back({"lensmith:focus_m", meta.focus_m});
   for (const auto& [key, value] : meta.extra) attributes.push_back({"lensmith:" + key, value});
+  for (const auto& [name, value] : meta.camera) attributes.push_back({name, value, true});
   return attributes;
 }
 
@@ -483,7 +484,35 @@ void write_output_image(const fs::path& path, const Image& linear_rgb, const Out
   }
   check_no_nan(path, linear_rgb);
 
-  const std::vector<ImageAttribute> attributes = output_attributes(meta);
+  std::vector<ImageAttribute> attributes = output_attributes(meta);
+  const bool overscan = meta.data_window.width() > 0 && !(meta.data_window == meta.display_window);
+  if (overscan && (meta.data_window.width() != linear_rgb.width || meta.data_window.height() != linear_rgb.height ||
+                   !meta.data_window.contains(meta.display_window))) {
+    throw OptionsError(path.string() + ": data window " + meta.data_window.to_string() + " and display window " +
+                       meta.display_window.to_string() + " for an image of " + std::to_string(linear_rgb.width) + " x " +
+                       std::to_string(linear_rgb.height));
+  }
+  if (overscan && format == OutputFormat::Exr) {
+    write_exr(path, PixelsView<float>{linear_rgb.width, linear_rgb.height, linear_rgb.channels, linear_rgb.data}, names, attributes,
+              std::pair{meta.data_window, meta.display_window});
+    return;
+  }
+  if (overscan) {
+    // A format without windows: the frame only.
+    const PixelBox& d = meta.display_window;
+    Image frame(d.width(), d.height(), linear_rgb.channels);
+    const auto c = static_cast<std::size_t>(linear_rgb.channels);
+    for (int y = 0; y < d.height(); ++y) {
+      const std::size_t from = (static_cast<std::size_t>(y + d.min_y - meta.data_window.min_y) * static_cast<std::size_t>(linear_rgb.width) +
+                                static_cast<std::size_t>(d.min_x - meta.data_window.min_x)) * c;
+      std::copy_n(linear_rgb.data.begin() + static_cast<std::ptrdiff_t>(from), static_cast<std::size_t>(d.width()) * c,
+                  frame.data.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(y) * static_cast<std::size_t>(d.width()) * c));
+    }
+    OutputMetadata framed = meta;
+    framed.data_window = framed.display_window = PixelBox{};
+    write_output_image(path, frame, framed, channel_names);
+    return;
+  }
 
   if (rgba_exr) {
     write_exr(path, PixelsView<float>{linear_rgb.width, linear_rgb.height, linear_rgb.channels, linear_rgb.data}, names, attributes);

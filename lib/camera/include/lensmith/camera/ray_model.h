@@ -143,6 +143,15 @@ LensFitOptions lens_fit_options_for(const Camera& camera);
 Camera camera_for_model(RayModelKind kind, const Prescription* lens, std::optional<double> thin_lens_focal_length_mm,
                         CameraOptions options, int width_px, int height_px);
 
+// The focus distance from the entrance pupil (what CameraOptions::focus_distance_m means) of a
+// camera focused at `image_plane_distance_m` from its image plane, as camera metadata measures it
+// (OpenEXR's focus): the sensor-to-pupil distance grows as the lens focuses nearer, so it is solved
+// by fixed-point iteration on camera_for_model's sensor position (converging in a few steps: the
+// sensor moves by the focus change times the squared magnification). Throws ComputationError when
+// the distance is too short for the lens to focus.
+double pupil_focus_distance_m(RayModelKind kind, const Prescription* lens, std::optional<double> thin_lens_focal_length_mm,
+                              CameraOptions options, int width_px, int height_px, double image_plane_distance_m);
+
 // Thin needs a thin-lens camera; the others a camera made from a prescription. Throws OptionsError
 // for a mismatch (poly: a fit of another lens, a stop wider than the fit's, a frame or wavelength
 // range beyond it) and what the Seidel analysis or the fit throws.

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <span>
+#include <optional>
 #include <string>
 #include <utility>
 #include <variant>
@@ -79,6 +80,9 @@ std::vector<std::pair<std::string, std::string>> read_image_metadata_pairs(const
 struct ImageAttribute {
   std::string name;  // "Software", "ImageDescription", "lensmith:lens", ...
   std::variant<std::string, double> value;
+  // OpenEXR: a number as a 32-bit float attribute, the type OpenEXR's standard attributes have
+  // (focus, aperture, focalLength, ...); other formats write the number as text either way.
+  bool exr_float = false;
 };
 
 // Interleaved samples of `channels` channels, row-major, top row first.
@@ -94,8 +98,10 @@ struct PixelsView {
 // file cannot be written, OptionsError when the view's sizes do not match its samples.
 // OpenEXR, 32-bit float, ZIP compression (16 scanlines a block), one channel per name; every attribute (ImageDescription
 // stored as the standard "comments", DateTime as "capDate").
+// `windows`, when given, are the file's data window (the pixels' size) and display window, for an
+// image with overscan; by default both are the image at (0, 0).
 void write_exr(const std::filesystem::path& path, const PixelsView<float>& pixels, const std::vector<std::string>& channel_names,
-               const std::vector<ImageAttribute>& attributes);
+               const std::vector<ImageAttribute>& attributes, const std::optional<std::pair<PixelBox, PixelBox>>& windows = {});
 // 8-bit PNG (1 to 4 channels: Y, YA, RGB, RGBA) with an sRGB chunk (the samples are sRGB codes) and
 // one tEXt chunk per attribute (ImageDescription as the standard keyword "Description").
 void write_png(const std::filesystem::path& path, const PixelsView<std::uint8_t>& pixels,

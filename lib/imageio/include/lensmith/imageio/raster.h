@@ -39,10 +39,31 @@ enum class ImageFormat { Exr, Tiff, Png, Jpeg, Hdr, Pfm, Bmp, Tga, Pnm };
 // "OpenEXR", "TIFF", "PNG", "JPEG", "Radiance HDR", "PFM", "BMP", "TGA", "PNM".
 std::string to_string(ImageFormat format);
 
+// A rectangle of pixels in a file's pixel space, corners inclusive (OpenEXR's Box2i).
+struct PixelBox {
+  int min_x = 0;
+  int min_y = 0;
+  int max_x = -1;
+  int max_y = -1;
+  int width() const { return max_x - min_x + 1; }
+  int height() const { return max_y - min_y + 1; }
+  bool contains(const PixelBox& other) const {
+    return min_x <= other.min_x && min_y <= other.min_y && max_x >= other.max_x && max_y >= other.max_y;
+  }
+  friend bool operator==(const PixelBox&, const PixelBox&) = default;
+  std::string to_string() const;  // "640 x 360 at (0, 0)"
+};
+
 struct RasterInfo {
   ImageFormat format = ImageFormat::Exr;
-  int width = 0;   // pixels, >= 1
+  int width = 0;   // pixels, >= 1 (the data window's)
   int height = 0;  // pixels, >= 1
+  // OpenEXR's windows as the file has them: the data window holds the pixels read (width x height),
+  // the display window is the frame. They differ for overscan (data beyond the frame); a crop
+  // (data inside the frame) is refused when reading. Other formats: both are the picture.
+  PixelBox data_window;
+  PixelBox display_window;
+  bool has_overscan() const { return !(data_window == display_window); }
   // In the order OpenImageIO and Nuke present them: for OpenEXR layer by layer, each layer's
   // R, G, B, (Y), A, ..., Z first; for other formats as stored.
   std::vector<RasterChannel> channels;

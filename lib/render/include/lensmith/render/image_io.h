@@ -160,6 +160,13 @@ struct OutputMetadata {
   double f_number = 0.0;         // working f-number; 0 = not recorded
   double focus_m = 0.0;          // focus distance, m (inf allowed); 0 = not recorded
   std::vector<std::pair<std::string, std::string>> extra;  // written as "lensmith:<key>"
+  // The input's OpenEXR windows when it had overscan: an OpenEXR output keeps them (the image is
+  // the data window), other formats get the display window only. Empty (width 0): the image.
+  PixelBox data_window;
+  PixelBox display_window;
+  // OpenEXR's standard camera attributes (float, as the standard has them), written when set:
+  // focus (m), aperture (f-number), focalLength (mm), entrancePupilOffset (m).
+  std::vector<std::pair<std::string, double>> camera;
 
   std::string to_string() const;  // "lens X, f/2.8, focus 2 m, model Y" (the ImageDescription)
   friend std::ostream& operator<<(std::ostream& os, const OutputMetadata& m) { return os << m.to_string(); }
