@@ -74,7 +74,7 @@ TEST_CASE("chunks of a shot render the same frames as the whole shot, bit for bi
   CHECK(fs::exists(other.path("c.1003.exr")));
 }
 
-TEST_CASE("a failing frame is named, leaves no file, and the others are written; the exit code says some failed", "[cli][sequence]") {
+TEST_CASE("a failing frame is named, leaves no file, and the others are written, and the exit code says some failed", "[cli][sequence]") {
   const Shot shot;
   fs::resize_file(shot.path("in.1003.exr"), 100);  // a truncated frame
   const auto r = run_lensmith("bokeh --image " + shot.path("in.####.exr") + " -o " + shot.path("out.####.exr") + " --frames 1001-1004 --focus 2" +

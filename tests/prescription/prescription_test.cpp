@@ -58,7 +58,7 @@ TEST_CASE("prescription: the flagged stop and vertex positions", "[prescription]
   CHECK_THAT(p.last_vertex_z_mm(), Catch::Matchers::WithinAbs(4.831 + 5.86 + 0.975 + 4.822 + 3.127, 1e-12));
 }
 
-TEST_CASE("Geometry a glassmaker cannot build is warned about, naming the surfaces; a real lens is not", "[prescription][geometry]") {
+TEST_CASE("Geometry a glassmaker cannot build is warned about, naming the surfaces, and a real lens is not", "[prescription][geometry]") {
   // A biconvex N-BK7 singlet, R = +/-50 mm, 5 mm thick, 10 mm semi-diameter: the sags at the rim
   // are +/-1.0102 mm, so the edge is 5 - 2 x 1.0102 = 2.98 mm thick.
   auto singlet = [](double centre_mm) {

@@ -1158,3 +1158,11 @@ TEST_CASE("a PNM header number too long for stb_image's int is refused before st
   std::ofstream(dir / "long.pnm") << "P5 " << std::string(12, '5') << " 2\n255\n";
   CHECK_THROWS_WITH(read_radiance_image(dir / "long.pnm"), Contains("more than nine digits"));
 }
+
+TEST_CASE("an OpenEXR header attribute of negative size is an IoError, not an allocation of 2^64 bytes", "[render][image_io]") {
+  // Found by tests/fuzz's exr_image target: OpenEXR reads the size as a signed int and allocated
+  // what a negative one became for an attribute of a type it does not know.
+  const fs::path damaged = fs::path(LENSMITH_SOURCE_DIR) / "tests/fuzz/corpus/exr_image/negative-attribute-size.exr";
+  CHECK_THROWS_AS(read_radiance_image(damaged), IoError);
+  CHECK_THROWS_WITH(read_radiance_image(damaged), Contains("'weird' has a negative size"));
+}

@@ -247,7 +247,12 @@ void check_header_sizes(const fs::path& path) {
       if (!read_name(name)) return;
       if (name.empty()) break;
       std::uint32_t size = 0;
-      if (!read_name(type) || !read_u32(size) || size > 0x7fffffffu) return;
+      if (!read_name(type) || !read_u32(size)) return;
+      // OpenEXR reads the size as a signed int: a negative one became an allocation of 2^64 - |size|
+      // bytes for an attribute of unknown type (found by tests/fuzz's exr_image target).
+      if (size > 0x7fffffffu) {
+        throw IoError(path.string() + ": cannot read the OpenEXR image: header attribute '" + name + "' has a negative size (a damaged file)");
+      }
       if (const std::size_t fixed = fixed_value_bytes(type); fixed > 0) {
         in.seekg(static_cast<std::streamoff>(fixed), std::ios::cur);
       } else if (type == "chlist") {

@@ -162,17 +162,21 @@ std::string one_line(std::string text) {
 constexpr const char* kRadianceSoftware = "SOFTWARE";
 
 // stb_image reads a PNM header's numbers into an int without checking for overflow (a "P5" followed
-// by ten digits is undefined behaviour, found by the fuzzer): a header number of more than nine digits
-// is refused here first. Other files pass.
+// by ten digits is undefined behaviour, found by the fuzzer): walked here first as stb walks it
+// (stbi__pnm_info: magic, then three numbers, each after whitespace and '#' comments to the end of
+// the line), a header number of more than nine digits, or a header that does not end within 64 KiB,
+// is refused. Other files pass.
 bool pnm_header_is_sane(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
-  char head[512] = {};
-  in.read(head, sizeof head);
+  std::string head(64 * 1024, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
   const auto n = static_cast<std::size_t>(in.gcount());
+  const bool whole_file = n < head.size();
   if (n < 2 || head[0] != 'P' || head[1] < '1' || head[1] > '7') return true;
+  const auto space = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\v' || c == '\f' || c == '\r'; };
   std::size_t i = 2;
-  for (int number = 0; number < 3 && i < n; ++number) {
-    while (i < n && (std::isspace(static_cast<unsigned char>(head[i])) || head[i] == '#')) {
+  for (int number = 0; number < 3; ++number) {
+    while (i < n && (space(head[i]) || head[i] == '#')) {
       if (head[i] == '#') {
         while (i < n && head[i] != '\n' && head[i] != '\r') ++i;
       } else {
@@ -180,11 +184,12 @@ bool pnm_header_is_sane(const fs::path& path) {
       }
     }
     std::size_t digits = 0;
-    while (i < n && std::isdigit(static_cast<unsigned char>(head[i]))) {
+    while (i < n && head[i] >= '0' && head[i] <= '9') {
       ++i;
       ++digits;
     }
     if (digits > 9) return false;
+    if (i >= n) return whole_file;  // the header runs past what was read: refused unless the file ends there
   }
   return true;
 }
