@@ -90,11 +90,10 @@ void note_uncovered_without_alpha(const BokehCommandOptions& o, const GlobalOpti
 }
 
 // What every output records of how it was made.
+// `input`: the picture's header (its OpenEXR windows, overscan, are the output's).
 OutputMetadata output_metadata(const BokehCommandOptions& o, const std::string& lens_name, RayModelKind kind, const Camera& camera,
-                               double focus_m, const Aperture& aperture) {
+                               double focus_m, const Aperture& aperture, const RasterInfo& input) {
   OutputMetadata meta;
-  // An OpenEXR input's windows (overscan) are the output's.
-  const RasterInfo input = is_deep_image(o.image) ? RasterInfo{} : read_raster_info(o.image);
   if (input.has_overscan()) {
     meta.data_window = input.data_window;
     meta.display_window = input.display_window;
@@ -324,8 +323,6 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   depth_options.kind = parse_depth_kind(o.depth_kind);
   depth_options.unit = parse_depth_unit(o.depth_unit);
   depth_options.invalid = parse_invalid_depth(o.invalid_depth);
-  // The camera's framing is the pinhole frame the depth is read in (Camera::from_lens and thin_lens
-  // build the same one).
   // Overscan: pixels beyond the frame, which light from outside it reaches the frame through. The
   // framing (sensor width, focal length, field of view) is the display window's; the pictures are
   // the data window, framed with the same focal length in pixels.
@@ -345,6 +342,8 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
                 << "; the pixels outside the frame are photographed too (their light reaches the frame)\n";
     }
   }
+  // The camera's framing is the pinhole frame the depth is read in (Camera::from_lens and thin_lens
+  // build the same one).
   const PinholeFrame frame = PinholeFrame::from_options(width, height, camera.framing, default_focal_mm);
   std::optional<DeepImage> deep;
   if (layered) deep = read_deep_image(o.image, depth_options, frame);
@@ -418,7 +417,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     const Image out = render_lightfield(*flat, depth, *model, aperture, options, &stats);
     const double render_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - render_started).count();
     bar.finish();
-    OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture);
+    OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture, windows);
     meta.extra.insert(meta.extra.end(), {{"views", std::to_string(options.views)}, {"mip_filter", options.mip_filter ? "on" : "off"},
                                          {"lightfield_colour", options.spectral ? "three wavelengths" : "reference wavelength"}});
     write_bokeh_output(out, meta, o, depth, other);
@@ -452,7 +451,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     const Image out = render_ewa(*flat, depth, *model, aperture, options, &stats);
     const double render_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - render_started).count();
     bar.finish();
-    OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture);
+    OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture, windows);
     meta.extra.insert(meta.extra.end(), {{"splat_kernel", options.lens_psf ? "lens psf" : "circular coc"},
                                          {"level_of_detail", options.level_of_detail ? "on" : "off"}});
     write_bokeh_output(out, meta, o, depth, other);
@@ -496,7 +495,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     const Image out = render_gather(*flat, depth, *model, aperture, options, &stats);
     const double render_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - render_started).count();
     bar.finish();
-    OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture);
+    OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture, windows);
     meta.extra.insert(meta.extra.end(), {{"rings", std::to_string(options.rings)}, {"median", options.median ? "on" : "off"},
                                          {"hidden_surfaces", traced ? "trace " + o.scene : std::string("none")}});
     write_bokeh_output(out, meta, o, depth, other);
@@ -542,7 +541,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     const bool transparent = scene.max_transparency() > 1e-4;
     if (transparent && layered) note_uncovered_without_alpha(o, global);
     const Image out = rgba.leading_channels(transparent && output_keeps_alpha(output) ? 4 : 3);
-    OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture);
+    OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture, windows);
     meta.extra.insert(meta.extra.end(), {{"samples", std::to_string(options.samples)}, {"layers", std::to_string(options.layers)},
                                          {"cone_tracing", options.cone_tracing ? "on" : "off"}});
     write_bokeh_output(out, meta, o, depth, other);
@@ -607,7 +606,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   const double render_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - render_started).count();
   bar.finish();
 
-  OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture);
+  OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture, windows);
   meta.extra.insert(meta.extra.end(), {{"hidden_surfaces", std::string(to_string(options.hidden))}, {"edge_pixels", o.edge_pixels}});
   write_bokeh_output(out, meta, o, depth, other);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

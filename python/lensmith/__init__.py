@@ -97,11 +97,14 @@ class SpectralTable(Record):
 
     def __init__(self, rows):
         super().__init__({"rows": rows})
+        object.__setattr__(self, "_columns", self._make_columns(rows))
 
     def columns(self):
         """A dict of numpy arrays, one per quantity, one entry per wavelength."""
-        rows = self._data["rows"]
+        return dict(self._columns)
 
+    @staticmethod
+    def _make_columns(rows):
         def col(get):
             return _np.array([_np.nan if get(r) is None else get(r) for r in rows], dtype=_np.float64)
 
@@ -120,7 +123,7 @@ class SpectralTable(Record):
     def __getattr__(self, key):
         if key in ("rows",):
             return super().__getattr__(key)
-        columns = self.columns()
+        columns = object.__getattribute__(self, "_columns")
         if key in columns:
             return columns[key]
         raise AttributeError(f"SpectralTable has no column {key!r}; its columns: {', '.join(columns)}")
@@ -285,7 +288,7 @@ class Lens:
         return _json.loads(self._handle.to_json_text())
 
     def save(self, path):
-        """Writes the native JSON file (atomically; never over the file the lens was read from)."""
+        """Writes the native JSON file (atomically; never over the file the lens was read from: UsageError)."""
         self._handle.save(str(path))
 
     def copy(self):

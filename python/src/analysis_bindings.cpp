@@ -1,6 +1,8 @@
 // Real-ray analyses in Python: spot diagrams, ray fans and the one-curve analyses of
 // `lensmith analyze` (distortion, field curves, focal shift, illumination, pupil), as the command's
 // JSON reports and, on request, the same PNG pictures (docs/python.md, "Real rays").
+#include <filesystem>
+
 #include <pybind11/stl.h>
 
 #include "bindings.h"
@@ -18,8 +20,14 @@
 
 namespace lensmith::python {
 
+void ensure_not_the_lens_file(const std::string& output, const LensHandle& lens) {
+  // The lens file (a lentil database's, without its "#id"); a shipped lens's id names no file.
+  const std::string file = lens.origin.substr(0, lens.origin.rfind('#'));
+  if (!file.empty() && std::filesystem::exists(file)) ensure_not_an_input(output, {file});
+}
+
 void write_picture(const plot::Canvas& canvas, const std::string& png, const LensHandle& lens) {
-  if (!lens.origin.empty()) ensure_not_an_input(png, {lens.origin.substr(0, lens.origin.rfind('#'))});
+  ensure_not_the_lens_file(png, lens);
   ensure_writable_location(png);
   canvas.write_png(png);
 }

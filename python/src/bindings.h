@@ -32,6 +32,8 @@ using LensPtr = std::shared_ptr<LensHandle>;
 
 // Writes a picture of the plot library where the command writes it; never over the lens's own file.
 void write_picture(const plot::Canvas& canvas, const std::string& png, const LensHandle& lens);
+// The command's rule (ensure_not_an_input): UsageError when `output` is the file the lens was read from.
+void ensure_not_the_lens_file(const std::string& output, const LensHandle& lens);
 
 // JSON text of a report (compact; Python's json module reads it).
 std::string dump(const ojson& o);

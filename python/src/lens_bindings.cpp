@@ -143,7 +143,7 @@ void bind_lens(py::module_& m) {
            }, py::arg("text"), py::arg("name"))
       .def("to_json_text", [](const LensHandle& l) { return write_lens_json(l.prescription); })
       .def("save", [](const LensHandle& l, const std::string& path) {
-             if (!l.origin.empty() && l.origin == path) throw IoError(path + ": is the file the lens was read from; lensmith never overwrites an input");
+             ensure_not_the_lens_file(path, l);
              write_file_atomically(path, write_lens_json(l.prescription));
            }, py::arg("path"))
       .def("copy", [](const LensHandle& l) { return std::make_shared<LensHandle>(LensHandle{l.prescription, ""}); })

@@ -109,5 +109,5 @@ def test_save_never_overwrites_the_file_the_lens_came_from(tmp_path):
     path = tmp_path / "lens.json"
     lensmith.Lens.load("smith-cooke-triplet").save(path)
     lens = lensmith.Lens.load(path)
-    with pytest.raises(lensmith.IoError):
+    with pytest.raises(lensmith.UsageError):  # the command's rule for every output (ensure_not_an_input)
         lens.save(path)

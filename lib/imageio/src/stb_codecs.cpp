@@ -168,11 +168,14 @@ constexpr const char* kRadianceSoftware = "SOFTWARE";
 // is refused. Other files pass.
 bool pnm_header_is_sane(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
+  char magic[2] = {};
+  if (!in.read(magic, 2) || magic[0] != 'P' || magic[1] < '1' || magic[1] > '7') return true;
   std::string head(64 * 1024, '\0');
-  in.read(head.data(), static_cast<std::streamsize>(head.size()));
-  const auto n = static_cast<std::size_t>(in.gcount());
+  head[0] = magic[0];
+  head[1] = magic[1];
+  in.read(head.data() + 2, static_cast<std::streamsize>(head.size() - 2));
+  const auto n = 2 + static_cast<std::size_t>(in.gcount());
   const bool whole_file = n < head.size();
-  if (n < 2 || head[0] != 'P' || head[1] < '1' || head[1] > '7') return true;
   const auto space = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\v' || c == '\f' || c == '\r'; };
   std::size_t i = 2;
   for (int number = 0; number < 3; ++number) {
@@ -203,7 +206,7 @@ bool stb_can_decode(const fs::path& path) {
 
 RasterInfo read_stb_info(const fs::path& path, ImageFormat format) {
   int width = 0, height = 0, channels = 0;
-  if (!pnm_header_is_sane(path)) throw ImageFileError(path.string() + ": a PNM header number of more than nine digits: not a picture lensmith reads");
+  if (format == ImageFormat::Pnm && !pnm_header_is_sane(path)) throw ImageFileError(path.string() + ": a PNM header number of more than nine digits: not a picture lensmith reads");
   if (stbi_info(path.c_str(), &width, &height, &channels) != 1) {
     throw IoError(path.string() + ": cannot read the " + to_string(format) + " image: " + stbi_failure_reason());
   }
