@@ -12,6 +12,8 @@
 
 #include "commands.h"
 #include "progress_bar.h"
+#include "lensmith/color/color_management.h"
+#include "lensmith/color/rgb_primaries.h"
 #include "lensmith/core/errors.h"
 #include "lensmith/core/number_parsing.h"
 #include "lensmith/core/units.h"
@@ -116,8 +118,79 @@ OutputMetadata output_metadata(const BokehCommandOptions& o, const std::string& 
   return meta;
 }
 
-// Writes the picture (RGB, or RGBA), with the input's depth (--keep-depth) and its passes after it.
-void write_bokeh_output(Image out, OutputMetadata& meta, const BokehCommandOptions& o, const DepthMap& depth, const OtherChannels& other) {
+// A note when a picture's chromaticities attribute names primaries other than Rec.709 (ACEScg's AP1,
+// say) and no --input-colorspace says how to convert them: the render is linear, so its numbers stay
+// in the picture's space, but the spectral colour (dispersion) is computed for Rec.709 primaries.
+void note_foreign_primaries(const std::string& image, const std::string& chromaticities) {
+  std::vector<double> v;
+  std::size_t start = 0;
+  while (start <= chromaticities.size()) {
+    const std::size_t comma = std::min(chromaticities.find(',', start), chromaticities.size());
+    std::string item = chromaticities.substr(start, comma - start);
+    item.erase(0, item.find_first_not_of(' '));
+    if (const auto number = parse_finite_number(item)) v.push_back(*number);
+    start = comma + 1;
+  }
+  if (v.size() != 8) return;
+  const auto same = [&](const RgbPrimaries& p) {
+    const double w[8] = {p.red.x, p.red.y, p.green.x, p.green.y, p.blue.x, p.blue.y, p.white.x, p.white.y};
+    for (int i = 0; i < 8; ++i) {
+      if (std::abs(v[i] - w[i]) > 1e-3) return false;  // OpenEXR stores them as floats; files round to 4 decimals
+    }
+    return true;
+  };
+  if (same(kRec709Primaries)) return;
+  const std::string known = same(kAcesAp1Primaries) ? " (ACES AP1: ACEScg)" : same(kAcesAp0Primaries) ? " (ACES AP0: ACES2065-1)" : "";
+  std::cerr << "note: " << image << "'s chromaticities are not Rec.709" << known
+            << "; lensmith renders its numbers as they are and the output keeps them, but its spectral colour assumes Rec.709 "
+               "primaries: give --input-colorspace with an OCIO config for exact colour (docs/color-management.md)\n";
+}
+
+// The colour management the options ask for (docs/color-management.md), or none. The output's colour
+// space defaults to the input's for an OpenEXR output (ACEScg plates in, ACEScg out); PNG, JPEG and
+// TIFF outputs are sRGB-encoded from the working space, as without colour management.
+std::optional<ColorManagement> color_management(const BokehCommandOptions& o, const std::filesystem::path& output, bool layered) {
+  if (o.input_colorspace.empty() && o.output_colorspace.empty()) {
+    if (!o.ocio_config.empty() || !o.working_colorspace.empty()) {
+      throw UsageError(std::string(o.ocio_config.empty() ? "--working-colorspace" : "--ocio") +
+                       " converts nothing without --input-colorspace or --output-colorspace");
+    }
+    return std::nullopt;
+  }
+  const bool exr = output_keeps_alpha(output);
+  if (!o.output_colorspace.empty() && !exr) {
+    throw UsageError("--output-colorspace " + o.output_colorspace + ": " + output.string() +
+                     " is written sRGB-encoded from linear Rec.709 (a picture to look at); colour spaces are for an .exr output");
+  }
+  if (!o.input_colorspace.empty() && !layered) {
+    // 8/16-bit codes of a PNG, JPEG or TIFF are read as sRGB; converting them again would be wrong.
+    const RasterInfo info = read_raster_info(o.image);
+    for (const RasterChannel& channel : info.channels) {
+      if ((channel.name == "R" || channel.name == "G" || channel.name == "B" || channel.name == "Y") && !is_floating_point(channel.type) &&
+          !info.integers_are_linear) {
+        throw UsageError("--input-colorspace " + o.input_colorspace + ": " + o.image + " stores " + to_string(channel.type) +
+                         " codes, which lensmith reads as sRGB; colour spaces are for float pictures (OpenEXR, float TIFF, PFM, HDR)");
+      }
+    }
+  }
+  ColorManagementOptions c;
+  c.config = o.ocio_config;
+  c.input_colorspace = o.input_colorspace;
+  c.output_colorspace = o.output_colorspace.empty() && exr ? o.input_colorspace : o.output_colorspace;
+  c.working_colorspace = o.working_colorspace;
+  return ColorManagement(c);
+}
+
+// Writes the picture (RGB, or RGBA) in the output colour space, with the input's depth (--keep-depth)
+// and its passes after it.
+void write_bokeh_output(Image out, OutputMetadata& meta, const BokehCommandOptions& o, const DepthMap& depth, const OtherChannels& other,
+                        const std::optional<ColorManagement>& color, const std::string& chromaticities) {
+  meta.chromaticities = chromaticities;
+  if (color && !color->options().output_colorspace.empty()) {
+    color->working_to_output(out.data, out.channels);
+    meta.extra.emplace_back("colorspace", color->options().output_colorspace);
+    meta.extra.emplace_back("ocio_config", color->config_path());
+  }
   std::vector<std::string> channels{"R", "G", "B"};
   if (out.channels == 4) channels.emplace_back("A");
   if (o.keep_depth) {
@@ -175,6 +248,16 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   if (o.keep_depth && !output_keeps_alpha(output)) {
     throw UsageError("--keep-depth needs an OpenEXR output (.exr): " + output.string() + " cannot hold a depth channel");
   }
+  // A deep OpenEXR is layered input: its samples carry colour, alpha and depth together.
+  const bool layered = is_deep_image(o.image);
+  const std::optional<ColorManagement> color = color_management(o, output, layered);
+  if (color && !global.quiet) {
+    const ColorManagementOptions& c = color->options();
+    std::cerr << "note: colour: " << (c.input_colorspace.empty() ? "linear Rec.709" : c.input_colorspace)
+              << " -> linear Rec.709 (working space: " << color->working_route() << ") -> "
+              << (c.output_colorspace.empty() ? (output_keeps_alpha(output) ? "linear Rec.709" : "sRGB-encoded") : c.output_colorspace)
+              << ", OCIO config " << color->config_path() << "\n";
+  }
   RadianceReadOptions read;
   read.highlight_gain = o.highlight_gain;
   read.highlight_threshold = o.highlight_threshold;
@@ -182,8 +265,6 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   if (o.threads > 0) set_image_codec_threads(o.threads);
   // The picture, its alpha, passes and depth are often one file: decoded once, until the depth is read.
   std::optional<ImageReadCache> read_cache(std::in_place);
-  // A deep OpenEXR is layered input: its samples carry colour, alpha and depth together.
-  const bool layered = is_deep_image(o.image);
   if (layered && !o.depth.empty()) {
     throw UsageError(o.image + " is a deep image, whose samples carry their own Z: --depth is for flat pictures");
   }
@@ -206,6 +287,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     }
   } else {
     flat = read_radiance_image(o.image, read);
+    if (color) color->input_to_working(flat->data, 3);
     width = flat->width;
     height = flat->height;
   }
@@ -254,6 +336,16 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   camera.framing.horizontal_fov_deg = o.hfov_deg;
   std::vector<std::string> from_file;
   const std::vector<std::pair<std::string, std::string>> attributes = read_image_metadata(o.image);
+  // The RGB's primaries, when the picture says: passed through to the output when its numbers are
+  // in the same colour space (no conversion, or output = input), and a note when they are not
+  // Rec.709 and nothing says what they are.
+  std::string input_chromaticities;
+  for (const auto& [key, value] : attributes) {
+    if (key == "chromaticities") input_chromaticities = value;
+  }
+  if (!input_chromaticities.empty() && o.input_colorspace.empty() && !global.quiet) note_foreign_primaries(o.image, input_chromaticities);
+  const std::string output_chromaticities =
+      !color || color->options().output_colorspace == color->options().input_colorspace ? input_chromaticities : std::string();
   for (const auto& [key, value] : attributes) {
     const std::optional<double> number = parse_finite_number(value);
     if (!number || !(*number > 0.0)) continue;
@@ -346,7 +438,15 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   // build the same one).
   const PinholeFrame frame = PinholeFrame::from_options(width, height, camera.framing, default_focal_mm);
   std::optional<DeepImage> deep;
-  if (layered) deep = read_deep_image(o.image, depth_options, frame);
+  if (layered) {
+    deep = read_deep_image(o.image, depth_options, frame);
+    if (color) {
+      std::vector<float> rgb(deep->samples.size() * 3);
+      for (std::size_t i = 0; i < deep->samples.size(); ++i) std::copy_n(deep->samples[i].rgb.begin(), 3, rgb.begin() + 3 * i);
+      color->input_to_working(rgb, 3);
+      for (std::size_t i = 0; i < deep->samples.size(); ++i) std::copy_n(rgb.begin() + 3 * i, 3, deep->samples[i].rgb.begin());
+    }
+  }
   // A layered input's depth per pixel is its front sample's, the nearest (for --focus-pixel,
   // --keep-depth and the models' nearest depth).
   const DepthMap depth = layered ? deep->front_depth() : read_depth(depth_source, depth_options, frame);
@@ -420,7 +520,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture, windows);
     meta.extra.insert(meta.extra.end(), {{"views", std::to_string(options.views)}, {"mip_filter", options.mip_filter ? "on" : "off"},
                                          {"lightfield_colour", options.spectral ? "three wavelengths" : "reference wavelength"}});
-    write_bokeh_output(out, meta, o, depth, other);
+    write_bokeh_output(out, meta, o, depth, other, color, output_chromaticities);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     const double pixel_views = static_cast<double>(out.width) * out.height * options.views;
     std::ostringstream what;
@@ -454,7 +554,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture, windows);
     meta.extra.insert(meta.extra.end(), {{"splat_kernel", options.lens_psf ? "lens psf" : "circular coc"},
                                          {"level_of_detail", options.level_of_detail ? "on" : "off"}});
-    write_bokeh_output(out, meta, o, depth, other);
+    write_bokeh_output(out, meta, o, depth, other, color, output_chromaticities);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     std::ostringstream what;
     what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds
@@ -498,7 +598,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture, windows);
     meta.extra.insert(meta.extra.end(), {{"rings", std::to_string(options.rings)}, {"median", options.median ? "on" : "off"},
                                          {"hidden_surfaces", traced ? "trace " + o.scene : std::string("none")}});
-    write_bokeh_output(out, meta, o, depth, other);
+    write_bokeh_output(out, meta, o, depth, other, color, output_chromaticities);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     std::ostringstream what;
     what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds
@@ -544,7 +644,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture, windows);
     meta.extra.insert(meta.extra.end(), {{"samples", std::to_string(options.samples)}, {"layers", std::to_string(options.layers)},
                                          {"cone_tracing", options.cone_tracing ? "on" : "off"}});
-    write_bokeh_output(out, meta, o, depth, other);
+    write_bokeh_output(out, meta, o, depth, other, color, output_chromaticities);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     std::ostringstream what;
     what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds
@@ -608,7 +708,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
 
   OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture, windows);
   meta.extra.insert(meta.extra.end(), {{"hidden_surfaces", std::string(to_string(options.hidden))}, {"edge_pixels", o.edge_pixels}});
-  write_bokeh_output(out, meta, o, depth, other);
+  write_bokeh_output(out, meta, o, depth, other, color, output_chromaticities);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   std::ostringstream what;
   what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds

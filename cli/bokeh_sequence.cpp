@@ -98,6 +98,10 @@ int run_bokeh_sequence(const BokehCommandOptions& o, const GlobalOptions& global
       throw UsageError(o.curves + ": focal_length_mm keys the focal length of --thin-lens; a prescription's focal length is its own");
     }
   }
+  if (o.list_frames) {
+    for (const long frame : frames) std::cout << frame << "\n";
+    return kExitOk;
+  }
 
   std::size_t written = 0, skipped = 0, done = 0;
   std::vector<std::pair<long, std::string>> failed;

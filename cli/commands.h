@@ -147,6 +147,11 @@ struct BokehCommandOptions {
   std::optional<double> f_number;            // --fstop; default: the lens's own
   std::optional<double> focus_m;             // --focus, metres from the entrance pupil (or --focus-pixel)
   std::string focus_pixel;                   // --focus-pixel X,Y: focus on the depth map's value there
+  // Colour management (docs/color-management.md): names in an OpenColorIO config.
+  std::string ocio_config;                   // --ocio FILE (default $OCIO)
+  std::string input_colorspace;              // --input-colorspace NAME (default: linear Rec.709, no conversion)
+  std::string output_colorspace;             // --output-colorspace NAME (default: the input's for .exr, else linear Rec.709)
+  std::string working_colorspace;            // --working-colorspace NAME: the config's linear Rec.709 (configs without aces_interchange)
   bool keep_depth = false;                   // --keep-depth: the input's planar depth as Z in an EXR output
   std::string other_channels = "keep";       // --other-channels keep|defocus|drop: an EXR input's other passes
   std::optional<double> sensor_width_mm;     // --sensor-width of the pinhole image; default the EXR's or 36
@@ -191,6 +196,7 @@ struct BokehCommandOptions {
   std::string chunk;                         // --chunk I/N: only the I-th (0-based) of N contiguous chunks of the frames
   std::string curves;                        // --curves FILE: per-frame focus_m, fstop, focal_length_mm, pinhole_focal_length_mm
   bool skip_existing = false;                // --skip-existing: frames whose output exists are not rendered again
+  bool list_frames = false;                  // --list-frames: print the frames (after --chunk) and render nothing
 };
 // One picture; a sequence when --frames is given (run_bokeh_sequence).
 int run_bokeh(const BokehCommandOptions& options, const GlobalOptions& global);

@@ -1,15 +1,19 @@
 // lensmith: command-line entry point. Parses options with CLI11, runs one subcommand, and maps
 // exceptions to the exit codes documented in docs/cli.md (pbrt-v4 cmd/pbrt.cpp does the same).
 #include <CLI/CLI.hpp>
+#include <omp.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <iostream>
+#include <optional>
 #include <string_view>
 
 #include "commands.h"
 #include "json_output.h"
 #include "lensmith/core/number_parsing.h"
 #include "lensmith/core/errors.h"
+#include "lensmith/core/termination_cleanup.h"
 #include "lensmith/prescription/lens_library.h"
 
 namespace lensmith::cli {
@@ -87,10 +91,27 @@ CLI::Validator focus_distance_check() {
       "M > 0 or inf", "focus distance");
 }
 
+// On a farm, "all cores" means the cores the scheduler gave this task, not the node's: a Slurm task
+// (SLURM_JOB_ID set) runs as many threads as SLURM_CPUS_PER_TASK (sbatch --cpus-per-task), else as
+// SLURM_CPUS_ON_NODE (what the job holds on this node). An explicit OMP_NUM_THREADS or --threads wins.
+void use_the_allocations_cpus() {
+  if (std::getenv("SLURM_JOB_ID") == nullptr || std::getenv("OMP_NUM_THREADS") != nullptr) return;
+  for (const char* name : {"SLURM_CPUS_PER_TASK", "SLURM_CPUS_ON_NODE"}) {
+    const char* text = std::getenv(name);
+    const std::optional<double> n = text ? lensmith::parse_finite_number(text) : std::nullopt;
+    if (n && *n >= 1 && *n <= 4096 && *n == std::floor(*n)) {
+      omp_set_num_threads(static_cast<int>(*n));
+      return;
+    }
+  }
+}
+
 }  // namespace lensmith::cli
 
 int main(int argc, char** argv) {
   using namespace lensmith::cli;
+  lensmith::remove_temporaries_on_termination();
+  use_the_allocations_cpus();
   CLI::App app{"lensmith: real camera lenses, from prescription to bokeh"};
   app.require_subcommand(1);
   app.fallthrough();  // global flags such as --quiet may follow the subcommand
@@ -258,6 +279,16 @@ int main(int argc, char** argv) {
   bokeh_cmd->add_option("--other-channels", bokeh.other_channels,
                         "An EXR input's channels besides R, G, B, A and Z (render passes) in an EXR output: keep (default: unchanged, in focus) | defocus (each through the picture's rays, without colour fringes) | drop")
       ->check(CLI::IsMember({"keep", "defocus", "drop"}));
+  // Colour management (docs/color-management.md).
+  bokeh_cmd->add_option("--ocio", bokeh.ocio_config, "OpenColorIO config for --input-colorspace/--output-colorspace (default: $OCIO)")
+      ->check(CLI::ExistingFile);
+  bokeh_cmd->add_option("--input-colorspace", bokeh.input_colorspace,
+                        "The input picture's colour space in the OCIO config (e.g. ACEScg); default: linear Rec.709, no conversion");
+  bokeh_cmd->add_option("--output-colorspace", bokeh.output_colorspace,
+                        "The .exr output's colour space in the OCIO config (default: the input's when --input-colorspace is given, "
+                        "else linear Rec.709)");
+  bokeh_cmd->add_option("--working-colorspace", bokeh.working_colorspace,
+                        "The config's linear Rec.709 colour space, for configs without an aces_interchange role (OCIO 1 configs)");
   bokeh_cmd->add_flag("--keep-depth", bokeh.keep_depth,
                       "Write the input's depth (planar metres from the entrance pupil, inf for the sky) as the Z channel of an .exr output");
   bokeh_cmd->add_option("--focus-pixel", bokeh.focus_pixel, "Focus on the depth at this pixel of the input, X,Y (0,0 = top left), instead of --focus")
@@ -344,7 +375,7 @@ int main(int argc, char** argv) {
   bokeh_scatter_only.push_back(bokeh_cmd->add_option("--subrows", bokeh.subrows, "Sub-rows per pixel of the scatter (1-16, default 4)")->check(range(1, 16)));
   bokeh_scatter_only.push_back(bokeh_cmd->add_option("--max-blur", bokeh.max_blur_px, "Largest blur diameter, px; nearer points are clamped (default 1000)")
       ->check(range(1.0, 1.0e6)));
-  bokeh_cmd->add_option("--threads", bokeh.threads, "Threads (default 0 = all cores)")->check(range(0, 4096));
+  bokeh_cmd->add_option("--threads", bokeh.threads, "Threads (default 0 = all cores, or the CPUs a Slurm task was given)")->check(range(0, 4096));
   CLI::Option* bokeh_frames = bokeh_cmd->add_option(
       "--frames", bokeh.frames,
       "Render a shot: these frames (1001-1100, 1001-1100x2, 1,5,10-20) of the sequences --image, --depth and -o name "
@@ -356,6 +387,10 @@ int main(int argc, char** argv) {
                         "(thin lens), pinhole_focal_length_mm curves")
       ->needs(bokeh_frames)->check(CLI::ExistingFile);
   bokeh_cmd->add_flag("--skip-existing", bokeh.skip_existing, "With --frames: leave frames whose output exists (a resumed shot)")
+      ->needs(bokeh_frames);
+  bokeh_cmd->add_flag("--list-frames", bokeh.list_frames,
+                      "With --frames: print the frames this command would render (after --chunk), one per line, and render nothing "
+                      "(checks the sequence options; farm scripts count frames with it)")
       ->needs(bokeh_frames);
 
   ValidateCommandOptions validate;
@@ -471,7 +506,7 @@ int main(int argc, char** argv) {
   scene_render_cmd->add_option("--pinhole-focal-length", scene_render.pinhole_focal_length_mm,
                                "Pinhole focal length of the framing, mm (default: the lens EFL, the thin lens's focal length; 50 with --pinhole)")
       ->check(positive());
-  scene_render_cmd->add_option("--threads", scene_render.threads, "Threads (default 0 = all cores)")->check(range(0, 4096));
+  scene_render_cmd->add_option("--threads", scene_render.threads, "Threads (default 0 = all cores, or the CPUs a Slurm task was given)")->check(range(0, 4096));
 
   // Under --json an error is also one JSON object on stdout, so that a script reading stdout sees
   // it: {"error": {"exit_code": N, "message": "..."}}.

@@ -11,8 +11,9 @@ export DEBIAN_FRONTEND=noninteractive
 apt-get update -qq
 apt-get install -y -qq --no-install-recommends \
   ca-certificates cmake ninja-build g++ pkg-config \
-  libeigen3-dev libceres-dev libopenexr-dev libimath-dev libtiff-dev libpng-dev libstb-dev \
+  libeigen3-dev libceres-dev libopenexr-dev libimath-dev libtiff-dev libpng-dev libstb-dev libopencolorio-dev \
   nlohmann-json3-dev libcli11-dev catch2 libbenchmark-dev \
   clang libclang-rt-14-dev fonts-dejavu-core \
-  python3 python3-dev pybind11-dev python3-numpy python3-matplotlib python3-pytest python3-pandas >/dev/null
+  python3 python3-dev pybind11-dev python3-numpy python3-matplotlib python3-pytest python3-pandas \
+  slurm-wlm >/dev/null
 echo "install-deps.sh: dependencies installed"

@@ -38,7 +38,7 @@ from ._lensmith import (  # noqa: F401  (the error types are part of the API)
 
 __version__ = _lensmith.__version__
 __all__ = [
-    "Lens", "Surface", "Fit", "Record", "TraceResult", "lenses", "bokeh", "read_image", "read_depth", "read_metadata", "write_image", "RAY_STATUS", "LensWarning",
+    "Lens", "Surface", "Fit", "Record", "TraceResult", "lenses", "bokeh", "convert_colorspace", "read_image", "read_depth", "read_metadata", "write_image", "RAY_STATUS", "LensWarning",
     "Error", "LensFileError", "GlassError", "PrescriptionError", "OptionsError", "UsageError", "ComputationError",
     "IoError", "ImageFileError", "FitError", "SceneError", "SceneFileError",
 ]
@@ -473,7 +473,8 @@ def bokeh(image, depth, lens=None, *, thin_lens_focal_length_mm=None, fstop=None
           samples=None, layers=None, ray_grid_px=None, cone_tracing=None,
           views=None, mip_filter=None,
           circular_splats=None, level_of_detail=None,
-          rings=None, median=None, scene=None, trace_rays=None):
+          rings=None, median=None, scene=None, trace_rays=None,
+          input_colorspace=None, output_colorspace=None, ocio=None, working_colorspace=None):
     """Photographs an all-in-focus picture with its depth through a lens (``lensmith bokeh``).
 
     image: float32 (H, W, 3), linear scene-referred RGB (Rec.709 primaries); depth: float32 (H, W),
@@ -486,6 +487,11 @@ def bokeh(image, depth, lens=None, *, thin_lens_focal_length_mm=None, fstop=None
     file for 'poly'. method: 'scatter' (default) | 'multiview' | 'lightfield' | 'ewa' | 'gather'.
     Every other keyword is the command's option of the same name (docs/cli.md, docs/python.md);
     options of another method than the one chosen are an error, as on the command line.
+
+    input_colorspace / output_colorspace: the picture's colour space and the result's in an
+    OpenColorIO config (``ocio``, default $OCIO), as ``--input-colorspace``/``--output-colorspace``
+    (docs/color-management.md); the result is in the input's colour space unless output_colorspace
+    says otherwise.
     """
     options = {k: v for k, v in dict(
         thin_lens_focal_length_mm=thin_lens_focal_length_mm, fstop=fstop, focus_m=focus_m, model=model, method=method,
@@ -504,7 +510,25 @@ def bokeh(image, depth, lens=None, *, thin_lens_focal_length_mm=None, fstop=None
         options["lens"] = lens._handle if isinstance(lens, Lens) else str(lens)
     if fit is not None:
         options["fit"] = fit._native if isinstance(fit, Fit) else str(fit)
-    return _lensmith.bokeh(image, depth, options)
+    if input_colorspace is None and output_colorspace is None:
+        if ocio is not None or working_colorspace is not None:
+            raise OptionsError("ocio / working_colorspace convert nothing without input_colorspace or output_colorspace")
+        return _lensmith.bokeh(image, depth, options)
+    if output_colorspace is None:
+        output_colorspace = input_colorspace
+    if input_colorspace is not None:
+        image = convert_colorspace(image, input_colorspace, None, ocio=ocio, working_colorspace=working_colorspace)
+    out = _lensmith.bokeh(image, depth, options)
+    return convert_colorspace(out, None, output_colorspace, ocio=ocio, working_colorspace=working_colorspace)
+
+
+def convert_colorspace(image, from_colorspace, to_colorspace, *, ocio=None, working_colorspace=None):
+    """float32 (H, W, 3) from one colour space of an OpenColorIO config to another, as ``lensmith bokeh``
+    converts its input and output (docs/color-management.md). None for either side is lensmith's
+    working space, linear Rec.709. ocio: the config file (default $OCIO); working_colorspace: the
+    config's linear Rec.709 when it has no aces_interchange role."""
+    return _lensmith.convert_colorspace(image, from_colorspace or "", to_colorspace or "", str(ocio) if ocio else "",
+                                        working_colorspace or "")
 
 
 # ---- pictures -----------------------------------------------------------------------------------

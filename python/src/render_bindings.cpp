@@ -18,6 +18,7 @@
 #include "lensmith/paraxial/paraxial_system.h"
 #include "lensmith/polyfit/lens_fit.h"
 #include "lensmith/prescription/lens_library.h"
+#include "lensmith/color/color_management.h"
 #include "lensmith/render/bokeh_renderer.h"
 #include "lensmith/render/ewa_renderer.h"
 #include "lensmith/render/gather_renderer.h"
@@ -359,6 +360,30 @@ void bind_render(py::module_& m) {
     py::gil_scoped_release release;
     write_output_image(path, image, meta);
   }, py::arg("path"), py::arg("image"));
+
+  m.def("convert_colorspace", [](const py::array& rgb, const std::string& from_space, const std::string& to_space, const std::string& config,
+                                 const std::string& working_space) {
+    check_float32(rgb, "image", 3, "(H, W, 3)");
+    ColorManagementOptions o;
+    o.config = config;
+    o.input_colorspace = from_space;
+    o.output_colorspace = to_space;
+    o.working_colorspace = working_space;
+    const ColorManagement color(o);
+    py::array_t<float> out({rgb.shape(0), rgb.shape(1), static_cast<py::ssize_t>(3)});
+    const auto c = rgb.unchecked<float, 3>();
+    float* data = out.mutable_data();
+    for (py::ssize_t y = 0; y < rgb.shape(0); ++y) {
+      for (py::ssize_t x = 0; x < rgb.shape(1); ++x) {
+        for (py::ssize_t k = 0; k < 3; ++k) *data++ = c(y, x, k);
+      }
+    }
+    const std::span<float> pixels(out.mutable_data(), static_cast<std::size_t>(out.size()));
+    py::gil_scoped_release release;
+    color.input_to_working(pixels, 3);
+    color.working_to_output(pixels, 3);
+    return out;
+  }, py::arg("image"), py::arg("from_space"), py::arg("to_space"), py::arg("config"), py::arg("working_space"));
 
   py::class_<LensFit, FitPtr>(m, "Fit", "A polynomial fit of a lens's ray mapping (lensmith fit).")
       .def_static("fit", [](const LensHandle& lens, int degree, int terms, int training_rays, int test_rays, std::uint64_t seed,

@@ -125,3 +125,16 @@ TEST_CASE("a shot's command line is checked before any frame is rendered", "[cli
   CHECK(r.err.find("--frames") != std::string::npos);
   CHECK_FALSE(fs::exists(shot.path("o.1001.exr")));
 }
+
+TEST_CASE("--list-frames prints the frames a chunk would render, one per line, and renders nothing", "[cli][sequence]") {
+  const Shot shot;
+  // 1001-1010x3 is 1001, 1004, 1007, 1010; chunk 1 of 2 is the last two.
+  const auto r = run_lensmith("bokeh --image " + shot.path("in.####.exr") + " -o " + shot.path("out.####.exr") +
+                              " --frames 1001-1010x3 --chunk 1/2 --list-frames" + kCamera);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.out == "1007\n1010\n");
+  CHECK_FALSE(fs::exists(shot.path("out.1007.exr")));
+  // It checks what a farm script would submit: a bad frame list is a usage error.
+  CHECK(run_lensmith("bokeh --image " + shot.path("in.####.exr") + " -o " + shot.path("out.####.exr") + " --frames 1001- --list-frames" + kCamera)
+            .exit_code == 2);
+}

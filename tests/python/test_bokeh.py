@@ -96,3 +96,37 @@ def test_an_invalid_depth_names_the_pixel_and_can_be_treated_as_far():
         lensmith.bokeh(image, depth, thin_lens_focal_length_mm=50, fstop=2, focus_m=1)
     out = lensmith.bokeh(image, depth, thin_lens_focal_length_mm=50, fstop=2, focus_m=1, invalid_depth="far")
     assert np.isfinite(out).all()
+
+
+OCIO_CONFIG = SOURCE_DIR / "tests" / "data" / "ocio" / "config.ocio"
+# Academy S-2014-004: ACES2065-1 (AP0) from ACEScg (AP1), and MaterialX's linear Rec.709 -> AP0.
+AP1_TO_AP0 = np.array([[0.6954522414, 0.1406786965, 0.1638690622], [0.0447945634, 0.8596711185, 0.0955343182],
+                       [-0.0055258826, 0.0040252103, 1.0015006723]])
+REC709_TO_AP0 = np.array([[0.43963298, 0.38298870, 0.17737832], [0.08977644, 0.81343943, 0.09678413],
+                          [0.01754117, 0.11154655, 0.87091228]])
+
+
+def test_convert_colorspace_takes_acescg_to_linear_rec709_by_the_published_matrices():
+    rng = np.random.default_rng(7)
+    acescg = rng.uniform(0.0, 4.0, (5, 7, 3)).astype(np.float32)
+    rec709 = lensmith.convert_colorspace(acescg, "ACEScg", None, ocio=OCIO_CONFIG)
+    expected = acescg.astype(np.float64) @ (np.linalg.inv(REC709_TO_AP0) @ AP1_TO_AP0).T
+    np.testing.assert_allclose(rec709, expected, rtol=2e-6, atol=2e-6)  # float pixels, 8-decimal matrices
+    back = lensmith.convert_colorspace(rec709, None, "ACEScg", ocio=OCIO_CONFIG)
+    np.testing.assert_allclose(back, acescg, rtol=2e-6, atol=2e-6)
+
+
+def test_bokeh_of_an_acescg_picture_is_the_acescg_of_the_rec709_bokeh(pinhole):
+    picture, depth = pinhole
+    rgb, z = lensmith.read_image(picture), lensmith.read_depth(depth)
+    meta = lensmith.read_metadata(picture)
+    camera = dict(lens="canon-35mm-f1.8-1956", focus_m=2, pinhole_focal_length_mm=float(meta["lensmith:focal_length_mm"]),
+                  sensor_width_mm=float(meta["lensmith:sensor_width_mm"]))
+    acescg = lensmith.convert_colorspace(rgb, None, "ACEScg", ocio=OCIO_CONFIG)
+    ours = lensmith.bokeh(acescg, z, input_colorspace="ACEScg", ocio=OCIO_CONFIG, **camera)
+    reference = lensmith.convert_colorspace(lensmith.bokeh(rgb, z, **camera), None, "ACEScg", ocio=OCIO_CONFIG)
+    np.testing.assert_allclose(ours, reference, rtol=2e-5, atol=2e-5)  # the renderer is linear in RGB
+    with pytest.raises(lensmith.OptionsError, match="ACEScct"):
+        lensmith.convert_colorspace(rgb, "ACEScct", None, ocio=OCIO_CONFIG)
+    with pytest.raises(lensmith.OptionsError):
+        lensmith.bokeh(rgb, z, ocio=OCIO_CONFIG, **camera)

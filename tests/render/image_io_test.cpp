@@ -6,6 +6,8 @@
 #include "lensmith/render/image_io.h"
 
 #include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfChromaticitiesAttribute.h>
+#include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfDeepFrameBuffer.h>
 #include <OpenEXR/ImfDeepScanLineOutputFile.h>
 #include <OpenEXR/ImfFrameBuffer.h>
@@ -260,6 +262,24 @@ TEST_CASE("EXR output records lens, f-number, focus, model, version and extra ke
   CHECK(value_of(metadata, "Software") == "lensmith 0.3.0");
   CHECK_THAT(value_of(metadata, "ImageDescription"), Contains("f/2.8") && Contains("focus 2.5 m") && Contains("double-gauss-50"));
   CHECK(value_of(metadata, "compression") == "zip");
+}
+
+TEST_CASE("EXR output writes chromaticities as OpenEXR's standard attribute, which reads back as its eight numbers", "[render][image_io]") {
+  TempDir dir;
+  const fs::path exr = dir / "acescg.exr";
+  OutputMetadata meta;
+  meta.chromaticities = "0.713, 0.293, 0.165, 0.83, 0.128, 0.044, 0.32168, 0.33767";  // ACES AP1 (S-2014-004)
+  write_output_image(exr, gradient_rgb(), meta);
+  // Read by OpenEXR itself: the typed attribute (a string of that name would hide it from readers).
+  Imf::InputFile file(exr.c_str());
+  const auto* c = file.header().findTypedAttribute<Imf::ChromaticitiesAttribute>("chromaticities");
+  REQUIRE(c != nullptr);
+  CHECK(c->value().green.y == 0.83f);
+  CHECK(c->value().white.x == 0.32168f);
+  CHECK(value_of(read_image_metadata(exr), "chromaticities") == meta.chromaticities);
+  meta.chromaticities = "0.713, 0.293";
+  CHECK_THROWS_AS(write_output_image(dir / "bad.exr", gradient_rgb(), meta), OptionsError);
+  CHECK_FALSE(fs::exists(dir / "bad.exr"));
 }
 
 TEST_CASE("PNG output records Software and an ImageDescription of the lens settings", "[render][image_io]") {

@@ -8,6 +8,7 @@
 #include <system_error>
 
 #include "lensmith/core/errors.h"
+#include "lensmith/core/termination_cleanup.h"
 
 namespace lensmith {
 
@@ -102,6 +103,7 @@ void write_atomically(const std::string& path, const std::string& extension,
   name += std::to_string(rd());
   name += extension;
   const fs::path temp = dir / name;
+  const TemporaryFileGuard removed_if_stopped(temp.string());  // SIGTERM mid-write leaves nothing
   try {
     write(temp.string());
   } catch (...) {

@@ -3,6 +3,7 @@
 // branch in read_exr that opens Imf::DeepScanLineInputPart / DeepTiledInputPart on the same file.
 // Attribute names follow OpenImageIO's mapping (comments <-> ImageDescription, ...).
 #include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfChromaticitiesAttribute.h>
 #include <OpenEXR/ImfDeepFrameBuffer.h>
 #include <OpenEXR/ImfDeepScanLineInputPart.h>
 #include <OpenEXR/ImfDeepScanLineOutputFile.h>
@@ -26,6 +27,7 @@
 #include <atomic>
 #include <cctype>
 #include <memory>
+#include <optional>
 #include <fstream>
 #include <set>
 #include <string_view>
@@ -72,9 +74,32 @@ bool is_structural(std::string_view name) {
   return false;
 }
 
+// OpenEXR's chromaticities as read_exr_metadata writes them: "rx, ry, gx, gy, bx, by, wx, wy".
+std::optional<Imf::Chromaticities> parse_chromaticities(const std::string& text) {
+  std::array<float, 8> v{};
+  std::size_t count = 0, start = 0;
+  while (start <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', start), text.size());
+    std::string item = text.substr(start, comma - start);
+    item.erase(0, item.find_first_not_of(' '));
+    const std::optional<double> number = parse_finite_number(item);
+    if (!number || count == v.size()) return std::nullopt;
+    v[count++] = static_cast<float>(*number);
+    start = comma + 1;
+  }
+  if (count != v.size()) return std::nullopt;
+  return Imf::Chromaticities({v[0], v[1]}, {v[2], v[3]}, {v[4], v[5]}, {v[6], v[7]});
+}
+
 void insert_attributes(Imf::Header& header, const std::vector<ImageAttribute>& attributes) {
   for (const ImageAttribute& attribute : attributes) {
-    if (const auto* text = std::get_if<std::string>(&attribute.value)) {
+    if (attribute.name == "chromaticities") {
+      // The standard attribute only: a string of that name would hide the primaries from readers.
+      const auto* text = std::get_if<std::string>(&attribute.value);
+      const std::optional<Imf::Chromaticities> c = text ? parse_chromaticities(*text) : std::nullopt;
+      if (!c) throw OptionsError("chromaticities attribute: expected eight numbers \"rx, ry, gx, gy, bx, by, wx, wy\"");
+      header.insert("chromaticities", Imf::ChromaticitiesAttribute(*c));
+    } else if (const auto* text = std::get_if<std::string>(&attribute.value)) {
       header.insert(exr_name(attribute.name), Imf::StringAttribute(*text));
     } else if (attribute.exr_float) {
       header.insert(exr_name(attribute.name), Imf::FloatAttribute(static_cast<float>(std::get<double>(attribute.value))));
@@ -426,8 +451,13 @@ Metadata read_exr_metadata(const fs::path& path) {
       value = shortest_float_text(v->value().x) + ", " + shortest_float_text(v->value().y);
     } else if (const auto* w = dynamic_cast<const Imf::V2iAttribute*>(&a)) {
       value = std::to_string(w->value().x) + ", " + std::to_string(w->value().y);
+    } else if (const auto* c = dynamic_cast<const Imf::ChromaticitiesAttribute*>(&a)) {
+      const Imf::Chromaticities& k = c->value();
+      for (const float x : {k.red.x, k.red.y, k.green.x, k.green.y, k.blue.x, k.blue.y, k.white.x, k.white.y}) {
+        value += (value.empty() ? "" : ", ") + shortest_float_text(x);
+      }
     } else {
-      continue;  // matrices, chromaticities, time codes, ...: no one-line text form
+      continue;  // matrices, time codes, ...: no one-line text form
     }
     metadata.emplace_back(common_name(name), value);
   }

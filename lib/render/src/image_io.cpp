@@ -467,6 +467,7 @@ std::vector<ImageAttribute> output_attributes(const OutputMetadata& meta) {
   if (meta.focus_m > 0.0) attributes.push_back({"lensmith:focus_m", meta.focus_m});
   for (const auto& [key, value] : meta.extra) attributes.push_back({"lensmith:" + key, value});
   for (const auto& [name, value] : meta.camera) attributes.push_back({name, value, true});
+  if (!meta.chromaticities.empty()) attributes.push_back({"chromaticities", meta.chromaticities});
   return attributes;
 }
 

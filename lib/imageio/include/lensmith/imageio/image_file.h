@@ -68,7 +68,7 @@ void set_image_codec_threads(int threads);
 // The metadata of a picture file as (name, value) text, under the names OpenImageIO used:
 // OpenEXR attributes (comments as ImageDescription, capDate as DateTime, owner as Copyright, the
 // compression as "compression"; strings as stored, floats and doubles in the shortest text that
-// reads back exactly), PNG text chunks (Description as ImageDescription), TIFF's Software,
+// reads back exactly; the standard chromaticities as "rx, ry, gx, gy, bx, by, wx, wy"), PNG text chunks (Description as ImageDescription), TIFF's Software,
 // ImageDescription, DateTime, Artist, Copyright and DocumentName tags and its compression, a
 // JPEG's Exif ImageDescription, Software, DateTime, Artist and Copyright (its comment as the
 // ImageDescription when Exif has none), and the NAME=value header lines of a Radiance HDR file
@@ -76,7 +76,9 @@ void set_image_codec_threads(int threads);
 std::vector<std::pair<std::string, std::string>> read_image_metadata_pairs(const std::filesystem::path& path);
 
 // One item of metadata to write: text, or a number that formats with typed attributes (OpenEXR)
-// keep as a double and others write as its shortest exact text.
+// keep as a double and others write as its shortest exact text. OpenEXR writes an attribute named
+// "chromaticities" whose text is eight numbers (as read_image_metadata_pairs gives them) as the
+// standard chromaticities attribute.
 struct ImageAttribute {
   std::string name;  // "Software", "ImageDescription", "lensmith:lens", ...
   std::variant<std::string, double> value;

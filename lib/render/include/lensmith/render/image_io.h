@@ -167,6 +167,10 @@ struct OutputMetadata {
   // OpenEXR's standard camera attributes (float, as the standard has them), written when set:
   // focus (m), aperture (f-number), focalLength (mm), entrancePupilOffset (m).
   std::vector<std::pair<std::string, double>> camera;
+  // OpenEXR's standard chromaticities of the output's RGB, "rx, ry, gx, gy, bx, by, wx, wy" as
+  // read_image_metadata gives them (an input's, passed through); empty: not written (readers then
+  // take Rec.709).
+  std::string chromaticities;
 
   std::string to_string() const;  // "lens X, f/2.8, focus 2 m, model Y" (the ImageDescription)
   friend std::ostream& operator<<(std::ostream& os, const OutputMetadata& m) { return os << m.to_string(); }
