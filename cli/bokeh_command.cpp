@@ -181,11 +181,34 @@ std::optional<ColorManagement> color_management(const BokehCommandOptions& o, co
   return ColorManagement(c);
 }
 
+// Pixels added on each side of the picture to centre the lens's axis in it (overscan wider on one
+// side than the other), cut off again before writing.
+struct EdgeGrowth {
+  int left = 0, top = 0, right = 0, bottom = 0;
+  bool any() const { return left + top + right + bottom > 0; }
+};
+
+// What the output needs from the input besides the render: its chromaticities (passed through) and
+// the growth to cut off, leaving the data window of data_width x data_height pixels.
+struct OutputExtras {
+  std::string chromaticities;
+  EdgeGrowth growth;
+  int data_width = 0, data_height = 0;
+};
+
 // Writes the picture (RGB, or RGBA) in the output colour space, with the input's depth (--keep-depth)
 // and its passes after it.
-void write_bokeh_output(Image out, OutputMetadata& meta, const BokehCommandOptions& o, const DepthMap& depth, const OtherChannels& other,
-                        const std::optional<ColorManagement>& color, const std::string& chromaticities) {
-  meta.chromaticities = chromaticities;
+void write_bokeh_output(Image out, OutputMetadata& meta, const BokehCommandOptions& o, DepthMap depth, OtherChannels other,
+                        const std::optional<ColorManagement>& color, const OutputExtras& extras) {
+  meta.chromaticities = extras.chromaticities;
+  if (const EdgeGrowth& g = extras.growth; g.any()) {
+    const int w = extras.data_width, h = extras.data_height;
+    out.data = crop_pixels(out.data, out.width, out.channels, g.left, g.top, w, h);
+    depth.z_m = crop_pixels(depth.z_m, depth.width, 1, g.left, g.top, w, h);
+    depth.width = out.width = w;
+    depth.height = out.height = h;
+    if (!other.names.empty()) other.samples = crop_pixels(other.samples, w + g.left + g.right, static_cast<int>(other.names.size()), g.left, g.top, w, h);
+  }
   if (color && !color->options().output_colorspace.empty()) {
     color->working_to_output(out.data, out.channels);
     meta.extra.emplace_back("colorspace", color->options().output_colorspace);
@@ -344,7 +367,8 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     if (key == "chromaticities") input_chromaticities = value;
   }
   if (!input_chromaticities.empty() && o.input_colorspace.empty() && !global.quiet) note_foreign_primaries(o.image, input_chromaticities);
-  const std::string output_chromaticities =
+  OutputExtras extras;
+  extras.chromaticities =
       !color || color->options().output_colorspace == color->options().input_colorspace ? input_chromaticities : std::string();
   for (const auto& [key, value] : attributes) {
     const std::optional<double> number = parse_finite_number(value);
@@ -422,17 +446,40 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   if (windows.has_overscan()) {
     const PixelBox& data = windows.data_window;
     const PixelBox& shown = windows.display_window;
-    if (shown.min_x - data.min_x != data.max_x - shown.max_x || shown.min_y - data.min_y != data.max_y - shown.max_y) {
-      throw ImageFileError(o.image + ": data window " + data.to_string() + " around display window " + shown.to_string() +
-                           ": overscan that is not the same on both sides (the lens's axis off the data window's centre) is not implemented");
-    }
+    // The lens's axis is the frame's centre. Overscan wider on one side than the other puts it off
+    // the data window's centre: the pictures are grown by their edge pixels on the narrower sides
+    // until it is centred, rendered whole, and cut back to the data window.
+    const int left = shown.min_x - data.min_x, right = data.max_x - shown.max_x;
+    const int top = shown.min_y - data.min_y, bottom = data.max_y - shown.max_y;
+    extras.growth = {std::max(0, right - left), std::max(0, bottom - top), std::max(0, left - right), std::max(0, top - bottom)};
     const double focal_px = PinholeFrame::from_options(shown.width(), shown.height(), camera.framing, default_focal_mm).focal_length_px();
     camera.framing = PinholeFrameOptions{};
-    camera.framing.focal_length_mm = focal_px * camera.framing.sensor_width_mm / width;
+    camera.framing.focal_length_mm =
+        focal_px * camera.framing.sensor_width_mm / (width + extras.growth.left + extras.growth.right);
     if (!global.quiet) {
       std::cerr << "note: " << o.image << " has overscan: data window " << data.to_string() << " around the frame " << shown.to_string()
-                << "; the pixels outside the frame are photographed too (their light reaches the frame)\n";
+                << "; the pixels outside the frame are photographed too (their light reaches the frame)";
+      if (extras.growth.any()) {
+        std::cerr << "; wider on one side, so the picture is extended by its edge pixels (" << extras.growth.left << " left, "
+                  << extras.growth.top << " top, " << extras.growth.right << " right, " << extras.growth.bottom
+                  << " bottom) to centre the lens's axis, and cut back";
+      }
+      std::cerr << "\n";
     }
+  }
+  const EdgeGrowth& grow = extras.growth;
+  extras.data_width = width;
+  extras.data_height = height;
+  if (grow.any()) {
+    flat->data = extend_edges(flat->data, width, height, 3, grow.left, grow.top, grow.right, grow.bottom);
+    if (alpha) *alpha = extend_edges(*alpha, width, height, 1, grow.left, grow.top, grow.right, grow.bottom);
+    if (!other.names.empty()) {
+      other.samples = extend_edges(other.samples, width, height, static_cast<int>(other.names.size()), grow.left, grow.top, grow.right, grow.bottom);
+    }
+    width += grow.left + grow.right;
+    height += grow.top + grow.bottom;
+    flat->width = width;
+    flat->height = height;
   }
   // The camera's framing is the pinhole frame the depth is read in (Camera::from_lens and thin_lens
   // build the same one).
@@ -449,18 +496,25 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   }
   // A layered input's depth per pixel is its front sample's, the nearest (for --focus-pixel,
   // --keep-depth and the models' nearest depth).
-  const DepthMap depth = layered ? deep->front_depth() : read_depth(depth_source, depth_options, frame);
+  DepthMap depth = layered ? deep->front_depth()
+                           : read_depth(depth_source, depth_options,
+                                        grow.any() ? frame.window(grow.left, grow.top, extras.data_width, extras.data_height) : frame);
+  if (grow.any()) {
+    depth.z_m = extend_edges(depth.z_m, depth.width, depth.height, 1, grow.left, grow.top, grow.right, grow.bottom);
+    depth.width = width;
+    depth.height = height;
+  }
   read_cache.reset();
   if (!o.focus_pixel.empty()) {
     // X,Y: integers inside the image.
     const std::size_t comma = o.focus_pixel.find(',');
     const std::optional<double> x = comma == std::string::npos ? std::nullopt : parse_finite_number(o.focus_pixel.substr(0, comma));
     const std::optional<double> y = comma == std::string::npos ? std::nullopt : parse_finite_number(o.focus_pixel.substr(comma + 1));
-    if (!x || !y || *x != std::floor(*x) || *y != std::floor(*y) || *x < 0 || *y < 0 || *x >= width || *y >= height) {
-      throw UsageError("--focus-pixel " + o.focus_pixel + ": expected X,Y, whole pixels inside the " + std::to_string(width) +
-                       " x " + std::to_string(height) + " image (0,0 = top left)");
+    if (!x || !y || *x != std::floor(*x) || *y != std::floor(*y) || *x < 0 || *y < 0 || *x >= extras.data_width || *y >= extras.data_height) {
+      throw UsageError("--focus-pixel " + o.focus_pixel + ": expected X,Y, whole pixels inside the " + std::to_string(extras.data_width) +
+                       " x " + std::to_string(extras.data_height) + " image (0,0 = top left)");
     }
-    const float z = depth.at(static_cast<int>(*x), static_cast<int>(*y));
+    const float z = depth.at(static_cast<int>(*x) + grow.left, static_cast<int>(*y) + grow.top);
     camera.focus_distance_m = z;
     if (!global.quiet) std::cerr << "note: focus " << format_rounded(z, 5) << " m, the depth at pixel (" << o.focus_pixel << ")\n";
   } else if (o.focus_m) {
@@ -520,7 +574,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture, windows);
     meta.extra.insert(meta.extra.end(), {{"views", std::to_string(options.views)}, {"mip_filter", options.mip_filter ? "on" : "off"},
                                          {"lightfield_colour", options.spectral ? "three wavelengths" : "reference wavelength"}});
-    write_bokeh_output(out, meta, o, depth, other, color, output_chromaticities);
+    write_bokeh_output(out, meta, o, depth, other, color, extras);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     const double pixel_views = static_cast<double>(out.width) * out.height * options.views;
     std::ostringstream what;
@@ -554,7 +608,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture, windows);
     meta.extra.insert(meta.extra.end(), {{"splat_kernel", options.lens_psf ? "lens psf" : "circular coc"},
                                          {"level_of_detail", options.level_of_detail ? "on" : "off"}});
-    write_bokeh_output(out, meta, o, depth, other, color, output_chromaticities);
+    write_bokeh_output(out, meta, o, depth, other, color, extras);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     std::ostringstream what;
     what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds
@@ -598,7 +652,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture, windows);
     meta.extra.insert(meta.extra.end(), {{"rings", std::to_string(options.rings)}, {"median", options.median ? "on" : "off"},
                                          {"hidden_surfaces", traced ? "trace " + o.scene : std::string("none")}});
-    write_bokeh_output(out, meta, o, depth, other, color, output_chromaticities);
+    write_bokeh_output(out, meta, o, depth, other, color, extras);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     std::ostringstream what;
     what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds
@@ -644,7 +698,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture, windows);
     meta.extra.insert(meta.extra.end(), {{"samples", std::to_string(options.samples)}, {"layers", std::to_string(options.layers)},
                                          {"cone_tracing", options.cone_tracing ? "on" : "off"}});
-    write_bokeh_output(out, meta, o, depth, other, color, output_chromaticities);
+    write_bokeh_output(out, meta, o, depth, other, color, extras);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     std::ostringstream what;
     what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds
@@ -708,7 +762,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
 
   OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture, windows);
   meta.extra.insert(meta.extra.end(), {{"hidden_surfaces", std::string(to_string(options.hidden))}, {"edge_pixels", o.edge_pixels}});
-  write_bokeh_output(out, meta, o, depth, other, color, output_chromaticities);
+  write_bokeh_output(out, meta, o, depth, other, color, extras);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   std::ostringstream what;
   what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds

@@ -35,11 +35,18 @@ std::string PinholeFrameOptions::to_string() const {
 }
 
 PinholeFrame::PinholeFrame(int width_px, int height_px, double focal_length_px)
-    : width_(width_px), height_(height_px), focal_px_(focal_length_px) {
+    : width_(width_px), height_(height_px), focal_px_(focal_length_px), centre_x_(0.5 * width_px), centre_y_(0.5 * height_px) {
   if (width_px < 1 || height_px < 1) throw OptionsError("pinhole image must be at least 1 x 1 pixel");
   if (!(std::isfinite(focal_length_px) && focal_length_px > 0.0)) {
     throw OptionsError("pinhole focal length in pixels must be finite and > 0 (got " + format_number(focal_length_px) + ")");
   }
+}
+
+PinholeFrame PinholeFrame::window(int left, int top, int width_px, int height_px) const {
+  PinholeFrame part(width_px, height_px, focal_px_);
+  part.centre_x_ = centre_x_ - left;
+  part.centre_y_ = centre_y_ - top;
+  return part;
 }
 
 PinholeFrame PinholeFrame::from_options(int width_px, int height_px, const PinholeFrameOptions& options,
@@ -63,7 +70,9 @@ std::string PinholeFrame::to_string() const {
   std::ostringstream os;
   os.precision(6);
   os << "PinholeFrame(" << width_ << " x " << height_ << " px, f = " << focal_px_ << " px, hfov "
-     << horizontal_fov_deg() << " deg)";
+     << horizontal_fov_deg() << " deg";
+  if (centre_x_ != 0.5 * width_ || centre_y_ != 0.5 * height_) os << ", axis at (" << centre_x_ << ", " << centre_y_ << ") px";
+  os << ")";
   return os.str();
 }
 

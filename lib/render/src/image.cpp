@@ -60,4 +60,43 @@ std::string DepthMap::to_string() const {
   return os.str();
 }
 
+std::vector<float> extend_edges(std::span<const float> samples, int width, int height, int channels, int left, int top, int right,
+                                int bottom) {
+  if (width < 1 || height < 1 || channels < 1 || left < 0 || top < 0 || right < 0 || bottom < 0 ||
+      samples.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * static_cast<std::size_t>(channels)) {
+    throw OptionsError("extend_edges: " + std::to_string(samples.size()) + " samples for " + std::to_string(width) + " x " +
+                       std::to_string(height) + " pixels of " + std::to_string(channels) + " channels, growth " + std::to_string(left) +
+                       ", " + std::to_string(top) + ", " + std::to_string(right) + ", " + std::to_string(bottom));
+  }
+  const int w = width + left + right, h = height + top + bottom;
+  const auto c = static_cast<std::size_t>(channels);
+  std::vector<float> out(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * c);
+  for (int y = 0; y < h; ++y) {
+    const int sy = std::clamp(y - top, 0, height - 1);
+    for (int x = 0; x < w; ++x) {
+      const int sx = std::clamp(x - left, 0, width - 1);
+      std::copy_n(samples.begin() + static_cast<std::ptrdiff_t>((static_cast<std::size_t>(sy) * static_cast<std::size_t>(width) + static_cast<std::size_t>(sx)) * c),
+                  c, out.begin() + static_cast<std::ptrdiff_t>((static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)) * c));
+    }
+  }
+  return out;
+}
+
+std::vector<float> crop_pixels(std::span<const float> samples, int full_width, int channels, int left, int top, int width, int height) {
+  const auto c = static_cast<std::size_t>(std::max(channels, 1));
+  const std::size_t full_height = full_width > 0 ? samples.size() / (static_cast<std::size_t>(full_width) * c) : 0;
+  if (channels < 1 || width < 1 || height < 1 || left < 0 || top < 0 || left + width > full_width ||
+      static_cast<std::size_t>(top + height) > full_height) {
+    throw OptionsError("crop_pixels: " + std::to_string(width) + " x " + std::to_string(height) + " at (" + std::to_string(left) + ", " +
+                       std::to_string(top) + ") is not inside a picture " + std::to_string(full_width) + " pixels wide and " +
+                       std::to_string(full_height) + " high");
+  }
+  std::vector<float> out(static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * c);
+  for (int y = 0; y < height; ++y) {
+    std::copy_n(samples.begin() + static_cast<std::ptrdiff_t>((static_cast<std::size_t>(y + top) * static_cast<std::size_t>(full_width) + static_cast<std::size_t>(left)) * c),
+                static_cast<std::size_t>(width) * c, out.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(y) * static_cast<std::size_t>(width) * c));
+  }
+  return out;
+}
+
 }  // namespace lensmith

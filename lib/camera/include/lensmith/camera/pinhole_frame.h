@@ -45,10 +45,14 @@ class PinholeFrame {
   double horizontal_fov_deg() const;
 
   // The direction through a continuous pixel position (pixel centres at i + 0.5).
-  Tangents tangents_at(const PixelPoint& p) const {
-    return {(p.x - 0.5 * width_) / focal_px_, (0.5 * height_ - p.y) / focal_px_};
-  }
-  PixelPoint pixel_at(const Tangents& t) const { return {0.5 * width_ + t.x * focal_px_, 0.5 * height_ - t.y * focal_px_}; }
+  Tangents tangents_at(const PixelPoint& p) const { return {(p.x - centre_x_) / focal_px_, (centre_y_ - p.y) / focal_px_}; }
+  PixelPoint pixel_at(const Tangents& t) const { return {centre_x_ + t.x * focal_px_, centre_y_ - t.y * focal_px_}; }
+
+  // The part of this frame from pixel (left, top), width x height pixels: its pixel (x, y) looks
+  // where this frame's (left + x, top + y) does, so its axis is off its centre. For reading a
+  // picture that covers part of a frame (an OpenEXR data window off the frame's centre); the
+  // renderers take whole frames, axis at the centre. Throws OptionsError for an empty size.
+  PinholeFrame window(int left, int top, int width_px, int height_px) const;
 
   std::string to_string() const;  // "PinholeFrame(640 x 360 px, f = 711.1 px, hfov 48.5 deg)"
   friend std::ostream& operator<<(std::ostream& os, const PinholeFrame& f) { return os << f.to_string(); }
@@ -57,6 +61,8 @@ class PinholeFrame {
   int width_ = 0;
   int height_ = 0;
   double focal_px_ = 0.0;
+  double centre_x_ = 0.0;  // where the axis meets the image, pixels from the left edge (width / 2 but in a window)
+  double centre_y_ = 0.0;  // ... from the top edge
 };
 
 }  // namespace lensmith

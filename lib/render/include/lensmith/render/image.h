@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <ostream>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -44,5 +45,16 @@ struct DepthMap {
   std::string to_string() const;  // "DepthMap(640 x 360, 0.5 m to inf)"
   friend std::ostream& operator<<(std::ostream& os, const DepthMap& d) { return os << d.to_string(); }
 };
+
+// Interleaved samples (`channels` per pixel, rows top first) of a width x height picture grown by
+// `left`, `top`, `right` and `bottom` pixels (each >= 0), every new pixel a copy of the nearest
+// edge pixel (clamp to edge, as compositors extend a picture). Throws OptionsError when the
+// samples do not fill width x height x channels.
+std::vector<float> extend_edges(std::span<const float> samples, int width, int height, int channels, int left, int top, int right,
+                                int bottom);
+
+// The width x height pixels from (left, top) of interleaved samples of a picture `full_width` pixels
+// wide (the inverse of extend_edges). Throws OptionsError when the box is not inside the picture.
+std::vector<float> crop_pixels(std::span<const float> samples, int full_width, int channels, int left, int top, int width, int height);
 
 }  // namespace lensmith
