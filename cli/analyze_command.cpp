@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "lensmith/core/json_text.h"
 #include "lensmith/report/json_report.h"
 #include "json_output.h"
 #include "lensmith/analysis/chromatic_focal_shift.h"
@@ -29,7 +30,7 @@ template <typename Result, typename Json, typename Plot>
 int report(const Result& result, const AnalyzeCommandOptions& options, const GlobalOptions& global, Json json, Plot plot) {
   if (!options.common.png.empty()) write_picture(plot(result, make_plot_options(global)), options.common.png, options.common.lens, global);
   if (options.common.json) {
-    std::cout << json(result).dump(2) << "\n";
+    std::cout << json_text(json(result), 2) << "\n";
   } else {
     std::cout << result.to_string();
   }

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "lensmith/core/json_text.h"
 #include "lensmith/report/json_report.h"
 #include "lensmith/analysis/ray_fan.h"
 #include "lensmith/core/units.h"
@@ -22,7 +23,7 @@ int run_fan(const FanCommandOptions& options, const GlobalOptions& global) {
     write_picture(plot::plot_ray_fan(fan, make_plot_options(global)), options.common.png, options.common.lens, global);
   }
   if (options.common.json) {
-    std::cout << fan_json(fan).dump(2) << "\n";
+    std::cout << json_text(fan_json(fan), 2) << "\n";
   } else {
     std::cout << fan.to_string();
   }

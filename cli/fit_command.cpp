@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "commands.h"
+#include "lensmith/core/json_text.h"
 #include "lensmith/report/json_report.h"
 #include "json_output.h"
 #include "lensmith/core/errors.h"
@@ -56,7 +57,7 @@ int run_fit(const FitCommandOptions& o, const GlobalOptions& global) {
   if (o.json) {
     ojson j = fit_json(fit);
     if (!o.output.empty()) j["output"] = o.output;
-    std::cout << j.dump(2) << "\n";
+    std::cout << json_text(j, 2) << "\n";
     return kExitOk;
   }
   std::cout << std::fixed;

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "lensmith/core/json_text.h"
 #include "lensmith/report/json_report.h"
 #include "json_output.h"
 #include "lensmith/core/units.h"
@@ -42,7 +43,7 @@ int run_info(const InfoOptions& options, const GlobalOptions& global) {
   if (options.json) {
     ojson o = info_json(lens, system);
     if (table) o["spectral"] = spectral_json(*table);
-    std::cout << o.dump(2) << "\n";
+    std::cout << json_text(o, 2) << "\n";
     return kExitOk;
   }
   std::cout << lens.to_string() << "\n";

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "lensmith/core/json_text.h"
 #include "lensmith/core/text_file.h"
 #include "lensmith/prescription/lens_library.h"
 #include "lensmith/prescription/lentil_reader.h"
@@ -22,7 +23,7 @@ int run_lenses(const LensesOptions& options, const GlobalOptions&) {
                        {"patent_focal_length_mm", e.patent_focal_length_mm}, {"production_ready", e.production_ready},
                        {"supported", e.supported}});
       }
-      std::cout << out.dump(2) << "\n";
+      std::cout << json_text(out, 2) << "\n";
       return kExitOk;
     }
     std::cout << std::left << std::setw(6) << "id" << std::setw(24) << "company" << std::setw(34) << "product" << std::setw(6) << "year"
@@ -38,7 +39,7 @@ int run_lenses(const LensesOptions& options, const GlobalOptions&) {
   if (options.json) {
     nlohmann::ordered_json out = nlohmann::ordered_json::array();
     for (const auto& l : lenses) out.push_back({{"id", l.id}, {"name", l.name}, {"source", l.source}});
-    std::cout << out.dump(2) << "\n";
+    std::cout << json_text(out, 2) << "\n";
     return kExitOk;
   }
   std::size_t width = 4;

@@ -11,6 +11,7 @@
 
 #include "commands.h"
 #include "json_output.h"
+#include "lensmith/core/json_text.h"
 #include "lensmith/core/number_parsing.h"
 #include "lensmith/core/errors.h"
 #include "lensmith/core/termination_cleanup.h"
@@ -514,7 +515,7 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) json = json || std::string_view(argv[i]) == "--json";
   auto fail = [json](int code, const std::string& message) {
     std::cerr << "lensmith: " << message << "\n";
-    if (json) std::cout << ojson{{"error", {{"exit_code", code}, {"message", message}}}}.dump(2) << "\n";
+    if (json) std::cout << lensmith::json_text(ojson{{"error", {{"exit_code", code}, {"message", message}}}}, 2) << "\n";
     return code;
   };
   // The first word that is not an option names the subcommand.
@@ -551,7 +552,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    if (json) std::cout << ojson{{"error", {{"exit_code", kExitUsage}, {"message", e.what()}}}}.dump(2) << "\n";
+    if (json) std::cout << lensmith::json_text(ojson{{"error", {{"exit_code", kExitUsage}, {"message", e.what()}}}}, 2) << "\n";
     app.exit(e);
     return kExitUsage;
   }

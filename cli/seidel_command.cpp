@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "lensmith/core/json_text.h"
 #include "lensmith/report/json_report.h"
 #include "json_output.h"
 #include "lensmith/core/units.h"
@@ -42,7 +43,7 @@ int run_seidel(const SeidelCommandOptions& options, const GlobalOptions& global)
     std::cout << "\n  Born & Wolf coefficients: " << AberrationCoefficients::from(seidel).to_string() << "\n";
     return kExitOk;
   }
-  std::cout << seidel_json(lens, seidel).dump(2) << "\n";
+  std::cout << json_text(seidel_json(lens, seidel), 2) << "\n";
   return kExitOk;
 }
 

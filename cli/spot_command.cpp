@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "lensmith/core/json_text.h"
 #include "lensmith/report/json_report.h"
 #include "json_output.h"
 #include "lensmith/analysis/spot_diagram.h"
@@ -29,7 +30,7 @@ int run_spot(const SpotCommandOptions& options, const GlobalOptions& global) {
     write_picture(plot::plot_spot_diagram(diagram, make_plot_options(global)), options.common.png, options.common.lens, global);
   }
   if (options.common.json) {
-    std::cout << spot_json(diagram).dump(2) << "\n";
+    std::cout << json_text(spot_json(diagram), 2) << "\n";
   } else {
     std::cout << diagram.to_string();
   }

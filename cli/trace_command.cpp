@@ -8,6 +8,7 @@
 #include "commands.h"
 #include "lensmith/analysis/ray_trace_listing.h"
 #include "lensmith/core/errors.h"
+#include "lensmith/core/json_text.h"
 
 namespace lensmith::cli {
 
@@ -92,7 +93,7 @@ int run_trace(const TraceCommandOptions& options, const GlobalOptions& global) {
   trace.image_plane = analysis.image_plane;
   const RayTraceListing listing = trace_ray_listing(lens, trace);
   if (options.json) {
-    std::cout << listing_json(listing, options.aim).dump(2) << "\n";
+    std::cout << json_text(listing_json(listing, options.aim), 2) << "\n";
   } else {
     std::cout << listing.to_string();
   }

@@ -4,13 +4,14 @@
 
 #include "bindings.h"
 #include "lensmith/core/errors.h"
+#include "lensmith/core/json_text.h"
 #include "lensmith/imageio/raster.h"
 #include "lensmith/polyfit/polynomial.h"
 #include "lensmith/scene/scene_error.h"
 
 namespace lensmith::python {
 
-std::string dump(const ojson& o) { return o.dump(); }
+std::string dump(const ojson& o) { return json_text(o); }
 
 namespace {
 

@@ -111,3 +111,22 @@ TEST_CASE("lensmith convert writes a file that reads back to the same analysis, 
   CHECK(fs::file_size(out) == before);
   fs::remove(out);
 }
+
+TEST_CASE("an ANSI-encoded Zemax file's name reaches info --json and convert as UTF-8, not as an internal error", "[cli][info]") {
+  // Issue 17: a NAME with "Ø" saved by OpticStudio as Windows-1252 (byte 0xD8) made nlohmann's dump
+  // throw (exit 70). The Sasian triplet (tests/data/zemax) with such a name.
+  std::ifstream in(std::string(LENSMITH_TEST_DATA_DIR) + "/zemax/sasian_triplet.zmx", std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t at = text.find("NAME");
+  text.replace(at, text.find('\n', at) - at, "NAME \xD8" "25 Triplet");
+  const lensmith::testing::ScratchFolder folder("lensmith_ansi_cli_");
+  const std::string lens = folder.file("ansi.zmx", text), out = folder.file("ansi.json");
+  const auto info = lensmith::testing::run_lensmith("info " + lens + " --json");
+  INFO(info.err);
+  REQUIRE(info.exit_code == 0);
+  CHECK(nlohmann::json::parse(info.out)["name"] == "\xC3\x98" "25 Triplet");
+  const auto convert = lensmith::testing::run_lensmith("convert " + lens + " -o " + out);
+  REQUIRE(convert.exit_code == 0);
+  std::ifstream written(out);
+  CHECK(nlohmann::json::parse(written)["name"] == "\xC3\x98" "25 Triplet");
+}

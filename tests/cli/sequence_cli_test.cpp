@@ -126,7 +126,7 @@ TEST_CASE("a shot's command line is checked before any frame is rendered", "[cli
   CHECK_FALSE(fs::exists(shot.path("o.1001.exr")));
 }
 
-TEST_CASE("--list-frames prints the frames a chunk would render, one per line, and renders nothing", "[cli][sequence]") {
+TEST_CASE("listing frames (--list-frames) prints the frames a chunk would render, one per line, and renders nothing", "[cli][sequence]") {
   const Shot shot;
   // 1001-1010x3 is 1001, 1004, 1007, 1010; chunk 1 of 2 is the last two.
   const auto r = run_lensmith("bokeh --image " + shot.path("in.####.exr") + " -o " + shot.path("out.####.exr") +

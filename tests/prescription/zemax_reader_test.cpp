@@ -154,6 +154,35 @@ TEST_CASE("Zemax: a UTF-16LE file with a byte-order mark reads exactly like its 
   CHECK(utf16.diagnostics.size() == utf8.diagnostics.size());
 }
 
+TEST_CASE("Zemax: an ANSI (Windows-1252) file reads like its UTF-8 copy, its name decoded to UTF-8", "[prescription][zemax]") {
+  // OpticStudio's "ANSI" encoding: NAME with a diameter sign and a degree sign, 0xD8 and 0xB0 in
+  // Windows-1252 (U+00D8 and U+00B0), and a right single quote, 0x92 (U+2019).
+  std::string ansi = mini_zmx();
+  const std::size_t at = ansi.find("NAME MINI");
+  ansi.replace(at, 9, "NAME \xD8" "25 mm 45\xB0 lens\x92s");
+  const LensReadResult r = read_zemax(ansi, "ansi.zmx");
+  CHECK(r.prescription.name == "\xC3\x98" "25 mm 45\xC2\xB0 lens\xE2\x80\x99s");
+  CHECK(is_valid_utf8(r.prescription.name));
+  CHECK(r.prescription.surfaces == read_zemax(mini_zmx(), "t.zmx").prescription.surfaces);
+}
+
+TEST_CASE("Zemax: UTF-16LE without a byte-order mark is recognised by its zero bytes", "[prescription][zemax]") {
+  const std::string plain = mini_zmx();
+  std::string utf16;
+  for (const char c : plain) utf16 += std::string{c, '\0'};
+  CHECK(read_zemax(utf16, "t.zmx").prescription == read_zemax(plain, "t.zmx").prescription);
+}
+
+TEST_CASE("UTF-8 validation follows RFC 3629: overlong forms, surrogates and bytes past U+10FFFF are not UTF-8", "[core][text]") {
+  CHECK(is_valid_utf8("plain ASCII"));
+  CHECK(is_valid_utf8("\xC3\x98 \xE2\x82\xAC \xF0\x9F\x93\xB7"));  // Ø € 📷
+  CHECK_FALSE(is_valid_utf8("\xD8" "25"));                                // Windows-1252 Ø
+  CHECK_FALSE(is_valid_utf8("\xC0\xAF"));                                // overlong '/'
+  CHECK_FALSE(is_valid_utf8("\xED\xA0\x80"));                           // a surrogate, U+D800
+  CHECK_FALSE(is_valid_utf8("\xF4\x90\x80\x80"));                      // U+110000
+  CHECK_FALSE(is_valid_utf8("\xE2\x82"));                                // cut off
+}
+
 TEST_CASE("Zemax: a UTF-8 byte-order mark is skipped", "[prescription][zemax]") {
   const std::string plain = mini_zmx();
   CHECK(read_zemax("\xEF\xBB\xBF" + plain, "t.zmx").prescription == read_zemax(plain, "t.zmx").prescription);

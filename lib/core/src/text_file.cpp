@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <system_error>
@@ -73,7 +74,68 @@ std::string decode_utf16(std::string_view bytes, bool little_endian, const std::
   return out;
 }
 
+// Unicode of the bytes 0x80-0x9F in Windows-1252 (the WHATWG Encoding Standard's index); the five
+// bytes it leaves undefined keep their ISO-8859-1 meaning (C1 controls), as browsers decode them.
+// Bytes 0xA0-0xFF are U+00A0-U+00FF in both.
+constexpr char32_t kWindows1252High[32] = {
+    0x20AC, 0x0081, 0x201A, 0x0192, 0x201E, 0x2026, 0x2020, 0x2021, 0x02C6, 0x2030, 0x0160, 0x2039, 0x0152, 0x008D, 0x017D, 0x008F,
+    0x0090, 0x2018, 0x2019, 0x201C, 0x201D, 0x2022, 0x2013, 0x2014, 0x02DC, 0x2122, 0x0161, 0x203A, 0x0153, 0x009D, 0x017E, 0x0178};
+
+std::string decode_windows_1252(std::string_view bytes) {
+  std::string out;
+  out.reserve(bytes.size() + bytes.size() / 8);
+  for (const char c : bytes) {
+    const auto b = static_cast<unsigned char>(c);
+    append_utf8(out, b >= 0x80 && b < 0xA0 ? kWindows1252High[b - 0x80] : static_cast<char32_t>(b));
+  }
+  return out;
+}
+
+// UTF-16 without a byte-order mark: text that is mostly ASCII has a zero byte in every pair, on the
+// high byte's side, and never on the other (a sample of the first 512 bytes).
+std::optional<bool> utf16_without_bom(std::string_view bytes) {
+  if (bytes.size() < 4 || bytes.size() % 2 != 0) return std::nullopt;
+  const std::size_t n = std::min<std::size_t>(bytes.size(), 512);
+  std::size_t zero_even = 0, zero_odd = 0;
+  for (std::size_t i = 0; i + 1 < n; i += 2) {
+    zero_even += bytes[i] == '\0';
+    zero_odd += bytes[i + 1] == '\0';
+  }
+  const std::size_t pairs = n / 2;
+  if (zero_even == 0 && zero_odd * 2 > pairs) return true;   // little-endian: "A\0"
+  if (zero_odd == 0 && zero_even * 2 > pairs) return false;  // big-endian: "\0A"
+  return std::nullopt;
+}
+
 }  // namespace
+
+bool is_valid_utf8(std::string_view bytes) {
+  std::size_t i = 0;
+  while (i < bytes.size()) {
+    const auto b = static_cast<unsigned char>(bytes[i]);
+    if (b < 0x80) {
+      ++i;
+      continue;
+    }
+    // The lead byte gives the length and the smallest code point it may encode (no overlong forms,
+    // no surrogates, nothing above U+10FFFF: RFC 3629).
+    std::size_t length = 0;
+    char32_t cp = 0, least = 0;
+    if (b >= 0xC2 && b <= 0xDF) length = 2, cp = b & 0x1F, least = 0x80;
+    else if (b >= 0xE0 && b <= 0xEF) length = 3, cp = b & 0x0F, least = 0x800;
+    else if (b >= 0xF0 && b <= 0xF4) length = 4, cp = b & 0x07, least = 0x10000;
+    else return false;
+    if (i + length > bytes.size()) return false;
+    for (std::size_t k = 1; k < length; ++k) {
+      const auto c = static_cast<unsigned char>(bytes[i + k]);
+      if ((c & 0xC0) != 0x80) return false;
+      cp = (cp << 6) | (c & 0x3F);
+    }
+    if (cp < least || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return false;
+    i += length;
+  }
+  return true;
+}
 
 std::string decode_text(std::string_view bytes, const std::string& file_name) {
   if (bytes.size() >= 2 && static_cast<unsigned char>(bytes[0]) == 0xFF && static_cast<unsigned char>(bytes[1]) == 0xFE) {
@@ -82,11 +144,14 @@ std::string decode_text(std::string_view bytes, const std::string& file_name) {
   if (bytes.size() >= 2 && static_cast<unsigned char>(bytes[0]) == 0xFE && static_cast<unsigned char>(bytes[1]) == 0xFF) {
     return decode_utf16(bytes.substr(2), false, file_name);
   }
+  if (const std::optional<bool> little_endian = utf16_without_bom(bytes)) return decode_utf16(bytes, *little_endian, file_name);
   if (bytes.size() >= 3 && static_cast<unsigned char>(bytes[0]) == 0xEF && static_cast<unsigned char>(bytes[1]) == 0xBB &&
       static_cast<unsigned char>(bytes[2]) == 0xBF) {
-    return std::string(bytes.substr(3));
+    bytes.remove_prefix(3);
   }
-  return std::string(bytes);
+  // Not UTF-8: OpticStudio's "ANSI" files, Windows-1252 (a superset of ISO-8859-1's printable
+  // characters) on the machines that write them.
+  return is_valid_utf8(bytes) ? std::string(bytes) : decode_windows_1252(bytes);
 }
 
 void write_atomically(const std::string& path, const std::string& extension,

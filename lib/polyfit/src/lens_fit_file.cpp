@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lensmith/core/errors.h"
+#include "lensmith/core/json_text.h"
 #include "lensmith/core/located_json.h"
 #include "lensmith/core/text_file.h"
 #include "lensmith/polyfit/lens_fit.h"
@@ -203,7 +204,7 @@ std::string LensFit::to_json() const {
   root["timing"] = {{"fit_seconds", timing_.fit_seconds},
                     {"exact_ns_per_ray", timing_.exact_ns_per_ray},
                     {"poly_ns_per_ray", timing_.poly_ns_per_ray}};
-  return root.dump(1) + "\n";
+  return json_text(root, 1) + "\n";
 }
 
 void LensFit::write(const std::string& path) const { write_file_atomically(path, to_json()); }

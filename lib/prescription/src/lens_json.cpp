@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "lensmith/core/json_text.h"
 #include "lensmith/core/located_json.h"
 #include "lensmith/core/units.h"
 
@@ -346,7 +347,7 @@ std::string write_lens_json(const Prescription& p) {
     surfaces.push_back(j);
   }
   o["surfaces"] = surfaces;
-  return o.dump(2) + "\n";
+  return json_text(o, 2) + "\n";
 }
 
 }  // namespace lensmith

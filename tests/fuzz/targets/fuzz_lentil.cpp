@@ -2,6 +2,7 @@
 #include <cstdint>
 #include <string_view>
 
+#include "json_output_check.h"
 #include "lensmith/core/errors.h"
 #include "lensmith/prescription/lentil_reader.h"
 
@@ -13,7 +14,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (const auto& e : entries) {
       if (++tried > 8) break;
       try {
-        lensmith::read_lentil(text, "fuzz.json", e.id);
+        check_json_output(lensmith::read_lentil(text, "fuzz.json", e.id));
       } catch (const lensmith::Error&) {
       }
     }

@@ -2,6 +2,7 @@
 #include <cstdint>
 #include <string_view>
 
+#include "json_output_check.h"
 #include "lensmith/core/errors.h"
 #include "lensmith/prescription/pbrt_reader.h"
 
@@ -10,7 +11,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (auto convention : {lensmith::PbrtConvention::Auto, lensmith::PbrtConvention::ThicknessToNext,
                           lensmith::PbrtConvention::SeparationFromPrevious}) {
     try {
-      lensmith::read_pbrt(text, "fuzz.dat", convention);
+      check_json_output(lensmith::read_pbrt(text, "fuzz.dat", convention));
     } catch (const lensmith::Error&) {
     }
   }

@@ -10,9 +10,16 @@ namespace lensmith {
 // Reads a whole file as bytes. Throws IoError naming the path when it cannot be opened.
 std::string read_file_bytes(const std::string& path);
 
-// Decodes text as Zemax and Windows tools write it: UTF-8 (with or without BOM) or UTF-16LE/BE
-// with a BOM, returned as UTF-8. Throws LensFileError(file) on a malformed UTF-16 sequence.
+// Decodes text as Zemax and Windows tools write it, returned as valid UTF-8: UTF-16LE/BE with a BOM
+// (or without one, recognised by the zero byte in every pair of mostly-ASCII text), UTF-8 with or
+// without a BOM, and otherwise (bytes that are not UTF-8) "ANSI": Windows-1252, whose printable
+// characters include ISO-8859-1's (OpticStudio writes all three). Throws LensFileError(file) on a
+// malformed UTF-16 sequence.
 std::string decode_text(std::string_view bytes, const std::string& file_name);
+
+// Whether the bytes are well-formed UTF-8 (RFC 3629: no overlong forms, surrogates or code points
+// above U+10FFFF).
+bool is_valid_utf8(std::string_view bytes);
 
 // Writes `contents` to `path` through a temporary file in the same folder and a rename, so a
 // crash never leaves a half-written output. Throws IoError.
