@@ -300,10 +300,32 @@ TEST_CASE("Zemax: a glass in no catalogue and without nd on its line is an error
 TEST_CASE("Zemax: OpticStudio's placeholder nd 1.5 / Vd 40 never stands in for an unknown glass",
           "[prescription][zemax]") {
   std::string text = mini_zmx();
-  text.replace(text.find("N-BK7 0 0 1.5 40"), 16, "SILICA 0 0 1.5 40");
+  text.replace(text.find("N-BK7 0 0 1.5 40"), 16, "ACME-42 0 0 1.5 40");
   const LensFileError e = zemax_error(text);
-  CHECK(e.where().line == line_of(text, "GLAS SILICA"));
-  CHECK_THAT(e.what(), Contains("SILICA") && Contains("placeholder"));
+  CHECK(e.where().line == line_of(text, "GLAS ACME-42"));
+  CHECK_THAT(e.what(), Contains("ACME-42") && Contains("placeholder"));
+}
+
+TEST_CASE("Zemax: an obsolete SCHOTT name is read as its lead-free successor, with a warning naming both", "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("N-BK7 0 0 1.5 40"), 16, "BK7 0 0 1.5 40");
+  const LensReadResult r = read_zemax(text, "t.zmx");
+  CHECK(r.prescription.surfaces[1].material == MaterialSpec::catalog("N-BK7", "SCHOTT"));
+  REQUIRE(r.diagnostics.size() == 1);
+  CHECK_THAT(r.diagnostics[0].message, Contains("\"BK7\" is an obsolete name") && Contains("SCHOTT N-BK7"));
+  CHECK(r.diagnostics[0].where.line == line_of(text, "GLAS BK7"));
+}
+
+TEST_CASE("Zemax: fused silica, CaF2 and plastics are found by their OpticStudio names", "[prescription][zemax]") {
+  for (const char* name : {"F_SILICA", "SILICA", "CAF2", "POLYCARB", "PMMA"}) {
+    std::string text = mini_zmx();
+    text.replace(text.find("GCAT SCHOTT"), 11, "GCAT SCHOTT MISC");  // OpticStudio's MISC catalogue has them
+    text.replace(text.find("N-BK7 0 0 1.5 40"), 16, std::string(name) + " 0 0 1.5 40");
+    const LensReadResult r = read_zemax(text, "t.zmx");
+    INFO(name);
+    CHECK(r.prescription.surfaces[1].material == MaterialSpec::catalog(name, "MISC"));
+    CHECK(r.diagnostics.empty());
+  }
 }
 
 TEST_CASE("Zemax: GCAT sets the vendor searched first", "[prescription][zemax]") {

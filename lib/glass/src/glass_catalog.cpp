@@ -286,8 +286,24 @@ const Glass& GlassCatalog::get(std::string_view name, std::string_view vendor,
                    (closest.empty() ? "" : "; closest " + vendor_upper + " names: " + join(closest)));
 }
 
+const Glass* GlassCatalog::successor(std::string_view obsolete_name) const {
+  if (obsolete_name.empty() || find(obsolete_name) != nullptr) return nullptr;
+  const std::string base = "N-" + upper(obsolete_name);
+  for (const std::string& candidate : {base, base + "A"}) {
+    if (const Glass* glass = find(candidate, "SCHOTT")) return glass;
+  }
+  return nullptr;
+}
+
 std::vector<std::string> GlassCatalog::closest_names(std::string_view name, std::size_t count) const {
-  return closest_names_at(name, {}, count);
+  std::vector<std::string> names = closest_names_at(name, {}, count);
+  if (const Glass* next = successor(name); next != nullptr && count > 0) {
+    const std::string entry = next->name() + " (" + next->vendor() + ")";
+    names.erase(std::remove(names.begin(), names.end(), entry), names.end());
+    names.insert(names.begin(), entry);
+    if (names.size() > count) names.resize(count);
+  }
+  return names;
 }
 
 std::vector<std::string> GlassCatalog::closest_names_at(std::string_view name, std::string_view vendor_upper,

@@ -640,12 +640,19 @@ class ZemaxParser {
       }
       return MaterialSpec::catalog(found->name(), found->vendor());
     }
+    if (const Glass* next = catalogue_.successor(g.name)) {
+      warn(g.line, "glass \"" + g.name + "\" is an obsolete name in no catalogue; using its successor " + next->vendor() + " " +
+                       next->name() + " (nd " + format_rounded(next->nd(), 6) + ", Vd " + format_rounded(next->vd(), 4) +
+                       "), the same glass type made lead-free, whose index differs slightly from the original's");
+      return MaterialSpec::catalog(next->name(), next->vendor());
+    }
     const bool placeholder = g.nd && g.vd && *g.nd == kPlaceholderNd && *g.vd == kPlaceholderVd;
     const bool usable_nd = g.nd && *g.nd >= 1.0 && *g.nd <= kMaxPlausibleIndex && !placeholder;
     if (usable_nd && (!g.vd || *g.vd >= 0.0)) {
       const std::optional<double> vd = g.vd && *g.vd > 0.0 ? g.vd : std::nullopt;
       warn(g.line, "glass \"" + g.name + "\" is in no catalogue; using a model glass nd=" + format_number(*g.nd) +
-                       (vd ? " Vd=" + format_number(*vd) : std::string(" without dispersion")) + " from its GLAS line");
+                       (vd ? " Vd=" + format_number(*vd) : std::string(" without dispersion")) + " from its GLAS line" +
+                       (vd ? " (Cauchy from nd and Vd: " + model_glass_accuracy(*vd) + " in index)" : std::string()));
       return MaterialSpec::model(*g.nd, vd);
     }
     std::string names;

@@ -99,4 +99,10 @@ class Glass {
   std::string replaced_by_;
 };
 
+// How far a model glass (Glass::model) of this Abbe number strays from real glass, for warnings:
+// the worst difference from every built-in catalogue glass of its class (crowns Vd >= 50, middle
+// 35-50, flints < 35), measured with each glass's own nd and Vd (docs/glass.md), e.g. "within 2e-4
+// from 450 to 700 nm, up to 8e-4 at 400 nm and 3e-4 at 750 nm (worst of the catalogues' crowns)".
+std::string model_glass_accuracy(double vd);
+
 }  // namespace lensmith

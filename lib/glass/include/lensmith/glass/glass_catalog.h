@@ -40,8 +40,15 @@ class GlassCatalog {
   const Glass& get(std::string_view name, std::string_view vendor = {},
                    std::span<const std::string> vendor_order = {}) const;
 
+  // The successor of an obsolete glass name that is in no catalogue: SCHOTT renamed its glasses when
+  // it made them lead- and arsenic-free (BK7 -> N-BK7, BAK1 -> N-BAK1, LAK21 -> N-LAK21); the new glass
+  // has the same glass type but not exactly the old index (N-BK7 and BK7 differ by about 1e-4 in nd).
+  // Returns SCHOTT's "N-" + name (or "N-" + name + "A"), or nullptr when `name` is itself in a
+  // catalogue or has no such successor. Callers warn, naming both.
+  const Glass* successor(std::string_view obsolete_name) const;
+
   // Up to `count` catalogue names closest to `name` (ignoring case, '-', ' ' and '_', then by
-  // edit distance), formatted "NAME (VENDOR)".
+  // edit distance), formatted "NAME (VENDOR)"; an obsolete name's successor comes first.
   std::vector<std::string> closest_names(std::string_view name, std::size_t count = 5) const;
 
   // Vendors in default search order (upper case, e.g. "SCHOTT").
