@@ -15,6 +15,7 @@
 #include "lensmith/core/number_parsing.h"
 #include "lensmith/core/errors.h"
 #include "lensmith/core/termination_cleanup.h"
+#include "lensmith/glass/glass_catalog.h"
 #include "lensmith/prescription/lens_library.h"
 
 namespace lensmith::cli {
@@ -119,6 +120,11 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "lensmith 0.1.0");
   GlobalOptions global;
   app.add_flag("-q,--quiet", global.quiet, "No warnings or progress on stderr");
+  std::vector<std::string> glass_catalogs;
+  app.add_option("--glass-catalog", glass_catalogs,
+                 "A Zemax .agf (or lensmith .json) glass catalogue, or a folder of .agf, searched after the built-in ones; repeatable "
+                 "(also LENSMITH_GLASS_CATALOGS, separated by ':'; docs/glass.md)")
+      ->check(CLI::ExistingPath);
 
   InfoOptions info;
   CLI::App* info_cmd = app.add_subcommand("info", "First-order (paraxial) optics of a lens: focal lengths, cardinal points, pupils, f-number, ray tables");
@@ -521,6 +527,10 @@ int main(int argc, char** argv) {
   // The first word that is not an option names the subcommand.
   for (int i = 1; i < argc; ++i) {
     const std::string_view word = argv[i];
+    if (word == "--glass-catalog") {  // the global option that takes a value
+      ++i;
+      continue;
+    }
     if (word.empty() || word.front() == '-') continue;
     std::string names;
     bool known = false;
@@ -558,6 +568,7 @@ int main(int argc, char** argv) {
   }
 
   try {
+    if (!glass_catalogs.empty()) lensmith::GlassCatalog::add_user_catalogs(glass_catalogs);
     if (*info_cmd) return run_info(info, global);
     if (*lenses_cmd) return run_lenses(lenses, global);
     if (*convert_cmd) return run_convert(convert, global);

@@ -2,6 +2,8 @@
 // and the published first-order values of the shipped reference lenses.
 #include <catch2/catch.hpp>
 
+#include <stdlib.h>
+
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -129,4 +131,35 @@ TEST_CASE("an ANSI-encoded Zemax file's name reaches info --json and convert as 
   REQUIRE(convert.exit_code == 0);
   std::ifstream written(out);
   CHECK(nlohmann::json::parse(written)["name"] == "\xC3\x98" "25 Triplet");
+}
+
+TEST_CASE("a user's Zemax .agf catalogue (--glass-catalog or LENSMITH_GLASS_CATALOGS) supplies the glasses a lens file names", "[cli][info]") {
+  // The Sasian triplet with its N-LAK9 renamed MYLAK9 from a catalogue MYCAT.agf that holds
+  // SCHOTT's N-LAK9 coefficients (Sellmeier 1): the same lens, so the same EFL to the last digit.
+  const lensmith::testing::ScratchFolder folder("lensmith_agf_cli_");
+  const std::string agf = folder.file("MYCAT.agf",
+                                      "CC a user's catalogue\nNM MYLAK9 2 691547 1.691 54.71 0 0 0\n"
+                                      "CD 1.46231905 0.00724270156 0.344399589 0.0243353131 1.15508372 85.4686868 0 0 0 0\nLD 0.3 2.5\n");
+  std::ifstream in(std::string(LENSMITH_TEST_DATA_DIR) + "/zemax/sasian_triplet.zmx", std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text.replace(text.find("GCAT SCHOTT"), 11, "GCAT MYCAT SCHOTT");
+  for (std::size_t at; (at = text.find("GLAS N-LAK9")) != std::string::npos;) text.replace(at, 11, "GLAS MYLAK9");
+  const std::string lens = folder.file("mine.zmx", text);
+  const auto reference = lensmith::testing::run_lensmith("info " + std::string(LENSMITH_TEST_DATA_DIR) + "/zemax/sasian_triplet.zmx --json");
+  REQUIRE(reference.exit_code == 0);
+  const auto without = lensmith::testing::run_lensmith("info " + lens + " --json");
+  CHECK(without.exit_code == 3);  // MYLAK9 is in no catalogue
+  const auto with = lensmith::testing::run_lensmith("--glass-catalog " + agf + " info " + lens + " --json");
+  INFO(with.err);
+  REQUIRE(with.exit_code == 0);
+  CHECK(nlohmann::json::parse(with.out)["efl_mm"] == nlohmann::json::parse(reference.out)["efl_mm"]);
+  setenv("LENSMITH_GLASS_CATALOGS", folder.dir.string().c_str(), 1);  // a folder of .agf
+  const auto env = lensmith::testing::run_lensmith("info " + lens + " --json");
+  unsetenv("LENSMITH_GLASS_CATALOGS");
+  CHECK(env.exit_code == 0);
+  // A catalogue named like a built-in vendor would be ambiguous: refused, saying how to rename it.
+  const std::string clash = folder.file("SCHOTT.agf", "NM X 2 0 1.5 60 0 0 0\nCD 1 0.006 0 0 0 0 0 0 0 0\nLD 0.3 2.5\n");
+  const auto refused = lensmith::testing::run_lensmith("--glass-catalog " + clash + " info " + lens);
+  CHECK(refused.exit_code == 3);
+  CHECK(refused.err.find("SCHOTT_2024.agf") != std::string::npos);
 }

@@ -1186,3 +1186,12 @@ TEST_CASE("an OpenEXR header attribute of negative size is an IoError, not an al
   CHECK_THROWS_AS(read_radiance_image(damaged), IoError);
   CHECK_THROWS_WITH(read_radiance_image(damaged), Contains("'weird' has a negative size"));
 }
+
+TEST_CASE("an OpenEXR whose tiles are 2^29 pixels or more is an IoError, not an allocation OpenEXR's int arithmetic wrapped", "[render][image_io]") {
+  // Found by tests/fuzz's exr_image target: a deep tiled header with a huge tile made OpenEXR 3.1
+  // size its sample-count table as xSize * ySize * 4 in an int and allocate 2^64 - 2^31 bytes.
+  const fs::path damaged = fs::path(LENSMITH_SOURCE_DIR) / "tests/fuzz/corpus/exr_image/deep-tiled-huge-tile.exr";
+  CHECK_THROWS_AS(read_radiance_image(damaged), IoError);
+  CHECK_THROWS_WITH(read_radiance_image(damaged), Contains("tile size"));
+  CHECK_FALSE(is_deep_image(fs::path(LENSMITH_SOURCE_DIR) / "examples/bokeh-scene.exr"));  // a sound file still opens
+}

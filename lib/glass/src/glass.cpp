@@ -48,8 +48,21 @@ std::string wavelength_text(double wavelength_nm) { return format("%.6g", wavele
 bool same_or_both_nan(double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); }
 
 bool is_catalogue_formula(Glass::Formula formula) {
-  return formula == Glass::Formula::Sellmeier || formula == Glass::Formula::Sellmeier2 ||
-         formula == Glass::Formula::Polynomial;
+  return formula == Glass::Formula::Sellmeier || formula == Glass::Formula::Sellmeier2 || formula == Glass::Formula::Polynomial ||
+         formula == Glass::Formula::Herzberger || formula == Glass::Formula::AgfSellmeier2 || formula == Glass::Formula::Conrady ||
+         formula == Glass::Formula::Handbook1 || formula == Glass::Formula::Handbook2;
+}
+
+// Coefficients an AGF-only formula takes (0: C1 and pairs, any odd count).
+std::size_t fixed_coefficient_count(Glass::Formula formula) {
+  switch (formula) {
+    case Glass::Formula::Herzberger: return 6;
+    case Glass::Formula::AgfSellmeier2: return 5;
+    case Glass::Formula::Conrady: return 3;
+    case Glass::Formula::Handbook1:
+    case Glass::Formula::Handbook2: return 4;
+    default: return 0;
+  }
 }
 
 }  // namespace
@@ -106,10 +119,16 @@ Glass Glass::from_formula(std::string name, std::string vendor, Formula formula,
   if (name.empty()) throw GlassError("catalogue glass with an empty name");
   if (!is_catalogue_formula(formula)) {
     throw GlassError("glass " + label + ": formula " + std::to_string(static_cast<int>(formula)) +
-                     " is not a catalogue dispersion formula (1, 2 or 3)");
+                     " is not a catalogue dispersion formula (1, 2, 3, or an AGF formula 203, 204, 205, 207, 208)");
   }
-  // Every formula is C1 followed by (coefficient, pole or exponent) pairs.
-  if (coefficients.size() % 2 != 1) {
+  // Formulas 1-3 are C1 followed by (coefficient, pole or exponent) pairs; the AGF-only ones have
+  // a fixed count.
+  if (const std::size_t fixed = fixed_coefficient_count(formula); fixed > 0) {
+    if (coefficients.size() != fixed) {
+      throw GlassError("glass " + label + ": formula " + std::to_string(static_cast<int>(formula)) + " needs " + std::to_string(fixed) +
+                       " coefficients; got " + std::to_string(coefficients.size()));
+    }
+  } else if (coefficients.size() % 2 != 1) {
     throw GlassError("glass " + label + ": formula " + std::to_string(static_cast<int>(formula)) +
                      " needs C1 followed by pairs of coefficients (an odd count); got " +
                      std::to_string(coefficients.size()));
@@ -159,6 +178,14 @@ double Glass::index(double wavelength_nm) const {
       for (std::size_t i = 1; i + 1 < c.size(); i += 2) n2 += c[i] * l2 / (l2 - c[i + 1]);
       return std::sqrt(n2);
     }
+    case Formula::Herzberger: {
+      const double big_l = 1.0 / (l2 - 0.028);
+      return c[0] + c[1] * big_l + c[2] * big_l * big_l + l2 * (c[3] + l2 * (c[4] + l2 * c[5]));
+    }
+    case Formula::AgfSellmeier2: return std::sqrt(1.0 + c[0] + c[1] * l2 / (l2 - c[2] * c[2]) + c[3] / (l2 - c[4] * c[4]));
+    case Formula::Conrady: return c[0] + c[1] / l + c[2] / (l2 * l * std::sqrt(l));
+    case Formula::Handbook1: return std::sqrt(c[0] + c[1] / (l2 - c[2]) - c[3] * l2);
+    case Formula::Handbook2: return std::sqrt(c[0] + c[1] * l2 / (l2 - c[2]) - c[3] * l2);
     case Formula::Polynomial: {
       // n^2 = C1 + sum C(2i) l^C(2i+1)
       double n2 = c[0];

@@ -4,6 +4,8 @@
 #include "lensmith/glass/glass_catalog.h"
 
 #include <algorithm>
+#include <cstdlib>
+#include <filesystem>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -13,6 +15,8 @@
 #include "lensmith/core/embedded_file.h"
 #include "lensmith/core/errors.h"
 #include "lensmith/core/located_json.h"
+#include "lensmith/core/number_parsing.h"
+#include "lensmith/core/text_file.h"
 #include "lensmith/core/units.h"
 
 namespace lensmith {
@@ -157,12 +161,186 @@ Glass read_glass(const LocatedJson& doc, std::size_t index, const std::string& v
 
 }  // namespace
 
-const GlassCatalog& GlassCatalog::builtin() {
+namespace {
+
+// The AGF formula number's glass: refractiveindex.info's formula 2 (Sellmeier) or 3 (polynomial)
+// where one matches, else the AGF formula itself (Zemax OpticStudio manual, "Glass Catalogs").
+std::pair<Glass::Formula, std::vector<double>> agf_formula(int number, const std::array<double, 10>& c) {
+  using F = Glass::Formula;
+  const auto polynomial = [&](std::initializer_list<double> exponents) {
+    std::vector<double> out{c[0]};
+    std::size_t i = 1;
+    for (const double e : exponents) out.insert(out.end(), {c[i++], e});
+    return out;
+  };
+  const auto sellmeier = [&](std::size_t terms) {
+    std::vector<double> out{0.0};
+    for (std::size_t i = 0; i < terms; ++i) out.insert(out.end(), {c[2 * i], c[2 * i + 1]});
+    return out;
+  };
+  switch (number) {
+    case 1: return {F::Polynomial, polynomial({2, -2, -4, -6, -8})};                     // Schott
+    case 2: return {F::Sellmeier2, sellmeier(3)};                                         // Sellmeier 1
+    case 3: return {F::Herzberger, {c[0], c[1], c[2], c[3], c[4], c[5]}};                // Herzberger
+    case 4: return {F::AgfSellmeier2, {c[0], c[1], c[2], c[3], c[4]}};                   // Sellmeier 2
+    case 5: return {F::Conrady, {c[0], c[1], c[2]}};                                      // Conrady
+    case 6: return {F::Sellmeier2, sellmeier(4)};                                         // Sellmeier 3
+    case 7: return {F::Handbook1, {c[0], c[1], c[2], c[3]}};                              // Handbook of Optics 1
+    case 8: return {F::Handbook2, {c[0], c[1], c[2], c[3]}};                              // Handbook of Optics 2
+    case 9: return {F::Sellmeier2, {c[0] - 1.0, c[1], c[2], c[3], c[4]}};                 // Sellmeier 4: n^2 = A + ...
+    case 10: return {F::Polynomial, polynomial({2, -2, -4, -6, -8, -10, -12})};          // Extended
+    case 11: return {F::Sellmeier2, sellmeier(5)};                                        // Sellmeier 5
+    case 12: return {F::Polynomial, polynomial({2, -2, -4, -6, -8, 4, 6})};              // Extended 2
+    case 13: return {F::Polynomial, polynomial({2, 4, -2, -4, -6, -8, -10, -12})};       // Extended 3
+    default: return {F::Constant, {}};
+  }
+}
+
+}  // namespace
+
+GlassCatalog GlassCatalog::from_agf(std::string_view text, const std::string& file_name, const std::string& vendor) {
+  struct Pending {
+    std::string name;
+    int formula = 0;
+    double nd = 0.0, vd = 0.0;
+    Glass::Status status = Glass::Status::Unspecified;
+    std::array<double, 10> coefficients{};
+    bool has_coefficients = false;
+    std::optional<std::pair<double, double>> range_um;
+    int line = 0;
+  };
+  GlassCatalog catalog;
+  std::optional<Pending> pending;
+  const auto finish = [&]() {
+    if (!pending) return;
+    const Pending& g = *pending;
+    const SourceLocation at{file_name, g.line, 1};
+    if (!g.has_coefficients) throw LensFileError(at, "glass " + g.name + " has no CD line (its dispersion coefficients)");
+    if (!g.range_um) throw LensFileError(at, "glass " + g.name + " has no LD line (the wavelength range of its formula, micrometres)");
+    const auto [formula, coefficients] = agf_formula(g.formula, g.coefficients);
+    try {
+      Glass glass = Glass::from_formula(g.name, vendor, formula, coefficients,
+                                        WavelengthRange{nm_from_catalogue_um(g.range_um->first), nm_from_catalogue_um(g.range_um->second)},
+                                        g.nd, g.vd);
+      glass.set_catalog_status(g.status);
+      catalog.add(std::move(glass));
+    } catch (const GlassError& e) {
+      throw LensFileError(at, e.what());
+    }
+    pending.reset();
+  };
+  int line_number = 0;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    const std::size_t end = std::min(text.find('\n', start), text.size());
+    std::string_view line = text.substr(start, end - start);
+    start = end + 1;
+    ++line_number;
+    std::vector<std::string_view> words;
+    for (std::size_t i = 0; i < line.size();) {
+      while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+      const std::size_t b = i;
+      while (i < line.size() && !std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+      if (i > b) words.push_back(line.substr(b, i - b));
+    }
+    if (words.empty()) continue;
+    const SourceLocation at{file_name, line_number, 1};
+    const auto number = [&](std::size_t i, const char* what) {
+      const std::optional<double> v = i < words.size() ? parse_finite_number(words[i]) : std::nullopt;
+      if (!v) throw LensFileError(at, std::string(words[0]) + ": expected " + what + " as field " + std::to_string(i) + ", got " +
+                                          (i < words.size() ? "\"" + std::string(words[i]) + "\"" : std::string("nothing")));
+      return *v;
+    };
+    const std::string_view key = words[0];
+    if (key == "NM") {
+      finish();
+      Pending g;
+      g.line = line_number;
+      if (words.size() < 2) throw LensFileError(at, "NM: expected the glass name");
+      g.name = std::string(words[1]);
+      const double formula = number(2, "the dispersion formula number (1-13)");
+      if (formula != std::floor(formula) || formula < 1 || formula > 13) {
+        throw LensFileError(at, "NM " + g.name + ": dispersion formula " + format_number(formula) + " is not one of AGF's 1-13");
+      }
+      g.formula = static_cast<int>(formula);
+      g.nd = words.size() > 4 ? number(4, "nd") : std::numeric_limits<double>::quiet_NaN();
+      g.vd = words.size() > 5 ? number(5, "Vd") : std::numeric_limits<double>::quiet_NaN();
+      if (words.size() > 7) {
+        const double status = number(7, "the status (0 standard, 1 preferred, 2 obsolete, 3 special, 4 melt)");
+        g.status = status == 0 ? Glass::Status::Standard : status == 1 ? Glass::Status::Preferred
+                 : status == 2 ? Glass::Status::Obsolete : Glass::Status::Special;
+      }
+      pending = std::move(g);
+    } else if (key == "CD") {
+      if (!pending) throw LensFileError(at, "CD before any NM line (coefficients of no glass)");
+      if (words.size() > 11) throw LensFileError(at, "CD: at most 10 coefficients, got " + std::to_string(words.size() - 1));
+      for (std::size_t i = 1; i < words.size(); ++i) pending->coefficients[i - 1] = number(i, "a coefficient");
+      pending->has_coefficients = true;
+    } else if (key == "LD") {
+      if (!pending) throw LensFileError(at, "LD before any NM line");
+      const double lo = number(1, "the shortest wavelength (um)"), hi = number(2, "the longest wavelength (um)");
+      if (!(lo > 0.0) || !(hi > lo)) throw LensFileError(at, "LD " + format_number(lo) + " " + format_number(hi) + ": expected 0 < min < max micrometres");
+      pending->range_um = std::make_pair(lo, hi);
+    } else if (key == "CC" || key == "GC" || key == "ED" || key == "TD" || key == "OD" || key == "IT" || key == "BD") {
+      // Comments, thermal, other and transmission data: not used by lensmith.
+    } else {
+      throw LensFileError(at, "unknown AGF record \"" + std::string(key.substr(0, 16)) +
+                                  "\" (expected NM, CD, LD, or CC, GC, ED, TD, OD, IT, BD)");
+    }
+  }
+  finish();
+  if (catalog.size() == 0) throw LensFileError({file_name, 0, 0}, "no glass (NM line) in this AGF catalogue");
+  return catalog;
+}
+
+GlassCatalog GlassCatalog::read_file(const std::string& path) {
+  const std::filesystem::path p(path);
+  std::string extension = p.extension().string();
+  for (char& ch : extension) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  const std::string text = decode_text(read_file_bytes(path), path);
+  if (extension == ".agf") return from_agf(text, path, upper(p.stem().string()));
+  if (extension == ".json") return from_json(text, path);
+  throw GlassError(path + ": a glass catalogue is a Zemax .agf or a lensmith .json file");
+}
+
+namespace {
+
+// Appends the catalogue files (or the .agf files of folders) of `paths` to `all`, refusing a vendor
+// already present. `origin` prefixes errors ("LENSMITH_GLASS_CATALOGS: ").
+void append_catalog_files(GlassCatalog& all, const std::vector<std::string>& paths, const std::string& origin) {
+  for (const std::string& path : paths) {
+    std::vector<std::string> files;
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) {
+      for (const auto& entry : std::filesystem::directory_iterator(path, ec)) {
+        std::string ext = entry.path().extension().string();
+        for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+        if (ext == ".agf") files.push_back(entry.path().string());
+      }
+      std::sort(files.begin(), files.end());
+      if (files.empty()) throw GlassError(origin + path + ": a folder without .agf glass catalogues");
+    } else {
+      files.push_back(path);
+    }
+    for (const std::string& file : files) {
+      const GlassCatalog user = GlassCatalog::read_file(file);
+      for (const std::string& vendor : user.vendors()) {
+        if (std::find(all.vendors().begin(), all.vendors().end(), vendor) != all.vendors().end()) {
+          throw GlassError(origin + file + ": catalogue vendor " + vendor + " is already present (built in, or given twice); name the " +
+                           "file differently (e.g. " + vendor + "_2024.agf) and list that name on the lens file's GCAT line");
+        }
+      }
+      all.merge(user);
+    }
+  }
+}
+
+GlassCatalog& mutable_builtin() {
   // A function-local static is initialised once, and thread-safely (C++11 [stmt.dcl]/4).
-  static const GlassCatalog catalog = [] {
+  static GlassCatalog catalog = [] {
     std::vector<GlassCatalog> parts;
     for (const EmbeddedFile& file : embedded_glass_catalogues()) {
-      parts.push_back(from_json(file.text, "lenses/glass/" + std::string(file.path)));
+      parts.push_back(GlassCatalog::from_json(file.text, "lenses/glass/" + std::string(file.path)));
     }
     // Default vendors in their fixed order; any other shipped catalogue after them, by vendor name.
     auto rank = [](const GlassCatalog& part) {
@@ -173,10 +351,27 @@ const GlassCatalog& GlassCatalog::builtin() {
     std::sort(parts.begin(), parts.end(), [&](const auto& a, const auto& b) { return rank(a) < rank(b); });
     GlassCatalog all;
     for (const auto& part : parts) all.merge(part);
+    // LENSMITH_GLASS_CATALOGS: the user's catalogue files or folders of .agf, separated by ':'.
+    if (const char* env = std::getenv("LENSMITH_GLASS_CATALOGS"); env != nullptr && *env != '\0') {
+      std::vector<std::string> paths;
+      std::string_view list(env);
+      while (!list.empty()) {
+        const std::size_t colon = std::min(list.find(':'), list.size());
+        if (colon > 0) paths.emplace_back(list.substr(0, colon));
+        list.remove_prefix(std::min(colon + 1, list.size()));
+      }
+      append_catalog_files(all, paths, "LENSMITH_GLASS_CATALOGS: ");
+    }
     return all;
   }();
   return catalog;
 }
+
+}  // namespace
+
+void GlassCatalog::add_user_catalogs(const std::vector<std::string>& paths) { append_catalog_files(mutable_builtin(), paths, ""); }
+
+const GlassCatalog& GlassCatalog::builtin() { return mutable_builtin(); }
 
 GlassCatalog GlassCatalog::from_json(std::string_view json_text, const std::string& source_name) {
   const LocatedJson doc = LocatedJson::parse(json_text, source_name);

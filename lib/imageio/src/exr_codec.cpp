@@ -278,7 +278,18 @@ void check_header_sizes(const fs::path& path) {
       if (size > 0x7fffffffu) {
         throw IoError(path.string() + ": cannot read the OpenEXR image: header attribute '" + name + "' has a negative size (a damaged file)");
       }
-      if (const std::size_t fixed = fixed_value_bytes(type); fixed > 0) {
+      if (type == "tiledesc") {
+        // OpenEXR sizes a deep tiled file's sample-count table as xSize * ySize * 4 in an int: a
+        // tile of 2^15 x 2^15 pixels became an allocation of 2^64 - 2^31 bytes (found by
+        // tests/fuzz's exr_image target). No real tile is near 2^29 pixels.
+        std::uint32_t x = 0, y = 0;
+        if (!read_u32(x) || !read_u32(y)) return;
+        if (x == 0 || y == 0 || std::uint64_t{x} * y > (std::uint64_t{1} << 29)) {
+          throw IoError(path.string() + ": cannot read the OpenEXR image: tile size " + std::to_string(x) + " x " + std::to_string(y) +
+                        " in attribute '" + name + "' (a damaged file)");
+        }
+        in.seekg(1, std::ios::cur);  // the level and rounding mode
+      } else if (const std::size_t fixed = fixed_value_bytes(type); fixed > 0) {
         in.seekg(static_cast<std::streamoff>(fixed), std::ios::cur);
       } else if (type == "chlist") {
         // Channels until an empty name, each a name and 16 bytes.

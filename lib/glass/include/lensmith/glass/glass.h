@@ -26,6 +26,13 @@ class Glass {
     Sellmeier = 1,      // n^2 - 1 = C1 + sum_i C(2i) l^2 / (l^2 - C(2i+1)^2), l in um
     Sellmeier2 = 2,     // n^2 - 1 = C1 + sum_i C(2i) l^2 / (l^2 - C(2i+1)),   l in um
     Polynomial = 3,     // n^2 = C1 + sum_i C(2i) l^C(2i+1),                  l in um
+    // Zemax AGF formulas with no refractiveindex.info equivalent (200 + the AGF number; the others
+    // become formulas 2 and 3 when an AGF is read):
+    Herzberger = 203,     // n = A + B L + C L^2 + D l^2 + E l^4 + F l^6, L = 1 / (l^2 - 0.028)
+    AgfSellmeier2 = 204,  // n^2 - 1 = A + B1 l^2 / (l^2 - L1^2) + B2 / (l^2 - L2^2)
+    Conrady = 205,        // n = n0 + A / l + B / l^3.5
+    Handbook1 = 207,      // n^2 = A + B / (l^2 - C) - D l^2
+    Handbook2 = 208,      // n^2 = A + B l^2 / (l^2 - C) - D l^2
     ModelCauchy = 100,  // model glass from nd, Vd: n = A + B / l^2 (docs/glass.md)
     Constant = 101,     // n independent of wavelength (air, or an index without dispersion data)
   };
