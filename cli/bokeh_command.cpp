@@ -122,16 +122,9 @@ OutputMetadata output_metadata(const BokehCommandOptions& o, const std::string& 
 // say) and no --input-colorspace says how to convert them: the render is linear, so its numbers stay
 // in the picture's space, but the spectral colour (dispersion) is computed for Rec.709 primaries.
 void note_foreign_primaries(const std::string& image, const std::string& chromaticities) {
-  std::vector<double> v;
-  std::size_t start = 0;
-  while (start <= chromaticities.size()) {
-    const std::size_t comma = std::min(chromaticities.find(',', start), chromaticities.size());
-    std::string item = chromaticities.substr(start, comma - start);
-    item.erase(0, item.find_first_not_of(' '));
-    if (const auto number = parse_finite_number(item)) v.push_back(*number);
-    start = comma + 1;
-  }
-  if (v.size() != 8) return;
+  const std::optional<std::array<double, 8>> parsed = parse_chromaticities(chromaticities);
+  if (!parsed) return;
+  const std::array<double, 8>& v = *parsed;
   const auto same = [&](const RgbPrimaries& p) {
     const double w[8] = {p.red.x, p.red.y, p.green.x, p.green.y, p.blue.x, p.blue.y, p.white.x, p.white.y};
     for (int i = 0; i < 8; ++i) {

@@ -74,31 +74,15 @@ bool is_structural(std::string_view name) {
   return false;
 }
 
-// OpenEXR's chromaticities as read_exr_metadata writes them: "rx, ry, gx, gy, bx, by, wx, wy".
-std::optional<Imf::Chromaticities> parse_chromaticities(const std::string& text) {
-  std::array<float, 8> v{};
-  std::size_t count = 0, start = 0;
-  while (start <= text.size()) {
-    const std::size_t comma = std::min(text.find(',', start), text.size());
-    std::string item = text.substr(start, comma - start);
-    item.erase(0, item.find_first_not_of(' '));
-    const std::optional<double> number = parse_finite_number(item);
-    if (!number || count == v.size()) return std::nullopt;
-    v[count++] = static_cast<float>(*number);
-    start = comma + 1;
-  }
-  if (count != v.size()) return std::nullopt;
-  return Imf::Chromaticities({v[0], v[1]}, {v[2], v[3]}, {v[4], v[5]}, {v[6], v[7]});
-}
-
 void insert_attributes(Imf::Header& header, const std::vector<ImageAttribute>& attributes) {
   for (const ImageAttribute& attribute : attributes) {
     if (attribute.name == "chromaticities") {
       // The standard attribute only: a string of that name would hide the primaries from readers.
       const auto* text = std::get_if<std::string>(&attribute.value);
-      const std::optional<Imf::Chromaticities> c = text ? parse_chromaticities(*text) : std::nullopt;
+      const std::optional<std::array<double, 8>> c = text ? parse_chromaticities(*text) : std::nullopt;
       if (!c) throw OptionsError("chromaticities attribute: expected eight numbers \"rx, ry, gx, gy, bx, by, wx, wy\"");
-      header.insert("chromaticities", Imf::ChromaticitiesAttribute(*c));
+      const auto xy = [&](int i) { return Imath::V2f(static_cast<float>((*c)[i]), static_cast<float>((*c)[i + 1])); };
+      header.insert("chromaticities", Imf::ChromaticitiesAttribute(Imf::Chromaticities(xy(0), xy(2), xy(4), xy(6))));
     } else if (const auto* text = std::get_if<std::string>(&attribute.value)) {
       header.insert(exr_name(attribute.name), Imf::StringAttribute(*text));
     } else if (attribute.exr_float) {
@@ -515,6 +499,22 @@ void write_exr_file(const fs::path& path, const std::string& file, const PixelsV
 }  // namespace lensmith::codecs
 
 namespace lensmith {
+
+std::optional<std::array<double, 8>> parse_chromaticities(std::string_view text) {
+  std::array<double, 8> v{};
+  std::size_t count = 0, start = 0;
+  while (start <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', start), text.size());
+    std::string_view item = text.substr(start, comma - start);
+    while (!item.empty() && item.front() == ' ') item.remove_prefix(1);
+    const std::optional<double> number = parse_finite_number(item);
+    if (!number || count == v.size()) return std::nullopt;
+    v[count++] = *number;
+    start = comma + 1;
+  }
+  if (count != v.size()) return std::nullopt;
+  return v;
+}
 
 void set_image_codec_threads(int threads) { codecs::codec_threads.store(std::max(0, threads)); }
 

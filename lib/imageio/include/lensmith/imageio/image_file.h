@@ -5,11 +5,13 @@
 // the same folder that is renamed onto the target (core's write_atomically).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
-#include <span>
 #include <optional>
+#include <span>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <variant>
 #include <vector>
@@ -74,6 +76,10 @@ void set_image_codec_threads(int threads);
 // ImageDescription when Exif has none), and the NAME=value header lines of a Radiance HDR file
 // (SOFTWARE as Software). PFM, BMP, TGA and PNM have none. Throws IoError.
 std::vector<std::pair<std::string, std::string>> read_image_metadata_pairs(const std::filesystem::path& path);
+
+// The eight numbers of the chromaticities text read_image_metadata_pairs gives ("rx, ry, gx, gy, bx,
+// by, wx, wy"), or nothing when the text is not exactly eight finite numbers.
+std::optional<std::array<double, 8>> parse_chromaticities(std::string_view text);
 
 // One item of metadata to write: text, or a number that formats with typed attributes (OpenEXR)
 // keep as a double and others write as its shortest exact text. OpenEXR writes an attribute named
