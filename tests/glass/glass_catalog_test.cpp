@@ -41,9 +41,10 @@ TEST_CASE("the built-in catalogue holds six vendors in the default search order,
   // means the shipped data changed.
   std::map<std::string, int> count;
   for (const Glass& g : catalogue.glasses()) ++count[g.vendor()];
-  CHECK(count == std::map<std::string, int>{{"SCHOTT", 169}, {"OHARA", 410}, {"HOYA", 190}, {"CDGM", 314},
+  // SCHOTT: 169 from the database and B 270 from its data sheet (schott-datasheets.json).
+  CHECK(count == std::map<std::string, int>{{"SCHOTT", 170}, {"OHARA", 410}, {"HOYA", 190}, {"CDGM", 314},
                                             {"HIKARI", 375}, {"SUMITA", 176}, {"MISC", 11}});
-  CHECK(catalogue.size() == 1645);
+  CHECK(catalogue.size() == 1646);
   // Built once: every call returns the same object.
   CHECK(&GlassCatalog::builtin() == &catalogue);
 }
@@ -93,7 +94,9 @@ TEST_CASE("every catalogue glass reproduces its catalogue nd and Vd from its dis
     }
     ++checked;
   }
-  CHECK(checked == 1636);  // MISC's 11 carry nd and Vd computed from their formulas: checked against published values below
+  // MISC's 11 carry nd and Vd computed from their formulas: checked against published values below; SCHOTT B 270
+  // (fitted to its data sheet) is checked here against its own fit's nd and Vd and against the sheet in its own test.
+  CHECK(checked == 1637);
   CHECK(without_values == kWithoutCatalogueValues);
 
   // The outlier really is one (so this list cannot go stale), and stays within its measured gap.
@@ -198,6 +201,17 @@ TEST_CASE("crystals and plastics that are not optical-glass vendors' reproduce t
   CHECK_THAT(catalogue.get("PMMA").index(lensmith::kWavelengthD_nm), WithinAbs(1.4906, 1e-4));
   CHECK_THAT(catalogue.get("POLYCARB").index(lensmith::kWavelengthD_nm), WithinAbs(1.5848, 1e-4));
   CHECK_FALSE(catalogue.get("POLYSTYR").covers(400.0));  // outside the fit: lens-level code warns
+}
+
+TEST_CASE("SCHOTT B 270 reproduces the eight indices of SCHOTT's data sheet", "[glass][catalog]") {
+  // schott.com, B 270 technical details: ng, nF', nF, ne, nd, nD, nC', nC printed to 4 decimals.
+  const Glass& g = GlassCatalog::builtin().get("B270", "SCHOTT");
+  const std::pair<double, double> sheet[] = {{435.8343, 1.5341}, {479.9914, 1.5297}, {486.1327, 1.5292}, {546.0740, 1.5251},
+                                             {587.5618, 1.5230}, {589.2938, 1.5229}, {643.8469, 1.5207}, {656.2725, 1.5203}};
+  for (const auto& [nm, n] : sheet) {
+    INFO(nm << " nm");
+    CHECK_THAT(g.index(nm), WithinAbs(n, 5e-5));  // half the last printed digit
+  }
 }
 
 TEST_CASE("a glass asked for at the wrong vendor is an error saying where the name exists", "[glass][catalog]") {
