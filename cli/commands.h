@@ -65,7 +65,7 @@ struct RealRayCommandOptions {
   std::vector<double> wavelengths_nm;                   // --wavelength: default the lens's
   std::optional<double> field_angle_deg;                // --field-angle: what relative field 1 means, deg
   std::string image = "prescribed";                     // --image prescribed|paraxial
-  std::string aim = "paraxial";                         // --aim paraxial|real
+  std::string aim;  // --aim paraxial|real; empty = as the lens file says (Prescription::ray_aiming)
   std::string png;                                      // --png FILE: write a picture
   bool json = false;
 };
@@ -98,7 +98,7 @@ struct TraceCommandOptions {
   std::string pupil = "0,0";               // --pupil PX,PY in the unit disc
   std::optional<double> wavelength_nm;
   std::string image = "prescribed";
-  std::string aim = "paraxial";
+  std::string aim;  // empty = as the lens file says
   bool json = false;
 };
 int run_trace(const TraceCommandOptions& options, const GlobalOptions& global);
@@ -292,6 +292,9 @@ void warn_about_aperture(const Camera& camera, const GlobalOptions& global);
 void report_written(const std::string& what, const GlobalOptions& global);
 
 // Loads LENS (a file path or a shipped lens name) and prints its warnings.
-Prescription load_lens(const std::string& lens, const GlobalOptions& global);
+// Reads a lens file or shipped lens, prints its diagnostics, and (unless `resolve_field` is false, as
+// `convert` asks, which writes the file's field as it is) turns a real-image-height field into object
+// field points by tracing (resolve_real_image_height_field), with a note saying so.
+Prescription load_lens(const std::string& lens, const GlobalOptions& global, bool resolve_field = true);
 
 }  // namespace lensmith::cli

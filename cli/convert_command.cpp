@@ -14,7 +14,7 @@ namespace lensmith::cli {
 int run_convert(const ConvertOptions& options, const GlobalOptions& global) {
   ensure_not_an_input(options.output, {options.lens.substr(0, options.lens.rfind('#'))});
   ensure_writable_location(options.output);
-  Prescription lens = load_lens(options.lens, global);
+  Prescription lens = load_lens(options.lens, global, /*resolve_field=*/false);
   if (options.scale_to_efl_mm) {
     const double efl = ParaxialSystem(lens).efl_mm();
     lens = lens.scaled(*options.scale_to_efl_mm / std::abs(efl));

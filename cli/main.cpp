@@ -17,6 +17,7 @@
 #include "lensmith/core/termination_cleanup.h"
 #include "lensmith/glass/glass_catalog.h"
 #include "lensmith/prescription/lens_library.h"
+#include "lensmith/trace/ray_aiming.h"
 
 namespace lensmith::cli {
 
@@ -25,10 +26,19 @@ void print_diagnostics(const Diagnostics& diagnostics, const GlobalOptions& glob
   for (const Diagnostic& d : diagnostics) std::cerr << d << "\n";
 }
 
-Prescription load_lens(const std::string& lens, const GlobalOptions& global) {
+Prescription load_lens(const std::string& lens, const GlobalOptions& global, bool resolve_field) {
   LensReadResult result = LensLibrary::load_path_or_name(lens);
   print_diagnostics(result.diagnostics, global);
-  return std::move(result.prescription);
+  if (!resolve_field || !result.prescription.field || result.prescription.field->kind != FieldSpec::Kind::RealImageHeightMm) {
+    return std::move(result.prescription);
+  }
+  Prescription resolved = resolve_real_image_height_field(result.prescription);
+  if (!global.quiet) {
+    std::cerr << "note: field: real image heights " << result.prescription.field->to_string() << " are the object field "
+              << resolved.field->to_string() << " (real chief rays, " << format_rounded(resolved.primary_wavelength_nm(), 6)
+              << " nm)\n";
+  }
+  return resolved;
 }
 
 void report_written(const std::string& what, const GlobalOptions& global) {
@@ -128,7 +138,7 @@ int main(int argc, char** argv) {
 
   InfoOptions info;
   CLI::App* info_cmd = app.add_subcommand("info", "First-order (paraxial) optics of a lens: focal lengths, cardinal points, pupils, f-number, ray tables");
-  info_cmd->add_option("lens", info.lens, "Lens file (.json, .zmx, .dat, lentil.json#ID) or shipped lens name (see `lensmith lenses`)")->required();
+  info_cmd->add_option("lens", info.lens, "Lens file (.json, .zmx, .seq, .dat, lentil.json#ID) or shipped lens name (see `lensmith lenses`)")->required();
   info_cmd->add_option("-w,--wavelength", info.wavelength_nm, "Wavelength, nm (default: the lens's primary wavelength; range 100-20000)")
       ->check(range(100.0, 20000.0));
   info_cmd->add_option("-d,--object-distance", info.object_distance_m,
@@ -150,13 +160,14 @@ int main(int argc, char** argv) {
       ->check(positive());
 
   // Real-ray analyses (docs/cli.md, docs/analysis.md).
-  const std::string lens_help = "Lens file (.json, .zmx, .dat, lentil.json#ID) or shipped lens name (see `lensmith lenses`)";
+  const std::string lens_help = "Lens file (.json, .zmx, .seq, .dat, lentil.json#ID) or shipped lens name (see `lensmith lenses`)";
   const CLI::Validator pupil_check(
       [](std::string& text) { return check_pupil_text(text); }, "PX,PY", "pupil in the unit disc");
   const CLI::IsMember image_words({"prescribed", "paraxial"});
   const CLI::IsMember aim_words({"paraxial", "real"});
   const std::string aim_help =
-      "Ray aiming: paraxial (at the paraxial entrance pupil, Zemax's \"ray aiming off\"; default) or real (iterate onto the real stop)";
+      "Ray aiming: paraxial (at the paraxial entrance pupil, Zemax's \"ray aiming off\") or real (iterate onto the real stop); "
+      "default: as the lens file says (real for a Zemax file with ray aiming on and for CODE V files, else paraxial)";
 
   TraceCommandOptions trace;
   CLI::App* trace_cmd = app.add_subcommand("trace", "Trace one real ray and print it at every surface and at the image plane");

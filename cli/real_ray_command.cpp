@@ -23,7 +23,9 @@ AnalysisOptions make_analysis_options(const RealRayCommandOptions& options) {
   }
   if (options.aim == "real") {
     a.aiming = RayAiming::RealStop;
-  } else if (options.aim != "paraxial") {
+  } else if (options.aim == "paraxial") {
+    a.aiming = RayAiming::ParaxialEntrancePupil;
+  } else if (!options.aim.empty()) {
     throw UsageError("--aim " + options.aim + ": must be paraxial or real");
   }
   return a;

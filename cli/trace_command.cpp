@@ -93,7 +93,8 @@ int run_trace(const TraceCommandOptions& options, const GlobalOptions& global) {
   trace.image_plane = analysis.image_plane;
   const RayTraceListing listing = trace_ray_listing(lens, trace);
   if (options.json) {
-    std::cout << json_text(listing_json(listing, options.aim), 2) << "\n";
+    const RayAiming used = trace.aiming.value_or(lens.ray_aiming);
+    std::cout << json_text(listing_json(listing, used == RayAiming::RealStop ? "real" : "paraxial"), 2) << "\n";
   } else {
     std::cout << listing.to_string();
   }

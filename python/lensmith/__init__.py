@@ -253,7 +253,7 @@ class TraceResult:
 _REAL_RAY_DOC = """
         fields: relative fields (0 = axis, 1 = the lens's maximum field); wavelengths_nm: default the
         lens's; field_angle_deg: what relative field 1 means, when the lens has no field or to override;
-        image: 'prescribed' or 'paraxial' (the image plane); aim: 'paraxial' (entrance pupil) or 'real'."""
+        image: 'prescribed' or 'paraxial' (the image plane); aim: 'paraxial' (entrance pupil), 'real' (real stop) or None (as the lens file says)."""
 
 
 class Lens:
@@ -375,9 +375,9 @@ class Lens:
 
     def _real(self, fields, wavelengths_nm, field_angle_deg, image, aim):
         return dict(fields=[float(f) for f in fields], wavelengths_nm=[float(w) for w in (wavelengths_nm or [])],
-                    field_angle_deg=_m(field_angle_deg), image=image, aim=aim)
+                    field_angle_deg=_m(field_angle_deg), image=image, aim=aim or "")
 
-    def spot(self, fields=(0.0, 0.7, 1.0), wavelengths_nm=None, field_angle_deg=None, image="prescribed", aim="paraxial",
+    def spot(self, fields=(0.0, 0.7, 1.0), wavelengths_nm=None, field_angle_deg=None, image="prescribed", aim=None,
              rings=6, random_rays=None, seed=1):
         """Spot diagrams (``lensmith spot --json``): hexapolar ``rings``, or ``random_rays`` uniform pupil points."""
         handle = self._handle.copy()
@@ -385,26 +385,26 @@ class Lens:
                     random_rays=None if random_rays is None else int(random_rays), seed=int(seed))
         return SpotDiagram(_json.loads(_lensmith.spot_json(handle, **args)), lambda png: _lensmith.spot_json(handle, **args, png=png))
 
-    def fan(self, fields=(0.0, 0.7, 1.0), wavelengths_nm=None, field_angle_deg=None, image="prescribed", aim="paraxial", samples=41):
+    def fan(self, fields=(0.0, 0.7, 1.0), wavelengths_nm=None, field_angle_deg=None, image="prescribed", aim=None, samples=41):
         """Tangential and sagittal ray fans (``lensmith fan --json``), ``samples`` pupil points each (odd)."""
         handle = self._handle.copy()
         args = dict(self._real(fields, wavelengths_nm, field_angle_deg, image, aim), samples=int(samples))
         return RayFan(_json.loads(_lensmith.fan_json(handle, **args)), lambda png: _lensmith.fan_json(handle, **args, png=png))
 
     def _analyze(self, cls, what, fields=(0.0, 0.7, 1.0), wavelengths_nm=None, field_angle_deg=None, image="prescribed",
-                 aim="paraxial", samples=None, grid=None):
+                 aim=None, samples=None, grid=None):
         handle = self._handle.copy()
         args = dict(self._real(fields, wavelengths_nm, field_angle_deg, image, aim), samples=None if samples is None else int(samples),
                     grid=None if grid is None else int(grid))
         return cls(_json.loads(_lensmith.analyze_json(handle, what, **args)),
                    lambda png: _lensmith.analyze_json(handle, what, **args, png=png))
 
-    def distortion(self, wavelengths_nm=None, field_angle_deg=None, image="prescribed", aim="paraxial", samples=None):
+    def distortion(self, wavelengths_nm=None, field_angle_deg=None, image="prescribed", aim=None, samples=None):
         """Distortion against field (``lensmith analyze --what distortion --json``), ``samples`` fields."""
         return self._analyze(Distortion, "distortion", wavelengths_nm=wavelengths_nm, field_angle_deg=field_angle_deg, image=image,
                              aim=aim, samples=samples)
 
-    def field_curves(self, wavelengths_nm=None, field_angle_deg=None, image="prescribed", aim="paraxial", samples=None):
+    def field_curves(self, wavelengths_nm=None, field_angle_deg=None, image="prescribed", aim=None, samples=None):
         """Tangential and sagittal field curves (``lensmith analyze --what field-curves --json``)."""
         return self._analyze(FieldCurves, "field-curves", wavelengths_nm=wavelengths_nm, field_angle_deg=field_angle_deg,
                              image=image, aim=aim, samples=samples)
@@ -413,12 +413,12 @@ class Lens:
         """Chromatic focal shift (``lensmith analyze --what focal-shift --json``)."""
         return self._analyze(FocalShift, "focal-shift", wavelengths_nm=wavelengths_nm, samples=samples)
 
-    def illumination(self, wavelengths_nm=None, field_angle_deg=None, image="prescribed", aim="paraxial", samples=None, grid=None):
+    def illumination(self, wavelengths_nm=None, field_angle_deg=None, image="prescribed", aim=None, samples=None, grid=None):
         """Relative illumination against field (``lensmith analyze --what illumination --json``)."""
         return self._analyze(Illumination, "illumination", wavelengths_nm=wavelengths_nm, field_angle_deg=field_angle_deg,
                              image=image, aim=aim, samples=samples, grid=grid)
 
-    def pupil(self, fields=(0.0, 0.7, 1.0), wavelengths_nm=None, field_angle_deg=None, image="prescribed", aim="paraxial", grid=None):
+    def pupil(self, fields=(0.0, 0.7, 1.0), wavelengths_nm=None, field_angle_deg=None, image="prescribed", aim=None, grid=None):
         """The unvignetted pupil per field (``lensmith analyze --what pupil --json``)."""
         return self._analyze(PupilShape, "pupil", fields, wavelengths_nm, field_angle_deg, image, aim, grid=grid)
 

@@ -40,7 +40,7 @@ struct RealRayArgs {
   std::vector<double> wavelengths_nm;
   std::optional<double> field_angle_deg;
   std::string image = "prescribed";
-  std::string aim = "paraxial";
+  std::string aim;  // "paraxial", "real", or empty: as the lens file says
 
   AnalysisOptions options() const {
     AnalysisOptions a;
@@ -54,7 +54,9 @@ struct RealRayArgs {
     }
     if (aim == "real") {
       a.aiming = RayAiming::RealStop;
-    } else if (aim != "paraxial") {
+    } else if (aim == "paraxial") {
+      a.aiming = RayAiming::ParaxialEntrancePupil;
+    } else if (!aim.empty()) {
       throw OptionsError("aim = '" + aim + "': must be 'paraxial' or 'real'");
     }
     return a;
@@ -68,7 +70,7 @@ RealRayArgs args(std::vector<double> fields, std::vector<double> wavelengths_nm,
 
 #define LENSMITH_REAL_RAY_ARGS                                                                                                           \
   py::arg("fields") = std::vector<double>{0.0, 0.7, 1.0}, py::arg("wavelengths_nm") = std::vector<double>{},                            \
-  py::arg("field_angle_deg") = py::none(), py::arg("image") = "prescribed", py::arg("aim") = "paraxial"
+  py::arg("field_angle_deg") = py::none(), py::arg("image") = "prescribed", py::arg("aim") = ""
 
 }  // namespace
 

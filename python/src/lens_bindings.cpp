@@ -16,6 +16,7 @@
 #include "lensmith/prescription/lens_json.h"
 #include "lensmith/prescription/lens_library.h"
 #include "lensmith/seidel/seidel_analysis.h"
+#include "lensmith/trace/ray_aiming.h"
 
 namespace lensmith::python {
 
@@ -56,7 +57,8 @@ LensPtr handle_from(LensReadResult result, std::string origin, std::vector<std::
     for (const Diagnostic& d : result.diagnostics) warnings->push_back(d.to_string());
   }
   auto lens = std::make_shared<LensHandle>();
-  lens->prescription = std::move(result.prescription);
+  // A real-image-height field becomes object field points here, by tracing, as the CLI does.
+  lens->prescription = resolve_real_image_height_field(result.prescription);
   lens->origin = std::move(origin);
   return lens;
 }
@@ -66,6 +68,9 @@ std::string aperture_kind(ApertureSpec::Kind kind) {
     case ApertureSpec::Kind::EntrancePupilDiameter: return "entrance_pupil_diameter_mm";
     case ApertureSpec::Kind::ImageSpaceFNumber: return "image_space_f_number";
     case ApertureSpec::Kind::FloatByStop: return "float_by_stop";
+    case ApertureSpec::Kind::ParaxialWorkingFNumber: return "paraxial_working_f_number";
+    case ApertureSpec::Kind::ObjectSpaceNA: return "object_space_na";
+    case ApertureSpec::Kind::ObjectConeAngleDeg: return "object_cone_angle_deg";
   }
   return "?";
 }
@@ -114,7 +119,10 @@ void bind_lens(py::module_& m) {
              return s.get().material.resolve(GlassCatalog::builtin()).index(wavelength_nm);
            }, py::arg("wavelength_nm"), "Refractive index of the medium after the surface.")
       .def_property("semi_diameter_mm", [](const SurfaceView& s) { return s.get().semi_diameter_mm; },
-                    [](const SurfaceView& s, std::optional<double> v) { s.get().semi_diameter_mm = v; }, "clear semi-diameter, mm (None = unlimited)")
+                    [](const SurfaceView& s, std::optional<double> v) { s.get().semi_diameter_mm = v; }, "semi-diameter, mm (None = not given)")
+      .def_property("clips_rays", [](const SurfaceView& s) { return s.get().clips_rays; },
+                    [](const SurfaceView& s, bool v) { s.get().clips_rays = v; },
+                    "whether semi_diameter_mm is a clear aperture that stops rays (False: a Zemax DIAM, a size only)")
       .def_property("is_stop", [](const SurfaceView& s) { return s.get().is_stop; },
                     [](const SurfaceView& s, bool v) { s.get().is_stop = v; })
       .def_property("conic", [](const SurfaceView& s) { return s.get().conic; }, [](const SurfaceView& s, double k) { s.get().conic = k; })
@@ -155,6 +163,9 @@ void bind_lens(py::module_& m) {
       .def_property_readonly("origin", [](const LensHandle& l) { return l.origin; })
       .def_property("object_distance_mm", [](const LensHandle& l) { return l.prescription.object_distance_mm; },
                     [](LensHandle& l, double d) { l.prescription.object_distance_mm = d; })
+      .def_property_readonly("ray_aiming", [](const LensHandle& l) {
+             return l.prescription.ray_aiming == RayAiming::RealStop ? "real" : "paraxial";
+           }, "the ray aiming the lens file asks for: 'paraxial' or 'real'")
       .def_property_readonly("wavelengths_nm", [](const LensHandle& l) { return l.prescription.wavelengths_nm; })
       .def_property_readonly("primary_wavelength_nm", [](const LensHandle& l) { return l.prescription.primary_wavelength_nm(); })
       .def_property_readonly("aperture", [](const LensHandle& l) {
@@ -163,7 +174,10 @@ void bind_lens(py::module_& m) {
       .def_property_readonly("max_field", [](const LensHandle& l) -> py::object {
              if (!l.prescription.field) return py::none();
              const FieldSpec& f = *l.prescription.field;
-             const char* unit = f.kind == FieldSpec::Kind::AngleDeg ? "deg" : f.kind == FieldSpec::Kind::ObjectHeightMm ? "object mm" : "image mm";
+             const char* unit = f.kind == FieldSpec::Kind::AngleDeg         ? "deg"
+                                : f.kind == FieldSpec::Kind::ObjectHeightMm ? "object mm"
+                                : f.kind == FieldSpec::Kind::ImageHeightMm  ? "image mm"
+                                                                            : "real image mm";
              return py::make_tuple(f.max_value(), unit);
            })
       .def("surface_count", [](const LensHandle& l) { return l.prescription.surfaces.size(); })

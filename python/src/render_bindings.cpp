@@ -27,6 +27,7 @@
 #include "lensmith/render/multiview_renderer.h"
 #include "lensmith/scene/lens_render.h"
 #include "lensmith/scene/scene_json.h"
+#include "lensmith/trace/ray_aiming.h"
 
 namespace lensmith::python {
 
@@ -147,7 +148,7 @@ py::array_t<float> render(const py::array& image, const py::array& depth, py::di
   if (lens_object.is_none() && !thin_focal_mm) throw UsageError("give lens (a Lens, a file or a shipped lens name) or thin_lens_focal_length_mm");
   if (!lens_object.is_none()) {
     if (py::isinstance<py::str>(lens_object)) {
-      lens = LensLibrary::load_path_or_name(lens_object.cast<std::string>()).prescription;
+      lens = resolve_real_image_height_field(LensLibrary::load_path_or_name(lens_object.cast<std::string>()).prescription);
     } else {
       lens = lens_object.cast<const LensHandle&>().checked();
     }

@@ -420,6 +420,86 @@ TEST_CASE("aperture specs: F/# gives EPD = EFL/F#, a floating stop gives the sto
   CHECK_THAT(by_stop.marginal_ray().rows[4].y_mm, WithinRel(10.3, kArithmetic));
 }
 
+TEST_CASE("image-space F/# in a medium: f'/EPD with f' = n' EFL, as OpticStudio defines it", "[paraxial][aperture]") {
+  // A single refracting surface into water-like n' = 1.336 (the eye's vitreous): its image-space
+  // focal length f' = n' R / (n' - 1) is n' times its EFL R / (n' - 1). OpticStudio reports Image Space
+  // F/# = f'/EPD (an eye model's 6.48 against its EFL/EPD of 4.84, issue 17); the working F/#
+  // 1/(2 n' u') = EFL/EPD at infinity is the one that sets the image irradiance.
+  Surface s;
+  s.curvature_per_mm = 1.0 / 7.8;
+  s.thickness_mm = 30.0;
+  s.material = MaterialSpec::model(1.336, std::nullopt);
+  Prescription eye = lens_in_air({s});
+  eye.resolve_materials(GlassCatalog::builtin());
+  eye.aperture = ApertureSpec{ApertureSpec::Kind::ImageSpaceFNumber, 6.48};
+  const ParaxialSystem p(eye);
+  const double efl = 7.8 / 0.336;
+  CHECK_THAT(p.efl_mm(), WithinRel(efl, kArithmetic));
+  CHECK_THAT(p.rear_focal_length_mm(), WithinRel(1.336 * efl, kArithmetic));
+  CHECK_THAT(p.entrance_pupil().diameter_mm, WithinRel(1.336 * efl / 6.48, kArithmetic));
+  CHECK_THAT(p.f_number(), WithinRel(6.48, kArithmetic));
+  CHECK_THAT(p.working_f_number(), WithinRel(6.48 / 1.336, kArithmetic));
+}
+
+TEST_CASE("aperture specs: a paraxial working F/# gives 1/(2 n' u') of the marginal ray at the working conjugate",
+          "[paraxial][aperture]") {
+  Prescription lens = smith_cooke_triplet();
+  lens.object_distance_mm = 500.0;
+  lens.image_at_paraxial_focus = true;
+  lens.aperture = ApertureSpec{ApertureSpec::Kind::ParaxialWorkingFNumber, 5.6};
+  const ParaxialSystem p(lens);
+  CHECK_THAT(p.working_f_number(), WithinRel(5.6, kArithmetic));
+  // At infinite conjugates the paraxial working F/# equals EFL/EPD (air on both sides).
+  lens.object_distance_mm = kInfinity;
+  const ParaxialSystem at_infinity(lens);
+  CHECK_THAT(at_infinity.entrance_pupil().diameter_mm, WithinRel(at_infinity.efl_mm() / 5.6, kArithmetic));
+}
+
+TEST_CASE("aperture specs: an object-space NA or cone angle sets the ray from the axial object point to the pupil's edge",
+          "[paraxial][aperture]") {
+  Prescription lens = smith_cooke_triplet();
+  lens.object_distance_mm = 300.0;
+  lens.image_at_paraxial_focus = true;
+  lens.aperture = ApertureSpec{ApertureSpec::Kind::ObjectSpaceNA, 0.05};
+  const ParaxialSystem by_na(lens);
+  const double to_pupil = 300.0 + by_na.entrance_pupil().z_mm;
+  // sin(theta) = NA in air; the pupil's edge is at tan(theta) times the distance to the pupil.
+  CHECK_THAT(0.5 * by_na.entrance_pupil().diameter_mm, WithinRel(to_pupil * std::tan(std::asin(0.05)), kArithmetic));
+  lens.aperture = ApertureSpec{ApertureSpec::Kind::ObjectConeAngleDeg, 3.0};
+  const ParaxialSystem by_cone(lens);
+  CHECK_THAT(0.5 * by_cone.entrance_pupil().diameter_mm, WithinRel(to_pupil * std::tan(rad_from_deg(3.0)), kArithmetic));
+  lens.object_distance_mm = kInfinity;
+  CHECK_THROWS_AS(lens.validate(), PrescriptionError);
+}
+
+TEST_CASE("object-space telecentric: chief rays leave the object parallel to the axis, the NA sets the marginal ray",
+          "[paraxial][telecentric]") {
+  Prescription lens = smith_cooke_triplet();
+  lens.object_distance_mm = 300.0;
+  lens.image_at_paraxial_focus = true;
+  lens.object_space_telecentric = true;
+  lens.aperture = ApertureSpec{ApertureSpec::Kind::ObjectSpaceNA, 0.05};
+  lens.field = FieldSpec{FieldSpec::Kind::ObjectHeightMm, {10.0}};
+  const ParaxialSystem p(lens);
+  // The pupil stands in at 1e12 mm: the chief slope is h / 1e12.
+  CHECK(std::abs(p.chief_ray()->object_slope) < 1e-10);
+  CHECK_THAT(p.chief_ray()->object_height_mm, WithinAbs(-10.0, kArithmetic));
+  CHECK_THAT(p.marginal_ray().object_slope, WithinRel(std::tan(std::asin(0.05)), 1e-9));
+  // Field by angle, or an entrance-pupil aperture, means nothing for such a lens.
+  lens.field = FieldSpec{FieldSpec::Kind::AngleDeg, {5.0}};
+  CHECK_THROWS_AS(lens.validate(), PrescriptionError);
+  lens.field = FieldSpec{FieldSpec::Kind::ObjectHeightMm, {10.0}};
+  lens.aperture = ApertureSpec{ApertureSpec::Kind::EntrancePupilDiameter, 10.0};
+  CHECK_THROWS_AS(lens.validate(), PrescriptionError);
+}
+
+TEST_CASE("a real-image-height field is refused by paraxial optics, which cannot find its object points",
+          "[paraxial][field]") {
+  Prescription lens = smith_cooke_triplet();
+  lens.field = FieldSpec{FieldSpec::Kind::RealImageHeightMm, {21.0}};
+  CHECK_THROWS_WITH(ParaxialSystem(lens), Catch::Matchers::Contains("resolve_real_image_height_field"));
+}
+
 TEST_CASE("image-height field: the chief ray is scaled to land at the given paraxial image height",
           "[paraxial][field]") {
   Prescription lens = smith_cooke_triplet();

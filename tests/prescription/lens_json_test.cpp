@@ -193,6 +193,32 @@ TEST_CASE("lens JSON: read -> write -> read gives an identical prescription for 
   }
 }
 
+TEST_CASE("lens JSON: apertures, non-clipping semi-diameters, ray aiming and the new aperture and field kinds round-trip",
+          "[prescription][json]") {
+  Prescription p = LensLibrary::load("sasian-triplet").prescription;
+  p.surfaces[0].clips_rays = false;
+  p.surfaces[1].aperture = SurfaceAperture{SurfaceAperture::Shape::Rectangular, false, 0.0, 3.0, 2.0, 0.5, -0.25};
+  p.surfaces[2].aperture = SurfaceAperture{SurfaceAperture::Shape::Circular, false, 1.0, 4.0, 4.0, 0.0, 0.0};
+  p.surfaces[3].aperture = SurfaceAperture{SurfaceAperture::Shape::Elliptical, true, 0.0, 1.0, 0.5, 0.0, 0.0};
+  p.ray_aiming = RayAiming::RealStop;
+  p.object_distance_mm = 800.0;
+  p.field = FieldSpec{FieldSpec::Kind::RealImageHeightMm, {0, 10, 21}};
+  for (const ApertureSpec& a : {ApertureSpec{ApertureSpec::Kind::ParaxialWorkingFNumber, 5.6}, ApertureSpec{ApertureSpec::Kind::ObjectSpaceNA, 0.02},
+                                ApertureSpec{ApertureSpec::Kind::ObjectConeAngleDeg, 1.5}}) {
+    p.aperture = a;
+    const Prescription again = read_lens_json(write_lens_json(p), "w.json").prescription;
+    CHECK(again == p);
+  }
+}
+
+TEST_CASE("lens JSON: a surface aperture's shape and sizes are checked with their key", "[prescription][json]") {
+  CHECK_THAT(read_error(lens_with(R"({"radius_mm": -50, "aperture": {"shape": "hexagonal", "radius_mm": 3}})")).what(), Contains("shape"));
+  CHECK_THAT(read_error(lens_with(R"({"radius_mm": -50, "aperture": {"shape": "rectangular", "half_x_mm": 3}})")).what(), Contains("half_y_mm"));
+  CHECK_THAT(read_error(lens_with(R"({"radius_mm": -50, "aperture": {"radius_mm": 3, "min_radius_mm": 4}})")).what(), Contains("min_radius_mm"));
+  CHECK_THAT(read_error(lens_with(R"({"radius_mm": -50, "clips_rays": false})")).what(), Contains("clips_rays"));
+  CHECK_THAT(read_error(lens_with(R"({"radius_mm": -50})", "  \"ray_aiming\": \"sideways\",\n")).what(), Contains("ray_aiming"));
+}
+
 TEST_CASE("lens JSON: conic, aspheric terms and curvatures that do not invert exactly round-trip", "[prescription][json]") {
   Prescription p = LensLibrary::load("sasian-triplet").prescription;
   p.surfaces[0].conic = -0.6;

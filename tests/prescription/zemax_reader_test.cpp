@@ -10,11 +10,14 @@
 
 #include "lensmith/core/errors.h"
 #include "lensmith/core/text_file.h"
+#include "lens_file_checks.h"
 
 using Catch::Matchers::Contains;
 using Catch::Matchers::WithinAbs;
 using Catch::Matchers::WithinRel;
 using namespace lensmith;
+using lensmith::testing::has_diagnostic;
+using lensmith::testing::line_of;
 
 namespace {
 
@@ -77,15 +80,6 @@ std::string mini_zmx(const std::string& system_extra = "", const std::string& le
 }
 // clang-format on
 
-// 1-based line of the first occurrence of `needle` in `text`.
-int line_of(const std::string& text, const std::string& needle) {
-  const auto pos = text.find(needle);
-  if (pos == std::string::npos) throw std::logic_error("test text lacks " + needle);
-  int line = 1;
-  for (std::size_t i = 0; i < pos; ++i) line += text[i] == '\n' ? 1 : 0;
-  return line;
-}
-
 LensFileError zemax_error(const std::string& text) {
   try {
     read_zemax(text, "t.zmx");
@@ -94,13 +88,6 @@ LensFileError zemax_error(const std::string& text) {
   }
   FAIL("expected a LensFileError");
   throw std::logic_error("unreachable");
-}
-
-bool has_diagnostic(const Diagnostics& d, Diagnostic::Severity severity, int line, const std::string& text) {
-  for (const Diagnostic& x : d) {
-    if (x.severity == severity && x.where.line == line && x.message.find(text) != std::string::npos) return true;
-  }
-  return false;
 }
 
 }  // namespace
@@ -416,18 +403,38 @@ TEST_CASE("Zemax: FTYP 2 gives a paraxial image-height field", "[prescription][z
   CHECK(p.field->kind == FieldSpec::Kind::ImageHeightMm);
 }
 
-TEST_CASE("Zemax: real image height fields (FTYP 3) are refused", "[prescription][zemax]") {
+TEST_CASE("Zemax: FTYP 3 gives a real image-height field, in lens units", "[prescription][zemax]") {
   std::string text = mini_zmx();
   text.replace(text.find("FTYP 0"), 6, "FTYP 3");
-  const LensFileError e = zemax_error(text);
-  CHECK(e.where().line == line_of(text, "FTYP 3"));
-  CHECK_THAT(e.what(), Contains("real image height"));
+  text.replace(text.find("UNIT MM"), 7, "UNIT CM");
+  const Prescription p = read_zemax(text, "t.zmx").prescription;
+  REQUIRE(p.field);
+  CHECK(p.field->kind == FieldSpec::Kind::RealImageHeightMm);
+  CHECK(p.field->values == std::vector<double>{0.0, 50.0});
 }
 
-TEST_CASE("Zemax: an object-space telecentric system is refused", "[prescription][zemax]") {
+TEST_CASE("Zemax: FTYP's theodolite angle fields are refused on their line", "[prescription][zemax]") {
   std::string text = mini_zmx();
-  text.replace(text.find("FTYP 0 0"), 8, "FTYP 0 1");
-  CHECK_THAT(zemax_error(text).what(), Contains("telecentric"));
+  text.replace(text.find("FTYP 0"), 6, "FTYP 4");
+  const LensFileError e = zemax_error(text);
+  CHECK(e.where().line == line_of(text, "FTYP 4"));
+  CHECK_THAT(e.what(), Contains("theodolite"));
+}
+
+TEST_CASE("Zemax: FTYP's telecentric flag makes the lens object-space telecentric", "[prescription][zemax]") {
+  std::string text = mini_zmx("", "", "400");
+  text.replace(text.find("FTYP 0 0"), 8, "FTYP 1 1");
+  text.replace(text.find("ENPD 10"), 7, "OBNA 0.05 0");
+  const Prescription p = read_zemax(text, "t.zmx").prescription;
+  CHECK(p.object_space_telecentric);
+}
+
+TEST_CASE("Zemax: a telecentric lens with an entrance-pupil aperture is refused on a located line", "[prescription][zemax]") {
+  std::string text = mini_zmx("", "", "400");
+  text.replace(text.find("FTYP 0 0"), 8, "FTYP 1 1");
+  const LensFileError e = zemax_error(text);
+  CHECK_THAT(e.what(), Contains("telecentric"));
+  CHECK(e.where().line == line_of(text, "ENPD"));
 }
 
 TEST_CASE("Zemax: XFLN components fold into radial fields with a note", "[prescription][zemax]") {
@@ -462,19 +469,98 @@ TEST_CASE("Zemax: ENPD is the entrance-pupil diameter, FNUM an image-space F/#, 
   CHECK(read_zemax(floa, "t.zmx").prescription.aperture.kind == ApertureSpec::Kind::FloatByStop);
 }
 
-TEST_CASE("Zemax: paraxial working F/# and object-space NA apertures are refused", "[prescription][zemax]") {
+TEST_CASE("Zemax: FNUM type 1 is a paraxial working F/#, OBNA an object-space NA (type 0) or cone angle (type 1)",
+          "[prescription][zemax]") {
   std::string working = mini_zmx();
   working.replace(working.find("ENPD 10"), 7, "FNUM 4.5 1");
-  CHECK(zemax_error(working).where().line == line_of(working, "FNUM"));
-  std::string na = mini_zmx();
+  CHECK(read_zemax(working, "t.zmx").prescription.aperture == ApertureSpec{ApertureSpec::Kind::ParaxialWorkingFNumber, 4.5});
+  std::string na = mini_zmx("", "", "400");
   na.replace(na.find("ENPD 10"), 7, "OBNA 1.5E-1 0");
-  CHECK_THAT(zemax_error(na).what(), Contains("NA"));
+  CHECK(read_zemax(na, "t.zmx").prescription.aperture == ApertureSpec{ApertureSpec::Kind::ObjectSpaceNA, 0.15});
+  std::string cone = mini_zmx("", "", "400");
+  cone.replace(cone.find("ENPD 10"), 7, "OBNA 3 1");
+  CHECK(read_zemax(cone, "t.zmx").prescription.aperture == ApertureSpec{ApertureSpec::Kind::ObjectConeAngleDeg, 3.0});
 }
 
-TEST_CASE("Zemax: CLAP's maximum radius is the semi-diameter, over DIAM", "[prescription][zemax]") {
+TEST_CASE("Zemax: an object-space NA with the object at infinity is refused on the OBNA line", "[prescription][zemax]") {
+  std::string na = mini_zmx();
+  na.replace(na.find("ENPD 10"), 7, "OBNA 1.5E-1 0");
+  const LensFileError e = zemax_error(na);
+  CHECK(e.where().line == line_of(na, "OBNA"));
+  CHECK_THAT(e.what(), Contains("finite object"));
+}
+
+TEST_CASE("Zemax: DIAM sizes a surface without clipping; FLAP makes it a clear aperture (OpticStudio's rule)",
+          "[prescription][zemax]") {
+  const Prescription plain = read_zemax(mini_zmx(), "t.zmx").prescription;
+  CHECK(*plain.surfaces[1].semi_diameter_mm == 8.0);
+  CHECK_FALSE(plain.surfaces[1].clips_rays);
+  CHECK_FALSE(plain.surfaces[1].aperture);
+  const Prescription floating = read_zemax(mini_zmx("", "  FLAP 0 8 0\n"), "t.zmx").prescription;
+  CHECK(floating.surfaces[1].clips_rays);
+  CHECK(*floating.surfaces[1].semi_diameter_mm == 8.0);
+}
+
+TEST_CASE("Zemax: a centred CLAP is the clear semi-diameter, over DIAM", "[prescription][zemax]") {
   const Prescription p = read_zemax(mini_zmx("", "  CLAP 0 6.5 0\n"), "t.zmx").prescription;
   CHECK(*p.surfaces[1].semi_diameter_mm == 6.5);
+  CHECK(p.surfaces[1].clips_rays);
   CHECK(*p.surfaces[2].semi_diameter_mm == 8.0);
+  CHECK_FALSE(p.surfaces[2].clips_rays);
+}
+
+TEST_CASE("Zemax: annular, rectangular and elliptical apertures and obscurations become surface apertures, decentred by OBDC",
+          "[prescription][zemax]") {
+  using Shape = SurfaceAperture::Shape;
+  struct Case {
+    const char* lines;
+    SurfaceAperture expected;
+  };
+  const Case cases[] = {
+      {"  CLAP 1 6 0\n", {Shape::Circular, false, 1.0, 6.0, 6.0, 0.0, 0.0}},
+      {"  OBSC 0 2.5 0\n", {Shape::Circular, true, 0.0, 2.5, 2.5, 0.0, 0.0}},
+      {"  SQAP 3 2 0\n  OBDC 0.5 -1\n", {Shape::Rectangular, false, 0.0, 3.0, 2.0, 0.5, -1.0}},
+      {"  ELAP 3 2 0\n", {Shape::Elliptical, false, 0.0, 3.0, 2.0, 0.0, 0.0}},
+      {"  OBSQ 1 1.5 0\n", {Shape::Rectangular, true, 0.0, 1.0, 1.5, 0.0, 0.0}},
+      {"  ELOB 1 0.5 0\n", {Shape::Elliptical, true, 0.0, 1.0, 0.5, 0.0, 0.0}},
+  };
+  for (const Case& c : cases) {
+    INFO(c.lines);
+    const Surface s = read_zemax(mini_zmx("", c.lines), "t.zmx").prescription.surfaces[1];
+    REQUIRE(s.aperture);
+    CHECK(*s.aperture == c.expected);
+    CHECK(*s.semi_diameter_mm == 8.0);  // DIAM still sizes the surface
+    CHECK_FALSE(s.clips_rays);
+  }
+}
+
+TEST_CASE("Zemax: two apertures on one surface are refused on the second's line", "[prescription][zemax]") {
+  const std::string text = mini_zmx("", "  CLAP 0 6 0\n  OBSC 0 1 0\n");
+  const LensFileError e = zemax_error(text);
+  CHECK(e.where().line == line_of(text, "OBSC"));
+  CHECK_THAT(e.what(), Contains("CLAP"));
+}
+
+TEST_CASE("Zemax: spiders and user-defined apertures are refused, naming the keyword and line", "[prescription][zemax]") {
+  for (const char* line : {"  SPID 1 4 0\n", "  UDAD 0 0 0\n"}) {
+    const std::string text = mini_zmx("", line);
+    INFO(line);
+    const LensFileError e = zemax_error(text);
+    CHECK(e.where().line == line_of(text, line));
+    CHECK_THAT(e.what(), Contains(std::string(line).substr(2, 4)));
+  }
+}
+
+TEST_CASE("Zemax: RAIM's second field sets the ray aiming (0 off, 1 paraxial, 2 real)", "[prescription][zemax]") {
+  CHECK(read_zemax(mini_zmx(), "t.zmx").prescription.ray_aiming == RayAiming::ParaxialEntrancePupil);
+  CHECK(read_zemax(mini_zmx("RAIM 0 0 1 1 0 0 0 0 0\n"), "t.zmx").prescription.ray_aiming == RayAiming::ParaxialEntrancePupil);
+  CHECK(read_zemax(mini_zmx("RAIM 0 2 1 1 0 1 0 0 0\n"), "t.zmx").prescription.ray_aiming == RayAiming::RealStop);
+  const LensReadResult paraxial_aiming = read_zemax(mini_zmx("RAIM 0 1 1 1 0 0 0 0 0 1\n"), "t.zmx");
+  CHECK(paraxial_aiming.prescription.ray_aiming == RayAiming::RealStop);
+  CHECK(has_diagnostic(paraxial_aiming.diagnostics, Diagnostic::Severity::Note, line_of(mini_zmx("RAIM 0 1 1 1 0 0 0 0 0 1\n"), "RAIM"),
+                       "paraxial ray aiming"));
+  const std::string bad = mini_zmx("RAIM 0 7 1 1 0 0 0 0 0\n");
+  CHECK(zemax_error(bad).where().line == line_of(bad, "RAIM"));
 }
 
 TEST_CASE("Zemax: DIAM 0 leaves a surface unlimited", "[prescription][zemax]") {
@@ -483,20 +569,12 @@ TEST_CASE("Zemax: DIAM 0 leaves a surface unlimited", "[prescription][zemax]") {
   CHECK_FALSE(read_zemax(text, "t.zmx").prescription.surfaces[1].semi_diameter_mm);
 }
 
-TEST_CASE("Zemax: obscurations and non-circular apertures are refused", "[prescription][zemax]") {
-  for (const char* line : {"  OBSC 0 2.5 0\n", "  SQAP 3 3 0\n", "  ELAP 3 2 0\n", "  CLAP 1 6 0\n"}) {
-    const std::string text = mini_zmx("", line);
-    INFO(line);
-    CHECK(zemax_error(text).where().line == line_of(text, line));
-  }
-}
-
 TEST_CASE("Zemax: decentres and tilts are refused unless zero", "[prescription][zemax]") {
   const std::string tilted = mini_zmx("", "  SCBD 1 0 0 0.0 0.0 90 0 0\n");
   CHECK(zemax_error(tilted).where().line == line_of(tilted, "SCBD"));
   CHECK_NOTHROW(read_zemax(mini_zmx("", "  SCBD 1 0 0 0 0 0 0 0\n"), "t.zmx"));
-  const std::string decentred = mini_zmx("", "  OBDC 0.000000000000E+00 1.906000000000E+02\n");
-  CHECK(zemax_error(decentred).where().line == line_of(decentred, "OBDC"));
+  const std::string decentred = mini_zmx("", "  DECX 1.906000000000E+02\n");
+  CHECK(zemax_error(decentred).where().line == line_of(decentred, "DECX"));
 }
 
 TEST_CASE("Zemax: PARM with a non-zero value on a STANDARD surface is an error", "[prescription][zemax]") {
@@ -622,4 +700,12 @@ TEST_CASE("Zemax: a glass missing from the file's GCAT catalogues is taken from 
   CHECK(message.find("using " + r.prescription.surfaces[1].material.vendor) != std::string::npos);
   // In its GCAT catalogue: no warning.
   CHECK(read_zemax(mini_zmx(), "t.zmx").diagnostics.empty());
+}
+
+TEST_CASE("Zemax: a moulding vendor's \"_MOLD\" glass reads as its base glass with a warning", "[prescription][zemax][glass]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("GLAS N-BK7"), 10, "GLAS L-TIM28_MOLD");
+  const LensReadResult r = read_zemax(text, "t.zmx");
+  CHECK(r.prescription.surfaces[1].material == MaterialSpec::catalog("L-TIM28", "OHARA"));
+  CHECK(has_diagnostic(r.diagnostics, Diagnostic::Severity::Warning, line_of(text, "L-TIM28_MOLD"), "moulded"));
 }

@@ -154,6 +154,36 @@ TEST_CASE("Seidel: a positive plano-convex singlet is undercorrected, S_I > 0 (W
   CHECK(s.sums().S4 > 0.0);             // inward-curving Petzval surface
 }
 
+TEST_CASE("Seidel: the colour sums use the lens's own shortest and longest wavelengths, as CODE V does", "[seidel]") {
+  // A thin singlet in air with the stop at the lens: C_I = y^2 phi dn / (n - 1) (Welford eq. 8.46 summed over
+  // both surfaces), dn the index difference at the two wavelengths. A 1-mm-thick lens stands in for thin.
+  const MaterialSpec bk7 = MaterialSpec::catalog("N-BK7", "SCHOTT");
+  Prescription p;
+  p.surfaces = {make_surface(50.0, 0.001, bk7, 12.0), make_surface(-50.0, 95.0, MaterialSpec::air(), 12.0)};
+  p.surfaces[0].is_stop = true;
+  p.aperture = {ApertureSpec::Kind::EntrancePupilDiameter, 20.0};
+  p.field = FieldSpec{FieldSpec::Kind::AngleDeg, {5.0}};
+  p.wavelengths_nm = {450.0, 550.0, 650.0};
+  p.primary_wavelength_index = 1;
+  p.resolve_materials(GlassCatalog::builtin());
+  const Glass& g = p.surfaces[0].medium;
+  const SeidelAnalysis own(p);
+  CHECK(own.colour_wavelengths_nm() == std::array<double, 2>{450.0, 650.0});
+  const double n = g.index(550.0);
+  const double phi = (n - 1.0) * (2.0 / 50.0);
+  const double thin = 10.0 * 10.0 * phi * (g.index(450.0) - g.index(650.0)) / (n - 1.0);
+  // 1 mm of thickness changes y at the second surface by 1e-3 of its value: a 1e-3 relative allowance.
+  CHECK_THAT(own.sums().C1, WithinRel(thin, 2e-3));
+  SeidelOptions fc;
+  fc.colour_wavelengths_nm = std::array<double, 2>{kWavelengthF_nm, kWavelengthC_nm};
+  const SeidelAnalysis principal(p, fc);
+  CHECK_THAT(principal.sums().C1 / own.sums().C1,
+             WithinRel((g.index(kWavelengthF_nm) - g.index(kWavelengthC_nm)) / (g.index(450.0) - g.index(650.0)), 1e-12));
+  // A lens at F, d, C gets n_F - n_C, the textbook C_I.
+  p.wavelengths_nm = {kWavelengthF_nm, kWavelengthD_nm, kWavelengthC_nm};
+  CHECK(SeidelAnalysis(p).colour_wavelengths_nm() == std::array<double, 2>{kWavelengthF_nm, kWavelengthC_nm});
+}
+
 TEST_CASE("Seidel: the aplanatic ellipsoid (k = -1/n^2, air to glass) has zero spherical aberration", "[seidel]") {
   // A refracting ellipsoid of eccentricity 1/n images infinity onto its far focus without any
   // spherical aberration (Descartes' ovals; Welford sec. 8.5): the conic term cancels the sphere's.

@@ -759,3 +759,60 @@ TEST_CASE("the Sasian triplet's paraxially aimed rim ray passes its stop, which 
   REQUIRE(beyond.ok());
   CHECK(tracer.trace_forward(beyond.ray).status == RayStatus::Vignetted);
 }
+
+TEST_CASE("a real-image-height field resolves to the object angles whose real chief rays land at those heights",
+          "[trace][aiming][field]") {
+  // Outside truth: an independent trace of the resolved field's chief ray, and the paraxial limit.
+  for (const RayAiming aiming : {RayAiming::ParaxialEntrancePupil, RayAiming::RealStop}) {
+    Prescription lens = smith_cooke_triplet();
+    lens.ray_aiming = aiming;
+    lens.field = FieldSpec{FieldSpec::Kind::RealImageHeightMm, {0.0, 0.01, 12.0, 21.0}};
+    const Prescription resolved = resolve_real_image_height_field(lens);
+    REQUIRE(resolved.field->kind == FieldSpec::Kind::AngleDeg);
+    TracerOptions free;
+    free.clip_apertures = false;
+    const SequentialTracer tracer(resolved, free);
+    AimOptions options;
+    options.aiming = aiming;
+    const RayAimer aimer(tracer, options);
+    CHECK(resolved.field->values[0] == 0.0);
+    for (std::size_t i = 1; i < lens.field->values.size(); ++i) {
+      const AimedRay chief = aimer.make_ray(FieldPoint::angle_deg(resolved.field->values[i]), {0.0, 0.0}, lens.primary_wavelength_nm());
+      REQUIRE(chief.ok());
+      const TraceResult r = tracer.trace_forward(chief.ray);
+      REQUIRE(r.ok());
+      CHECK_THAT(std::abs(r.ray.position_mm.y()), WithinAbs(lens.field->values[i], 1e-8));
+    }
+    // 0.01 mm is a paraxial height: its angle is the paraxial one, atan(h / EFL) for this object at infinity.
+    const ParaxialSystem paraxial(smith_cooke_triplet());
+    CHECK_THAT(resolved.field->values[1], WithinRel(deg_from_rad(std::atan(0.01 / paraxial.efl_mm())), 1e-4));
+  }
+}
+
+TEST_CASE("a real image height beyond the lens's reach is a ComputationError naming the height", "[trace][aiming][field]") {
+  Prescription lens = smith_cooke_triplet();
+  lens.field = FieldSpec{FieldSpec::Kind::RealImageHeightMm, {0.0, 5000.0}};
+  CHECK_THROWS_AS(resolve_real_image_height_field(lens), ComputationError);
+  CHECK_THROWS_WITH(resolve_real_image_height_field(lens), Catch::Matchers::Contains("5000"));
+}
+
+TEST_CASE("object-space telecentric: the aimed chief ray leaves the object parallel to the axis, the marginal ray at the NA's angle",
+          "[trace][aiming][telecentric]") {
+  Prescription lens = smith_cooke_triplet();
+  lens.object_distance_mm = 300.0;
+  lens.image_at_paraxial_focus = true;
+  lens.object_space_telecentric = true;
+  lens.aperture = ApertureSpec{ApertureSpec::Kind::ObjectSpaceNA, 0.05};
+  lens.field = FieldSpec{FieldSpec::Kind::ObjectHeightMm, {10.0}};
+  TracerOptions free;
+  free.clip_apertures = false;
+  const SequentialTracer tracer(lens, free);
+  const RayAimer aimer(tracer);
+  const AimedRay chief = aimer.make_ray(aimer.field_at(1.0), {0.0, 0.0}, lens.primary_wavelength_nm());
+  REQUIRE(chief.ok());
+  CHECK(std::abs(chief.ray.direction.y()) < 1e-10);
+  const AimedRay marginal = aimer.make_ray(aimer.field_at(0.0), {0.0, 1.0}, lens.primary_wavelength_nm());
+  REQUIRE(marginal.ok());
+  // n sin(theta) = NA in air for the ray to the pupil's edge.
+  CHECK_THAT(marginal.ray.direction.y(), WithinRel(0.05, 1e-9));
+}

@@ -572,6 +572,56 @@ TEST_CASE("clipping at a clear semi-diameter and at the stop gives Vignetted wit
   CHECK(at_stop.to_string().find("vignetted at surface 5") != std::string::npos);
 }
 
+TEST_CASE("a semi-diameter that is not a clear aperture (a Zemax DIAM) clips no ray", "[trace][status]") {
+  Prescription lens = smith_cooke_triplet();
+  lens.surfaces[0].clips_rays = false;  // 14.7 mm
+  const SequentialTracer tracer(lens);
+  const TraceResult r = tracer.trace_forward(make_ray({0, 14.75, -5.0}, {0, 0, 1}));
+  CHECK(r.surface != 1);  // it may still die at a later clear aperture, never at surface 1
+}
+
+TEST_CASE("a clear aperture passes a ray on its rim within the rim tolerance", "[trace][status]") {
+  // The rim tolerance is 1e-5 relative (sequential_tracer.cpp): a file's semi-diameter printed to 6 digits.
+  const Prescription lens = smith_cooke_triplet();
+  const SequentialTracer tracer(lens);
+  CHECK(tracer.trace_forward(make_ray({0, 14.7 * (1.0 + 0.5e-5), -5.0}, {0, 0, 1})).surface != 1);
+  CHECK(tracer.trace_forward(make_ray({0, 14.7 * (1.0 + 2e-5), -5.0}, {0, 0, 1})).surface == 1);
+}
+
+TEST_CASE("explicit apertures clip by their shape: annulus, decentred rectangle, ellipse, obscurations", "[trace][status]") {
+  using Shape = SurfaceAperture::Shape;
+  struct Case {
+    SurfaceAperture aperture;
+    double x, y;
+    bool passes;
+  };
+  const Case cases[] = {
+      {{Shape::Circular, false, 2.0, 6.0, 6.0, 0.0, 0.0}, 0.0, 1.0, false},    // inside the annulus's hole
+      {{Shape::Circular, false, 2.0, 6.0, 6.0, 0.0, 0.0}, 3.0, 3.0, true},     // in the ring (r 4.24)
+      {{Shape::Circular, false, 2.0, 6.0, 6.0, 0.0, 0.0}, 4.5, 4.5, false},    // beyond it (r 6.36)
+      {{Shape::Rectangular, false, 0.0, 3.0, 2.0, 1.0, 0.0}, 3.9, 1.9, true},  // the box is shifted +1 in x
+      {{Shape::Rectangular, false, 0.0, 3.0, 2.0, 1.0, 0.0}, -2.5, 0.0, false},
+      {{Shape::Rectangular, false, 0.0, 3.0, 2.0, 1.0, 0.0}, 0.0, 2.1, false},
+      {{Shape::Elliptical, false, 0.0, 3.0, 2.0, 0.0, 0.0}, 2.9, 0.0, true},
+      {{Shape::Elliptical, false, 0.0, 3.0, 2.0, 0.0, 0.0}, 2.0, 1.6, false},  // (2/3)^2 + 0.8^2 = 1.084
+      {{Shape::Circular, true, 0.0, 2.5, 2.5, 0.0, 0.0}, 1.0, 1.0, false},     // a central obscuration
+      {{Shape::Circular, true, 0.0, 2.5, 2.5, 0.0, 0.0}, 3.0, 0.0, true},
+      {{Shape::Elliptical, true, 0.0, 1.0, 0.5, 0.0, 0.0}, 0.0, 0.6, true},
+  };
+  for (const Case& c : cases) {
+    INFO(c.aperture.to_string() << " at (" << c.x << ", " << c.y << ")");
+    Prescription lens = smith_cooke_triplet();
+    lens.surfaces[0].aperture = c.aperture;
+    const SequentialTracer tracer(lens);
+    const TraceResult r = tracer.trace_forward(make_ray({c.x, c.y, -5.0}, {0, 0, 1}));
+    CHECK((r.surface != 1) == c.passes);
+    CHECK(c.aperture.passes(c.x, c.y, 0.0) == c.passes);
+    TracerOptions unclipped_options;
+    unclipped_options.clip_apertures = false;
+    CHECK(SequentialTracer(lens, unclipped_options).trace_forward(make_ray({c.x, c.y, -5.0}, {0, 0, 1})).surface != 1);
+  }
+}
+
 TEST_CASE("a steep ray inside glass is totally internally reflected at the surface where it would leave", "[trace][status]") {
   // Plano-convex, n = 1.5, rear radius -10 mm: a ray parallel to the axis at h meets the rear sphere at
   // incidence asin(h / 10), beyond the critical angle asin(1 / 1.5) when h > 6.67 mm.

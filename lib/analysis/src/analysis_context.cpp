@@ -89,11 +89,11 @@ struct AnalysisContext::Impl {
   Impl(const Prescription& lens, const AnalysisOptions& options)
       : clipped(lens, tracer_options(options, true)),
         unclipped(lens, tracer_options(options, false)),
-        aimer(clipped, aim_options(options)),
-        unclipped_aimer(unclipped, aim_options(options)) {}
-  static AimOptions aim_options(const AnalysisOptions& options) {
+        aimer(clipped, aim_options(lens, options)),
+        unclipped_aimer(unclipped, aim_options(lens, options)) {}
+  static AimOptions aim_options(const Prescription& lens, const AnalysisOptions& options) {
     AimOptions a;
-    a.aiming = options.aiming;
+    a.aiming = options.aiming.value_or(lens.ray_aiming);
     return a;
   }
   // The aimers keep references to the tracers: Impl lives on the heap and never moves.

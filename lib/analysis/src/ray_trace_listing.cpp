@@ -31,7 +31,7 @@ RayTraceListing trace_ray_listing(const Prescription& lens, const RayTraceOption
   tracer_options.image_plane = options.image_plane;
   const SequentialTracer tracer(lens, tracer_options);
   AimOptions aim;
-  aim.aiming = options.aiming;
+  aim.aiming = options.aiming.value_or(lens.ray_aiming);
   const RayAimer aimer(tracer, aim);
 
   RayTraceListing out;

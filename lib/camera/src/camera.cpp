@@ -95,12 +95,16 @@ Camera Camera::thin_lens(double focal_length_mm, const CameraOptions& options, i
 
 Camera Camera::from_lens(const Prescription& lens, const CameraOptions& options, int width_px, int height_px) {
   options.validate();
-  const ParaxialSystem own(lens);
+  // A camera's pupil is where its stop images, at its f-number: a lens file's object-space telecentric
+  // flag (a measuring lens's) is dropped.
+  Prescription as_camera = lens;
+  as_camera.object_space_telecentric = false;
+  const ParaxialSystem own(as_camera);
   if (!(own.efl_mm() > 0.0)) {
     throw ComputationError("the bokeh renderer needs a lens that forms a real image (EFL > 0); this one has EFL " +
                            format_number(own.efl_mm()) + " mm");
   }
-  auto at_f_number = std::make_shared<Prescription>(lens);
+  auto at_f_number = std::make_shared<Prescription>(as_camera);
   const double n = options.f_number.value_or(own.f_number());
   at_f_number->aperture = ApertureSpec{ApertureSpec::Kind::ImageSpaceFNumber, n};
   // The stop's clear aperture follows the f-number (an iris), so the exact tracer clips the beam
@@ -118,6 +122,10 @@ Camera Camera::from_lens(const Prescription& lens, const CameraOptions& options,
                        format_rounded(own.f_number(), 3) + ")");
   }
   at_f_number->surfaces[stop].semi_diameter_mm = stop_mm;
+  at_f_number->surfaces[stop].aperture.reset();
+  // A camera is a physical lens: its glass ends at each surface's semi-diameter, so every one clips,
+  // also where a lens file gives it as a size only (a Zemax DIAM; docs/lens-format.md, "Apertures").
+  for (Surface& s : at_f_number->surfaces) s.clips_rays = true;
 
   Camera c(PinholeFrame::from_options(width_px, height_px, options.framing, own.efl_mm()));
   c.options_ = options;

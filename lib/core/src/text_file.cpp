@@ -109,6 +109,19 @@ std::optional<bool> utf16_without_bom(std::string_view bytes) {
 
 }  // namespace
 
+std::string ascii_upper(std::string_view text) {
+  std::string out(text);
+  for (char& c : out) {
+    if (c >= 'a' && c <= 'z') c = static_cast<char>(c - 'a' + 'A');
+  }
+  return out;
+}
+
+std::string shown_text(std::string_view text, std::size_t max_length) {
+  if (text.size() <= max_length) return std::string(text);
+  return std::string(text.substr(0, max_length)) + "...";
+}
+
 bool is_valid_utf8(std::string_view bytes) {
   std::size_t i = 0;
   while (i < bytes.size()) {

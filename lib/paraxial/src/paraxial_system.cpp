@@ -129,6 +129,15 @@ std::string right_aligned(const std::string& text, std::size_t width) {
 // ---------------------------------------------------------------------------------------------
 namespace {
 
+// An object-space telecentric lens's entrance pupil, at infinity, is put this far behind surface 1
+// (mm): chief rays then leave the object at slopes of h / 1e12, 1e-11 mm of image height for a 10-mm
+// field over 1 m, and every formula written for a finite pupil holds.
+constexpr double kTelecentricPupilZ_mm = 1e12;
+
+}  // namespace
+
+namespace {
+
 using paraxial_detail::CardinalPoints;
 using paraxial_detail::KernelMatrices;
 
@@ -268,7 +277,9 @@ ParaxialSystem::ParaxialSystem(const Prescription& lens, const ParaxialOptions& 
   z_rear_principal_mm_ = cardinal.z_rear_principal_mm;
   z_front_nodal_mm_ = cardinal.z_front_nodal_mm;
   z_rear_nodal_mm_ = cardinal.z_rear_nodal_mm;
-  const paraxial_detail::PupilImages pupils = paraxial_detail::pupil_images(m, n_object_, n_image_, z_last_mm_);
+  paraxial_detail::PupilImages pupils = paraxial_detail::pupil_images(m, n_object_, n_image_, z_last_mm_);
+  telecentric_ = lens.object_space_telecentric;
+  if (telecentric_) pupils.z_entrance_mm = kTelecentricPupilZ_mm;
   if (!std::isfinite(pupils.z_entrance_mm)) {
     throw ComputationError("the entrance pupil lies at infinity (stop at the rear focal point of the surfaces "
                            "before it, object-space telecentric): the marginal and chief rays are undefined");
@@ -285,9 +296,44 @@ ParaxialSystem::ParaxialSystem(const Prescription& lens, const ParaxialOptions& 
       epd_mm_ = lens.aperture.value;
       break;
     case ApertureSpec::Kind::ImageSpaceFNumber: {
+      // OpticStudio's Image Space F/# is f'/EPD with f' = n'/P the image-space focal length (equal to
+      // the EFL in air): an eye model (n' = 1.336) has f'/EPD 1.336 times its EFL/EPD.
       const double power = paraxial_detail::cardinal_points(primary_m, n_object_primary, primary_indices.back(),
                                                             z_last_mm_).power_per_mm;
-      epd_mm_ = std::abs(1.0 / power) / lens.aperture.value;
+      epd_mm_ = std::abs(primary_indices.back() / power) / lens.aperture.value;
+      break;
+    }
+    case ApertureSpec::Kind::ParaxialWorkingFNumber: {
+      // W = 1 / (2 n' |u'|): trace the marginal ray for a unit pupil radius (slopes scale with it).
+      const paraxial_detail::PupilImages primary_pupils =
+          paraxial_detail::pupil_images(primary_m, n_object_primary, primary_indices.back(), z_last_mm_);
+      double unit_slope = 0.0;
+      double start_height = 1.0;
+      if (!at_infinity) {
+        const double object_to_pupil = object_distance_mm_ + primary_pupils.z_entrance_mm;
+        if (object_to_pupil == 0.0) throw ComputationError("the object plane coincides with the entrance pupil: no marginal ray");
+        unit_slope = 1.0 / object_to_pupil;
+        start_height = unit_slope * object_distance_mm_;
+      }
+      const ParaxialRayTable unit = trace_ray(curvatures_, thicknesses_, primary_indices, n_object_primary, object_distance_mm_,
+                                              unit_slope, 0.0, start_height, thicknesses_.back());
+      const double u_image = std::abs(unit.rows.back().u_after);
+      if (!(u_image > 0.0)) throw ComputationError("the marginal ray leaves the lens parallel to the axis: no paraxial working F/#");
+      epd_mm_ = 2.0 / (2.0 * primary_indices.back() * lens.aperture.value * u_image);
+      break;
+    }
+    case ApertureSpec::Kind::ObjectSpaceNA:
+    case ApertureSpec::Kind::ObjectConeAngleDeg: {
+      // The ray from the axial object point to the edge of the paraxial entrance pupil makes the angle
+      // theta with the axis: n sin(theta) = NA, or theta the cone angle.
+      if (at_infinity) throw ComputationError("an object-space NA or cone angle needs a finite object distance");
+      paraxial_detail::PupilImages primary_pupils =
+          paraxial_detail::pupil_images(primary_m, n_object_primary, primary_indices.back(), z_last_mm_);
+      if (lens.object_space_telecentric) primary_pupils.z_entrance_mm = kTelecentricPupilZ_mm;
+      const double theta = lens.aperture.kind == ApertureSpec::Kind::ObjectSpaceNA
+                               ? std::asin(std::min(1.0, lens.aperture.value / n_object_primary))
+                               : rad_from_deg(lens.aperture.value);
+      epd_mm_ = 2.0 * std::abs(object_distance_mm_ + primary_pupils.z_entrance_mm) * std::tan(theta);
       break;
     }
     case ApertureSpec::Kind::FloatByStop: {
@@ -333,6 +379,10 @@ ParaxialSystem::ParaxialSystem(const Prescription& lens, const ParaxialOptions& 
     marginal_ = trace_ray(curvatures_, thicknesses_, indices_, n_object_, object_distance_mm_, slope, 0.0,
                           slope * object_distance_mm_, image_plane_distance_mm_);
   }
+  if (lens.object_space_telecentric) {
+    // The exit pupil is still the stop's image; the beam, set by the NA, fills it to the marginal ray.
+    exit_pupil_.diameter_mm = 2.0 * std::abs(marginal_.rows[stop_index].y_mm * pupils.exit_magnification);
+  }
 
   // Chief ray: from the edge of the field through the centre of the entrance pupil, rising in
   // object space for a positive field (conventions.h), so a positive object-height field puts the
@@ -364,6 +414,9 @@ ParaxialSystem::ParaxialSystem(const Prescription& lens, const ParaxialOptions& 
         field_description_ = number(value, 4) + " mm object height (object point at y = -" + number(value, 4) + ")";
         break;
       }
+      case FieldSpec::Kind::RealImageHeightMm:
+        throw ComputationError("the field is given as real image heights: only ray tracing finds the object points "
+                               "(resolve_real_image_height_field in lensmith/trace/ray_aiming.h)");
       case FieldSpec::Kind::ImageHeightMm: {
         // The chief ray is linear in its slope: trace a unit slope to the paraxial image and scale.
         const ParaxialRayTable unit = chief_with_slope(1.0);
@@ -394,7 +447,7 @@ double ParaxialSystem::z_rear_nodal_mm() const { return z_rear_nodal_mm_; }
 double ParaxialSystem::z_last_surface_mm() const { return z_last_mm_; }
 double ParaxialSystem::z_image_mm() const { return z_last_mm_ + image_distance_mm_; }
 
-double ParaxialSystem::f_number() const { return efl_mm() / epd_mm_; }
+double ParaxialSystem::f_number() const { return std::abs(rear_focal_length_mm()) / epd_mm_; }
 
 double ParaxialSystem::working_f_number() const { return 1.0 / (2.0 * image_space_na()); }
 
@@ -468,7 +521,11 @@ std::string ParaxialSystem::to_string() const {
   point("Rear principal point P'", z_rear_principal_mm());
   point("Front nodal point N", z_front_nodal_mm());
   point("Rear nodal point N'", z_rear_nodal_mm());
-  point("Entrance pupil", entrance_pupil_.z_mm);
+  if (telecentric_) {
+    os << label("  Entrance pupil", 28) << "at infinity (object-space telecentric)\n";
+  } else {
+    point("Entrance pupil", entrance_pupil_.z_mm);
+  }
   point("Exit pupil", exit_pupil_.z_mm);
   point("Paraxial image", z_image_mm());
   point("Image plane", z_last_mm_ + image_plane_distance_mm_);
@@ -478,11 +535,13 @@ std::string ParaxialSystem::to_string() const {
                             (stop_semi_diameter_mm_ ? ", semi-diameter " + number(*stop_semi_diameter_mm_, 4) + " mm"
                                                     : std::string()),
        stop_flagged_ ? "flagged" : "found: limits the axial beam");
-  line("Entrance pupil diameter EPD", number(entrance_pupil_.diameter_mm, 4) + " mm",
-       "magnification " + number(entrance_pupil_.magnification, 5) + " of the stop");
+  if (!telecentric_) {
+    line("Entrance pupil diameter EPD", number(entrance_pupil_.diameter_mm, 4) + " mm",
+         "magnification " + number(entrance_pupil_.magnification, 5) + " of the stop");
+  }
   line("Exit pupil diameter", number(exit_pupil_.diameter_mm, 4) + " mm",
        "magnification " + number(exit_pupil_.magnification, 5) + " of the stop");
-  line("F-number", number(f_number(), 4), "EFL/EPD");
+  if (!telecentric_) line("F-number", number(f_number(), 4), n_image_ == 1.0 ? "EFL/EPD" : "f'/EPD (image space)");
   line("Working F-number", number(working_f_number(), 4), "1/(2 n'|u'|), this object distance");
   line("Image-space NA", number(image_space_na(), 6), "n'|u'|");
   line("Image distance", number(image_distance_mm_, 4) + " mm", "last surface to paraxial image");

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 
 #include "lensmith/core/text_file.h"
+#include "lensmith/prescription/codev_reader.h"
 #include "lensmith/prescription/lens_json.h"
 #include "lensmith/prescription/lentil_reader.h"
 #include "lensmith/prescription/pbrt_reader.h"
@@ -43,13 +45,52 @@ void resolve_and_validate(Prescription& lens, const GlassCatalog& catalogue, con
   }
 }
 
+std::string lens_name_from_path(const std::string& path) {
+  const std::size_t slash = path.find_last_of("/\\");
+  std::string stem = slash == std::string::npos ? path : path.substr(slash + 1);
+  const std::size_t dot = stem.find_last_of('.');
+  if (dot != std::string::npos && dot > 0) stem.resize(dot);
+  return stem;
+}
+
+double radial_field_value(FieldSpec::Kind kind, double x, double y) {
+  if (x == 0.0) return y;
+  if (kind != FieldSpec::Kind::AngleDeg) return std::hypot(x, y);
+  return deg_from_rad(std::atan(std::hypot(std::tan(rad_from_deg(x)), std::tan(rad_from_deg(y)))));
+}
+
+void UnknownKeywords::record(std::string_view keyword, int line) {
+  const std::string key = shown_text(keyword);
+  auto it = seen_.find(key);
+  if (it != seen_.end()) {
+    ++it->second.count;
+  } else if (seen_.size() >= kMaxListed) {
+    ++overflow_;
+  } else {
+    seen_.emplace(key, Seen{line, 1});
+  }
+}
+
+void UnknownKeywords::report(Diagnostics& diagnostics, const std::string& file, const std::string& noun) const {
+  for (const auto& [keyword, seen] : seen_) {
+    diagnostics.push_back(Diagnostic{Diagnostic::Severity::Warning, SourceLocation{file, seen.first_line, 0},
+                                     "unknown keyword " + keyword + " ignored" +
+                                         (seen.count > 1 ? " (" + std::to_string(seen.count) + " " + noun + ")" : std::string())});
+  }
+  if (overflow_ > 0) {
+    diagnostics.push_back(Diagnostic{Diagnostic::Severity::Warning, SourceLocation{file, 0, 0},
+                                     std::to_string(overflow_) + " more " + noun + " with unknown keywords ignored"});
+  }
+}
+
 LensFormat lens_format_from_path(const std::string& path) {
   const std::string ext = lower_extension(path.substr(0, path.find('#')));
   if (ext == ".json") return LensFormat::Json;
   if (ext == ".zmx") return LensFormat::Zemax;
   if (ext == ".dat") return LensFormat::Pbrt;
+  if (ext == ".seq") return LensFormat::CodeV;
   throw LensFileError({path, 0, 0}, "unknown lens file type \"" + ext +
-                                        "\"; expected .json (lensmith or lentil), .zmx (Zemax) or .dat (pbrt)");
+                                        "\"; expected .json (lensmith or lentil), .zmx (Zemax), .seq (CODE V) or .dat (pbrt)");
 }
 
 namespace {
@@ -81,6 +122,7 @@ LensReadResult read_any(const std::string& path_with_id, const GlassCatalog& cat
   const std::string bytes = read_file_bytes(path);
   switch (format) {
     case LensFormat::Zemax: return read_zemax(bytes, path, catalogue);
+    case LensFormat::CodeV: return read_codev(bytes, path, catalogue);
     case LensFormat::Pbrt: return read_pbrt(decode_text(bytes, path), path);
     case LensFormat::Json:
     case LensFormat::Lentil: {

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 #include "lensmith/core/json_text.h"
 #include "lensmith/core/located_json.h"
@@ -17,9 +18,11 @@ using nlohmann::json;
 constexpr const char* kFormatName = "lensmith-lens";
 const std::vector<std::string> kTopKeys = {"format", "version", "name", "source", "notes", "object_distance_mm",
                                            "object_material", "aperture", "field", "wavelengths_nm",
-                                           "primary_wavelength_nm", "surfaces"};
+                                           "primary_wavelength_nm", "ray_aiming", "object_space_telecentric", "surfaces"};
 const std::vector<std::string> kSurfaceKeys = {"radius_mm", "curvature_per_mm", "thickness_mm", "material", "semi_diameter_mm",
-                                               "stop", "conic", "even_asphere", "comment"};
+                                               "clips_rays", "aperture", "stop", "conic", "even_asphere", "comment"};
+const std::vector<std::string> kApertureKeys = {"shape", "radius_mm", "half_x_mm", "half_y_mm", "min_radius_mm",
+                                                "obscuration", "decenter_x_mm", "decenter_y_mm"};
 const std::vector<std::string> kAsphereKeys = {"a2", "a4", "a6", "a8", "a10", "a12", "a14", "a16"};
 
 // Reads a material: "air", "NAME", or {"glass", "vendor"} / {"nd", "vd"}.
@@ -100,11 +103,23 @@ ApertureSpec read_aperture(const LocatedJson& doc, JsonObjectReader& top) {
     a = {ApertureSpec::Kind::FloatByStop, 0.0};
     ++given;
   }
-  r.finish({"entrance_pupil_diameter_mm", "f_number", "float_by_stop"});
-  if (given != 1) r.fail("", "give exactly one of entrance_pupil_diameter_mm, f_number, float_by_stop");
-  if (a.kind != ApertureSpec::Kind::FloatByStop && !(std::isfinite(a.value) && a.value > 0.0)) {
-    r.fail(a.kind == ApertureSpec::Kind::EntrancePupilDiameter ? "entrance_pupil_diameter_mm" : "f_number", "must be finite and > 0");
+  std::string key_given = a.kind == ApertureSpec::Kind::EntrancePupilDiameter ? "entrance_pupil_diameter_mm" : "f_number";
+  for (const auto& [key, kind] : {std::pair{"paraxial_working_f_number", ApertureSpec::Kind::ParaxialWorkingFNumber},
+                                  std::pair{"object_space_na", ApertureSpec::Kind::ObjectSpaceNA},
+                                  std::pair{"object_cone_angle_deg", ApertureSpec::Kind::ObjectConeAngleDeg}}) {
+    if (auto v = r.get_optional_number(key)) {
+      a = {kind, *v};
+      key_given = key;
+      ++given;
+    }
   }
+  r.finish({"entrance_pupil_diameter_mm", "f_number", "float_by_stop", "paraxial_working_f_number", "object_space_na",
+            "object_cone_angle_deg"});
+  if (given != 1) {
+    r.fail("", "give exactly one of entrance_pupil_diameter_mm, f_number, float_by_stop, paraxial_working_f_number, "
+               "object_space_na, object_cone_angle_deg");
+  }
+  if (a.kind != ApertureSpec::Kind::FloatByStop && !(std::isfinite(a.value) && a.value > 0.0)) r.fail(key_given, "must be finite and > 0");
   return a;
 }
 
@@ -126,9 +141,44 @@ std::optional<FieldSpec> read_field(const LocatedJson& doc, JsonObjectReader& to
     f = {FieldSpec::Kind::ImageHeightMm, read_number_list(r, "image_height_mm")};
     ++given;
   }
-  r.finish({"angle_deg", "object_height_mm", "image_height_mm"});
-  if (given != 1) r.fail("", "give exactly one of angle_deg, object_height_mm, image_height_mm");
+  if (r.has("real_image_height_mm")) {
+    f = {FieldSpec::Kind::RealImageHeightMm, read_number_list(r, "real_image_height_mm")};
+    ++given;
+  }
+  r.finish({"angle_deg", "object_height_mm", "image_height_mm", "real_image_height_mm"});
+  if (given != 1) r.fail("", "give exactly one of angle_deg, object_height_mm, image_height_mm, real_image_height_mm");
   return f;
+}
+
+// A surface's explicit aperture: {"shape": "circular", "radius_mm": 12, "min_radius_mm": 3} or
+// {"shape": "rectangular"|"elliptical", "half_x_mm", "half_y_mm"}, with "obscuration" and decentres.
+SurfaceAperture read_surface_aperture(const LocatedJson& doc, const std::string& pointer, const std::string& path) {
+  JsonObjectReader r(doc, pointer, path);
+  SurfaceAperture a;
+  const std::string shape = r.get_optional_string("shape").value_or("circular");
+  if (shape == "circular") {
+    a.shape = SurfaceAperture::Shape::Circular;
+    a.half_x_mm = a.half_y_mm = r.get_number("radius_mm");
+    if (!(a.half_x_mm > 0.0)) r.fail("radius_mm", "must be > 0");
+    if (r.has("half_x_mm") || r.has("half_y_mm")) r.fail("half_x_mm", "a circular aperture has radius_mm, not half widths");
+    a.min_radius_mm = r.get_optional_number("min_radius_mm").value_or(0.0);
+    if (!(a.min_radius_mm >= 0.0 && a.min_radius_mm < a.half_x_mm)) r.fail("min_radius_mm", "must lie in [0, radius_mm)");
+  } else if (shape == "rectangular" || shape == "elliptical") {
+    a.shape = shape == "rectangular" ? SurfaceAperture::Shape::Rectangular : SurfaceAperture::Shape::Elliptical;
+    a.half_x_mm = r.get_number("half_x_mm");
+    a.half_y_mm = r.get_number("half_y_mm");
+    if (!(a.half_x_mm > 0.0)) r.fail("half_x_mm", "must be > 0");
+    if (!(a.half_y_mm > 0.0)) r.fail("half_y_mm", "must be > 0");
+    if (r.has("radius_mm") || r.has("min_radius_mm")) r.fail("radius_mm", "a " + shape + " aperture has half_x_mm and half_y_mm");
+  } else {
+    r.fail("shape", "expected \"circular\", \"rectangular\" or \"elliptical\", got \"" + shape + "\"");
+  }
+  a.obscuration = r.get_optional_bool("obscuration").value_or(false);
+  if (a.obscuration && a.min_radius_mm > 0.0) r.fail("min_radius_mm", "an obscuration has no inner radius");
+  a.decenter_x_mm = r.get_optional_number("decenter_x_mm").value_or(0.0);
+  a.decenter_y_mm = r.get_optional_number("decenter_y_mm").value_or(0.0);
+  r.finish(kApertureKeys);
+  return a;
 }
 
 Surface read_surface(const LocatedJson& doc, const std::string& pointer, const std::string& path, bool last, bool* thickness_given) {
@@ -168,6 +218,12 @@ Surface read_surface(const LocatedJson& doc, const std::string& pointer, const s
   }
   s.semi_diameter_mm = r.get_optional_number("semi_diameter_mm");
   if (s.semi_diameter_mm && !(*s.semi_diameter_mm > 0.0)) r.fail("semi_diameter_mm", "must be > 0");
+  s.clips_rays = r.get_optional_bool("clips_rays").value_or(true);
+  if (!s.clips_rays && !s.semi_diameter_mm) r.fail("clips_rays", "false is meaningful only with a semi_diameter_mm");
+  if (r.has("aperture")) {
+    r.get("aperture");
+    s.aperture = read_surface_aperture(doc, r.child_pointer("aperture"), r.child_path("aperture"));
+  }
   s.is_stop = r.get_optional_bool("stop").value_or(false);
   s.conic = r.get_optional_number("conic").value_or(0.0);
   if (r.has("even_asphere")) {
@@ -208,6 +264,14 @@ LensReadResult read_lens_json(std::string_view text, const std::string& file_nam
   }
   p.aperture = read_aperture(doc, top);
   p.field = read_field(doc, top);
+  p.object_space_telecentric = top.get_optional_bool("object_space_telecentric").value_or(false);
+  if (auto aiming = top.get_optional_string("ray_aiming")) {
+    if (*aiming == "real") {
+      p.ray_aiming = RayAiming::RealStop;
+    } else if (*aiming != "paraxial") {
+      top.fail("ray_aiming", "expected \"paraxial\" (at the paraxial entrance pupil) or \"real\" (onto the real stop)");
+    }
+  }
 
   if (top.has("wavelengths_nm")) {
     p.wavelengths_nm = read_number_list(top, "wavelengths_nm");
@@ -311,14 +375,21 @@ std::string write_lens_json(const Prescription& p) {
     case ApertureSpec::Kind::EntrancePupilDiameter: o["aperture"] = ojson{{"entrance_pupil_diameter_mm", p.aperture.value}}; break;
     case ApertureSpec::Kind::ImageSpaceFNumber: o["aperture"] = ojson{{"f_number", p.aperture.value}}; break;
     case ApertureSpec::Kind::FloatByStop: o["aperture"] = ojson{{"float_by_stop", true}}; break;
+    case ApertureSpec::Kind::ParaxialWorkingFNumber: o["aperture"] = ojson{{"paraxial_working_f_number", p.aperture.value}}; break;
+    case ApertureSpec::Kind::ObjectSpaceNA: o["aperture"] = ojson{{"object_space_na", p.aperture.value}}; break;
+    case ApertureSpec::Kind::ObjectConeAngleDeg: o["aperture"] = ojson{{"object_cone_angle_deg", p.aperture.value}}; break;
   }
   if (p.field) {
-    const char* key = p.field->kind == FieldSpec::Kind::AngleDeg ? "angle_deg"
-                      : p.field->kind == FieldSpec::Kind::ObjectHeightMm ? "object_height_mm" : "image_height_mm";
+    const char* key = p.field->kind == FieldSpec::Kind::AngleDeg         ? "angle_deg"
+                      : p.field->kind == FieldSpec::Kind::ObjectHeightMm ? "object_height_mm"
+                      : p.field->kind == FieldSpec::Kind::ImageHeightMm  ? "image_height_mm"
+                                                                         : "real_image_height_mm";
     o["field"] = ojson{{key, write_numbers(p.field->values)}};
   }
   o["wavelengths_nm"] = write_numbers(p.wavelengths_nm);
   o["primary_wavelength_nm"] = p.primary_wavelength_nm();
+  if (p.ray_aiming == RayAiming::RealStop) o["ray_aiming"] = "real";
+  if (p.object_space_telecentric) o["object_space_telecentric"] = true;
   ojson surfaces = ojson::array();
   for (std::size_t i = 0; i < p.surfaces.size(); ++i) {
     const Surface& s = p.surfaces[i];
@@ -334,6 +405,24 @@ std::string write_lens_json(const Prescription& p) {
     if (!(last && p.image_at_paraxial_focus)) j["thickness_mm"] = s.thickness_mm;
     j["material"] = write_material(s.material);
     if (s.semi_diameter_mm) j["semi_diameter_mm"] = *s.semi_diameter_mm;
+    if (s.semi_diameter_mm && !s.clips_rays) j["clips_rays"] = false;
+    if (s.aperture) {
+      const SurfaceAperture& a = *s.aperture;
+      ojson ap;
+      if (a.shape == SurfaceAperture::Shape::Circular) {
+        ap["shape"] = "circular";
+        ap["radius_mm"] = a.half_x_mm;
+        if (a.min_radius_mm > 0.0) ap["min_radius_mm"] = a.min_radius_mm;
+      } else {
+        ap["shape"] = a.shape == SurfaceAperture::Shape::Rectangular ? "rectangular" : "elliptical";
+        ap["half_x_mm"] = a.half_x_mm;
+        ap["half_y_mm"] = a.half_y_mm;
+      }
+      if (a.obscuration) ap["obscuration"] = true;
+      if (a.decenter_x_mm != 0.0) ap["decenter_x_mm"] = a.decenter_x_mm;
+      if (a.decenter_y_mm != 0.0) ap["decenter_y_mm"] = a.decenter_y_mm;
+      j["aperture"] = ap;
+    }
     if (s.is_stop) j["stop"] = true;
     if (s.conic != 0.0) j["conic"] = s.conic;
     if (s.has_asphere()) {

@@ -37,6 +37,9 @@ std::string ApertureSpec::to_string() const {
     case Kind::EntrancePupilDiameter: return "entrance-pupil diameter " + number(value) + " mm";
     case Kind::ImageSpaceFNumber: return "image-space f/" + number(value);
     case Kind::FloatByStop: return "float by stop size";
+    case Kind::ParaxialWorkingFNumber: return "paraxial working f/" + number(value);
+    case Kind::ObjectSpaceNA: return "object-space NA " + number(value);
+    case Kind::ObjectConeAngleDeg: return "object cone angle " + number(value) + " deg";
   }
   return "?";
 }
@@ -48,7 +51,10 @@ double FieldSpec::max_value() const {
 }
 
 std::string FieldSpec::to_string() const {
-  std::string unit = kind == Kind::AngleDeg ? " deg (angle)" : kind == Kind::ObjectHeightMm ? " mm (object height)" : " mm (paraxial image height)";
+  std::string unit = kind == Kind::AngleDeg         ? " deg (angle)"
+                     : kind == Kind::ObjectHeightMm ? " mm (object height)"
+                     : kind == Kind::ImageHeightMm  ? " mm (paraxial image height)"
+                                                    : " mm (real image height)";
   std::string s;
   for (double v : values) s += (s.empty() ? "" : ", ") + number(v);
   return s + unit;
@@ -123,6 +129,24 @@ void Prescription::validate() const {
                        "larger than the surface allows (" + number(widest) + " mm for this radius and conic)");
       }
     }
+    if (s.aperture) {
+      const SurfaceAperture& a = *s.aperture;
+      const bool circle = a.shape == SurfaceAperture::Shape::Circular;
+      if (!std::isfinite(a.half_x_mm) || !(a.half_x_mm > 0.0)) {
+        reject_surface(i, circle ? "aperture.radius_mm" : "aperture.half_x_mm", a.half_x_mm, "must be finite and > 0");
+      }
+      if (!circle && (!std::isfinite(a.half_y_mm) || !(a.half_y_mm > 0.0))) {
+        reject_surface(i, "aperture.half_y_mm", a.half_y_mm, "must be finite and > 0");
+      }
+      if (!std::isfinite(a.min_radius_mm) || a.min_radius_mm < 0.0 || (a.min_radius_mm > 0.0 && (!circle || a.obscuration))) {
+        reject_surface(i, "aperture.min_radius_mm", a.min_radius_mm, "must be >= 0, and only on a circular aperture that is not an obscuration");
+      }
+      if (circle && a.min_radius_mm >= a.half_x_mm) {
+        reject_surface(i, "aperture.min_radius_mm", a.min_radius_mm, "must be smaller than the radius " + number(a.half_x_mm) + " mm");
+      }
+      if (!std::isfinite(a.decenter_x_mm)) reject_surface(i, "aperture.decenter_x_mm", a.decenter_x_mm, "must be finite");
+      if (!std::isfinite(a.decenter_y_mm)) reject_surface(i, "aperture.decenter_y_mm", a.decenter_y_mm, "must be finite");
+    }
     if (!std::isfinite(s.conic)) reject_surface(i, "conic", s.conic, "must be finite");
     for (std::size_t j = 0; j < s.even_asphere.size(); ++j) {
       if (!std::isfinite(s.even_asphere[j])) reject_surface(i, "even_asphere.a" + std::to_string(2 * (j + 1)), s.even_asphere[j], "must be finite");
@@ -163,6 +187,25 @@ void Prescription::validate() const {
     case ApertureSpec::Kind::ImageSpaceFNumber:
       if (!std::isfinite(aperture.value) || aperture.value <= 0.0) reject_system("aperture.f_number", aperture.value, "must be finite and > 0");
       break;
+    case ApertureSpec::Kind::ParaxialWorkingFNumber:
+      if (!std::isfinite(aperture.value) || aperture.value <= 0.0) {
+        reject_system("aperture.paraxial_working_f_number", aperture.value, "must be finite and > 0");
+      }
+      break;
+    case ApertureSpec::Kind::ObjectSpaceNA:
+    case ApertureSpec::Kind::ObjectConeAngleDeg: {
+      const bool na = aperture.kind == ApertureSpec::Kind::ObjectSpaceNA;
+      const std::string key = na ? "aperture.object_space_na" : "aperture.object_cone_angle_deg";
+      if (std::isinf(object_distance_mm)) {
+        reject_system(key, aperture.value, "needs a finite object distance (the object is at infinity: give an entrance-pupil diameter or f-number)");
+      }
+      if (!std::isfinite(aperture.value) || aperture.value <= 0.0) reject_system(key, aperture.value, "must be finite and > 0");
+      if (!na && aperture.value >= 90.0) reject_system(key, aperture.value, "must be below 90 degrees");
+      if (na && aperture.value >= object_medium.index(primary_wavelength_nm())) {
+        reject_system(key, aperture.value, "must be below the object-space index " + number(object_medium.index(primary_wavelength_nm())));
+      }
+      break;
+    }
     case ApertureSpec::Kind::FloatByStop: {
       auto stop = flagged_stop_index();
       if (stop && !surfaces[*stop].semi_diameter_mm) {
@@ -178,6 +221,19 @@ void Prescription::validate() const {
     }
   }
 
+  if (object_space_telecentric) {
+    if (std::isinf(object_distance_mm)) {
+      throw PrescriptionError("object_space_telecentric: needs a finite object distance (the object is at infinity)");
+    }
+    if (aperture.kind != ApertureSpec::Kind::ObjectSpaceNA && aperture.kind != ApertureSpec::Kind::ObjectConeAngleDeg) {
+      throw PrescriptionError("aperture: an object-space telecentric lens has its entrance pupil at infinity; give its "
+                              "aperture as an object-space NA or cone angle, not " + aperture.to_string());
+    }
+    if (field && field->kind == FieldSpec::Kind::AngleDeg) {
+      throw PrescriptionError("field: an object-space telecentric lens has every chief ray parallel to the axis; give "
+                              "its field as object or image heights, not angles");
+    }
+  }
   if (field) {
     if (field->values.empty()) throw PrescriptionError("field: at least one field point is needed");
     for (std::size_t i = 0; i < field->values.size(); ++i) {
@@ -215,6 +271,13 @@ Prescription Prescription::scaled(double factor) const {
     s.curvature_per_mm /= factor;
     s.thickness_mm *= factor;
     if (s.semi_diameter_mm) *s.semi_diameter_mm *= factor;
+    if (s.aperture) {
+      s.aperture->min_radius_mm *= factor;
+      s.aperture->half_x_mm *= factor;
+      s.aperture->half_y_mm *= factor;
+      s.aperture->decenter_x_mm *= factor;
+      s.aperture->decenter_y_mm *= factor;
+    }
     // z = a_{2k} r^{2k} scales as length: a_{2k} -> a_{2k} * factor^(1 - 2k).
     for (std::size_t j = 0; j < s.even_asphere.size(); ++j) {
       s.even_asphere[j] *= std::pow(factor, 1.0 - 2.0 * static_cast<double>(j + 1));

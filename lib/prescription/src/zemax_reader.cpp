@@ -27,8 +27,6 @@ namespace {
 constexpr int kMaxSurfaceNumber = 10000;
 constexpr int kMaxWavelengthSlot = 1000;
 constexpr int kMaxFieldCount = 1000;
-constexpr std::size_t kMaxUnknownKeywordWarnings = 50;
-constexpr std::size_t kMaxShownKeywordLength = 32;
 
 // OpticStudio writes nd 1.5 and Vd 40 on the GLAS line of every catalogue glass: they are its
 // model-glass defaults, not data about that glass, so they never stand in for a missing glass.
@@ -43,21 +41,20 @@ constexpr double kMaxPlausibleIndex = 5.0;
 // what makes a mirror). Sorted for binary search.
 // clang-format off
 constexpr auto kIgnoredKeywords = std::to_array<std::string_view>({
-    "BLNK", "COAT", "COFN", "CONF", "DMFS", "EDGE", "EFFL", "FIMP", "FLAP", "FWGN", "FWGT", "GFAC", "GLRS",
+    "BLNK", "COAT", "COFN", "CONF", "DMFS", "EDGE", "EFFL", "FIMP", "FWGN", "FWGT", "GFAC", "GLRS",
     "GSTD", "HIDE", "HYPR", "ISNA", "LANG", "MAZH", "MEMA", "MIRR", "MNCA", "MNCG", "MNEA", "MNEG", "MOFF",
     "MXCA", "MXCG", "NSCD", "OEMA", "OMMA", "OPDX", "PFIL", "PICB", "PKUP", "PMAG", "POLS", "POPS", "PPAR",
-    "PUPD", "PUSH", "PZUP", "RAIM", "RGLA", "ROPD", "SDMA", "SLAB", "TCED", "TCMM", "TOL", "TOLE", "TOTR",
+    "PUPD", "PUSH", "PZUP", "RGLA", "ROPD", "SDMA", "SLAB", "TCED", "TCMM", "TOL", "TOLE", "TOTR",
     "TRAC", "VANN", "VCON", "VCXN", "VCYN", "VDSZ", "VDXN", "VDYN", "VERS", "VPAR", "WAVN", "WWGN", "WWGT",
     "ZVAN", "ZVCX", "ZVCY", "ZVDX", "ZVDY",
 });
-// Surface apertures and obscurations lensmith cannot represent (lensmith has one circular clear
-// aperture per surface): always an error.
+// Surface apertures lensmith cannot represent (spiders, user-defined aperture files): always an error.
 constexpr auto kRefusedApertureKeywords = std::to_array<std::string_view>({
-    "ELAP", "ELOB", "OBSC", "OBSQ", "SPID", "SQAP", "SQOB", "UDAD", "USAP", "USOB",
+    "SPID", "UDAD", "USAP", "USOB",
 });
 // Decentres, tilts and extra surface data: an error unless every value is zero.
 constexpr auto kZeroOnlyKeywords = std::to_array<std::string_view>({
-    "DECX", "DECY", "OBDC", "TILT", "TILX", "TILY", "TILZ", "XDAT", "YDAT",
+    "DECX", "DECY", "TILT", "TILX", "TILY", "TILZ", "XDAT", "YDAT",
 });
 // clang-format on
 static_assert(std::ranges::is_sorted(kIgnoredKeywords) && std::ranges::is_sorted(kRefusedApertureKeywords) &&
@@ -82,22 +79,6 @@ std::string_view trim_lines(std::string_view s) {
   while (!s.empty() && (is_blank(s.back()) || s.back() == '\n')) s.remove_suffix(1);
   return s;
 }
-
-std::string to_upper(std::string_view s) {
-  std::string out(s);
-  for (char& c : out) {
-    if (c >= 'a' && c <= 'z') c = static_cast<char>(c - 'a' + 'A');
-  }
-  return out;
-}
-
-// A display form of user text for messages: bounded in length, so a megabyte "keyword" from a
-// garbage file does not become a megabyte error message.
-std::string shown(std::string_view s, std::size_t max_length = kMaxShownKeywordLength) {
-  if (s.size() <= max_length) return std::string(s);
-  return std::string(s.substr(0, max_length)) + "...";
-}
-
 
 std::optional<long long> parse_integer(std::string_view s) {
   if (s.size() >= 2 && s.front() == '+' && s[1] != '-') s.remove_prefix(1);
@@ -175,7 +156,13 @@ struct ZmxSurface {
   int disz_column = 0;
   std::optional<GlassRef> glass;
   std::optional<double> diam;      // semi-diameter, lens units
-  std::optional<double> clap_max;  // circular aperture radius, lens units
+  bool floating_aperture = false;  // FLAP: the semi-diameter is a clear aperture
+  // An explicit aperture (CLAP, SQAP, ELAP, OBSC, OBSQ, ELOB), lens units; decentred by OBDC.
+  std::optional<SurfaceAperture> aperture;
+  int aperture_line = 0;
+  std::string aperture_keyword;
+  std::optional<std::array<double, 2>> aperture_decenter;  // OBDC x y, lens units
+  int decenter_line = 0;
   bool stop = false;
   int stop_line = 0;
   double conic = 0.0;
@@ -193,6 +180,7 @@ struct FieldTypeLine {
   long long type = 0;
   long long field_count = 0;
   long long wavelength_count = 0;
+  bool telecentric = false;  // object space
   int line = 0;
 };
 
@@ -202,10 +190,6 @@ struct Located {
   int column = 0;
 };
 
-struct UnknownKeyword {
-  int first_line = 0;
-  int count = 0;
-};
 
 class ZemaxParser {
  public:
@@ -257,13 +241,13 @@ class ZemaxParser {
   double number(const ZmxLine& l, std::size_t i, const std::string& what) const {
     const Token& t = required_arg(l, i, what);
     auto v = parse_finite_number(t.text);
-    if (!v) fail_at(l, t, "expected a finite number for " + what + ", got \"" + shown(t.text) + "\"");
+    if (!v) fail_at(l, t, "expected a finite number for " + what + ", got \"" + shown_text(t.text) + "\"");
     return *v;
   }
   long long integer(const ZmxLine& l, std::size_t i, const std::string& what, long long min, long long max) const {
     const Token& t = required_arg(l, i, what);
     auto v = parse_integer(t.text);
-    if (!v) fail_at(l, t, "expected an integer for " + what + ", got \"" + shown(t.text) + "\"");
+    if (!v) fail_at(l, t, "expected an integer for " + what + ", got \"" + shown_text(t.text) + "\"");
     if (*v < min || *v > max) {
       fail_at(l, t,
               what + " = " + std::to_string(*v) + ": must be in [" + std::to_string(min) + ", " + std::to_string(max) +
@@ -306,7 +290,20 @@ class ZemaxParser {
       s.diam = sd;
       return;
     }
-    if (k == "CLAP") return handle_clap(l);
+    if (k == "CLAP" || k == "SQAP" || k == "ELAP" || k == "OBSC" || k == "OBSQ" || k == "ELOB" || k == "SQOB") {
+      return handle_aperture(l);
+    }
+    if (k == "FLAP") {
+      current_surface(l).floating_aperture = true;
+      return;
+    }
+    if (k == "OBDC") {
+      ZmxSurface& s = current_surface(l);
+      s.aperture_decenter = std::array<double, 2>{number(l, 0, "the aperture x decentre"), number(l, 1, "the aperture y decentre")};
+      s.decenter_line = l.number;
+      return;
+    }
+    if (k == "RAIM") return handle_raim(l);
     if (k == "STOP") {
       ZmxSurface& s = current_surface(l);
       if (stop_line_ != 0) {
@@ -347,7 +344,7 @@ class ZemaxParser {
     if (k == "MODE") {
       const Token& t = required_arg(l, 0, "the mode");
       if (t.text != "SEQ") {
-        fail_at(l, t, "mode \"" + shown(t.text) + "\" is not supported: only sequential (SEQ) files are read");
+        fail_at(l, t, "mode \"" + shown_text(t.text) + "\" is not supported: only sequential (SEQ) files are read");
       }
       return;
     }
@@ -358,11 +355,11 @@ class ZemaxParser {
       return;
     }
     if (k == "FNUM") {
+      // FNUM value type: type 0 image-space F/#, 1 paraxial working F/#.
       const double f = number(l, 0, "the F-number");
-      if (l.args.size() > 1 && number(l, 1, "the F-number type") != 0.0) {
-        fail_at(l, l.args[1], "paraxial working F/# apertures are not supported (use image-space F/#, ENPD or FLOA)");
-      }
-      aperture_ = ApertureLine{ApertureSpec::Kind::ImageSpaceFNumber, f, l.number};
+      const long long type = l.args.size() > 1 ? integer(l, 1, "the F-number type (0 image space, 1 paraxial working)", 0, 1) : 0;
+      aperture_ = ApertureLine{type == 0 ? ApertureSpec::Kind::ImageSpaceFNumber : ApertureSpec::Kind::ParaxialWorkingFNumber, f,
+                               l.number};
       return;
     }
     if (k == "FLOA") {
@@ -370,8 +367,11 @@ class ZemaxParser {
       return;
     }
     if (k == "OBNA") {
-      fail(l.number, l.keyword.column,
-           "OBNA: object-space NA and object cone angle apertures are not supported (use ENPD, FNUM or FLOA)");
+      // OBNA value type: type 0 object-space NA, 1 object cone angle (degrees).
+      const double v = number(l, 0, "the object-space NA or cone angle");
+      const long long type = l.args.size() > 1 ? integer(l, 1, "the type (0 object-space NA, 1 object cone angle)", 0, 1) : 0;
+      aperture_ = ApertureLine{type == 0 ? ApertureSpec::Kind::ObjectSpaceNA : ApertureSpec::Kind::ObjectConeAngleDeg, v, l.number};
+      return;
     }
     if (k == "FTYP") return handle_ftyp(l);
     if (k == "XFLN" || k == "XFLD") {
@@ -426,7 +426,8 @@ class ZemaxParser {
     }
     if (contains(kRefusedApertureKeywords, k)) {
       fail(l.number, l.keyword.column,
-           std::string(k) + ": non-circular apertures, obscurations and user apertures are not supported");
+           std::string(k) + ": spiders and user-defined apertures are not supported (circular, annular, rectangular and "
+                           "elliptical apertures and obscurations are)");
     }
     if (contains(kZeroOnlyKeywords, k)) {
       // XDAT/YDAT are "index value ...": only the value matters. The others are values throughout.
@@ -440,7 +441,7 @@ class ZemaxParser {
         auto v = parse_finite_number(l.args[i].text);
         if (v && *v != 0.0) {
           fail_at(l, l.args[i],
-                  "decentres, tilts and extra surface data are not supported (value " + shown(l.args[i].text) + ")");
+                  "decentres, tilts and extra surface data are not supported (value " + shown_text(l.args[i].text) + ")");
         }
       }
       return;
@@ -469,7 +470,7 @@ class ZemaxParser {
       std::string why = "only STANDARD and EVENASPH surfaces are read";
       if (t.text == "COORDBRK") why = "coordinate breaks (tilts and decentres) are not supported; " + why;
       fail_at(l, t,
-              "surface type " + shown(t.text) + " on SURF " + std::to_string(s.number) + " is not supported: " + why);
+              "surface type " + shown_text(t.text) + " on SURF " + std::to_string(s.number) + " is not supported: " + why);
     }
     s.type = std::string(t.text);
   }
@@ -479,7 +480,7 @@ class ZemaxParser {
     const Token& t = required_arg(l, 0, "the thickness");
     s.disz_line = l.number;
     s.disz_column = t.column;
-    if (to_upper(t.text) == "INFINITY") {
+    if (ascii_upper(t.text) == "INFINITY") {
       s.disz.reset();
       s.disz_infinite = true;
       return;
@@ -491,7 +492,7 @@ class ZemaxParser {
   void handle_glas(const ZmxLine& l) {
     ZmxSurface& s = current_surface(l);
     const Token& t = required_arg(l, 0, "the glass name");
-    if (to_upper(t.text) == "MIRROR") {
+    if (ascii_upper(t.text) == "MIRROR") {
       fail_at(l, t,
               "mirrors are not supported (SURF " + std::to_string(s.number) + "; lensmith models refracting systems)");
     }
@@ -507,20 +508,64 @@ class ZemaxParser {
     s.glass = std::move(g);
   }
 
-  void handle_clap(const ZmxLine& l) {
+  // CLAP/OBSC min max (circular aperture / obscuration, radii), SQAP/OBSQ x y (rectangular, half
+  // widths), ELAP/ELOB x y (elliptical, half widths), in lens units. SQOB is an old name of OBSQ.
+  void handle_aperture(const ZmxLine& l) {
     ZmxSurface& s = current_surface(l);
-    const double min_radius = number(l, 0, "the minimum radius");
-    const double max_radius = number(l, 1, "the maximum radius");
-    if (min_radius != 0.0) {
-      fail_at(l, l.args[0], "annular apertures (minimum radius " + format_number(min_radius) + ") are not supported");
+    const std::string_view k = l.keyword.text;
+    if (s.aperture) {
+      fail(l.number, l.keyword.column,
+           std::string(k) + ": a second aperture on SURF " + std::to_string(s.number) + " (the first, " + s.aperture_keyword +
+               ", is on line " + std::to_string(s.aperture_line) + ")");
     }
-    if (max_radius <= 0.0) fail_at(l, l.args[1], "maximum radius = " + format_number(max_radius) + ": must be > 0");
-    s.clap_max = max_radius;
+    SurfaceAperture a;
+    if (k == "CLAP" || k == "OBSC") {
+      const double min_radius = number(l, 0, "the minimum radius");
+      const double max_radius = number(l, 1, "the maximum radius");
+      if (!(max_radius > 0.0)) fail_at(l, l.args[1], "maximum radius = " + format_number(max_radius) + ": must be > 0");
+      if (!(min_radius >= 0.0 && min_radius < max_radius)) {
+        fail_at(l, l.args[0], "minimum radius = " + format_number(min_radius) + ": must lie in [0, maximum radius)");
+      }
+      if (k == "OBSC" && min_radius > 0.0) {
+        fail_at(l, l.args[0], "annular obscurations (minimum radius " + format_number(min_radius) + ") are not supported");
+      }
+      a.shape = SurfaceAperture::Shape::Circular;
+      a.half_x_mm = a.half_y_mm = mm(max_radius);
+      a.min_radius_mm = mm(min_radius);
+      a.obscuration = k == "OBSC";
+    } else {
+      const double half_x = number(l, 0, "the x half width");
+      const double half_y = number(l, 1, "the y half width");
+      if (!(half_x > 0.0)) fail_at(l, l.args[0], "x half width = " + format_number(half_x) + ": must be > 0");
+      if (!(half_y > 0.0)) fail_at(l, l.args[1], "y half width = " + format_number(half_y) + ": must be > 0");
+      a.shape = k == "SQAP" || k == "OBSQ" || k == "SQOB" ? SurfaceAperture::Shape::Rectangular : SurfaceAperture::Shape::Elliptical;
+      a.half_x_mm = mm(half_x);
+      a.half_y_mm = mm(half_y);
+      a.obscuration = k == "OBSQ" || k == "SQOB" || k == "ELOB";
+    }
+    s.aperture = a;
+    s.aperture_line = l.number;
+    s.aperture_keyword = std::string(k);
+  }
+
+  // RAIM <?> type ...: the second field is OpticStudio's ray aiming (0 off, 1 paraxial, 2 real).
+  void handle_raim(const ZmxLine& l) {
+    if (l.args.size() < 2) return;  // an old or partial line: ray aiming off
+    const long long type = integer(l, 1, "the ray aiming type", 0, 2);
+    if (type == 0) {
+      ray_aiming_ = RayAiming::ParaxialEntrancePupil;
+      return;
+    }
+    ray_aiming_ = RayAiming::RealStop;
+    if (type == 1) {
+      note(l.number, "paraxial ray aiming (RAIM type 1) is read as real ray aiming: lensmith aims every ray onto the real "
+                     "stop, which OpticStudio's paraxial aiming approximates");
+    }
   }
 
   void handle_unit(const ZmxLine& l) {
     const Token& t = required_arg(l, 0, "the lens unit");
-    const std::string u = to_upper(t.text);
+    const std::string u = ascii_upper(t.text);
     if (u == "MM") {
       mm_per_unit_ = 1.0;
     } else if (u == "CM") {
@@ -530,7 +575,7 @@ class ZemaxParser {
     } else if (u == "METER" || u == "METERS" || u == "M") {
       mm_per_unit_ = mm_from_m(1.0);
     } else {
-      fail_at(l, t, "unknown lens unit \"" + shown(t.text) + "\" (expected MM, CM, IN or METER)");
+      fail_at(l, t, "unknown lens unit \"" + shown_text(t.text) + "\" (expected MM, CM, IN or METER)");
     }
   }
 
@@ -555,7 +600,7 @@ class ZemaxParser {
     // Vendor catalogue names may carry a date suffix ("SUMITA_AUG2011"); other catalogues
     // (MISC, INFRARED, user catalogues) are not in lensmith and are skipped.
     for (const Token& t : l.args) {
-      const std::string token = to_upper(t.text);
+      const std::string token = ascii_upper(t.text);
       for (const std::string& vendor : catalogue_.vendors()) {
         if (token == vendor || (token.size() > vendor.size() && token.compare(0, vendor.size(), vendor) == 0 &&
                                 token[vendor.size()] == '_')) {
@@ -570,15 +615,10 @@ class ZemaxParser {
   void handle_ftyp(const ZmxLine& l) {
     // FTYP type telecentric field-count wavelength-count ... afocal ...
     const long long type = integer(l, 0, "the field type", 0, 1000);
-    if (type == 3) {
-      fail_at(l, l.args[0], "real image height fields (type 3) are not supported; use paraxial image height (2)");
-    }
     if (type == 4) fail_at(l, l.args[0], "theodolite angle fields (type 4) are not supported");
     if (type > 4) fail_at(l, l.args[0], "field type " + std::to_string(type) + " is not supported");
-    if (l.args.size() > 1 && integer(l, 1, "the telecentric flag", 0, 1000) != 0) {
-      fail_at(l, l.args[1], "object-space telecentric systems are not supported");
-    }
     FieldTypeLine f;
+    f.telecentric = l.args.size() > 1 && integer(l, 1, "the object-space telecentric flag (0 or 1)", 0, 1) != 0;
     f.type = type;
     f.field_count = l.args.size() > 2 ? integer(l, 2, "the number of fields", 0, kMaxFieldCount) : -1;
     f.wavelength_count = l.args.size() > 3 ? integer(l, 3, "the number of wavelengths", 0, kMaxWavelengthSlot) : -1;
@@ -599,26 +639,14 @@ class ZemaxParser {
     }
   }
 
-  void record_unknown(const ZmxLine& l) {
-    const std::string key = shown(l.keyword.text);
-    auto it = unknown_.find(key);
-    if (it != unknown_.end()) {
-      ++it->second.count;
-      return;
-    }
-    if (unknown_.size() >= kMaxUnknownKeywordWarnings) {
-      ++unknown_overflow_;
-      return;
-    }
-    unknown_.emplace(key, UnknownKeyword{l.number, 1});
-  }
+  void record_unknown(const ZmxLine& l) { unknown_.record(l.keyword.text, l.number); }
 
   // ---- building the prescription ----------------------------------------------------------------
 
   double mm(double lens_units) const { return lens_units * mm_per_unit_; }
 
   MaterialSpec material_for(const GlassRef& g) {
-    const std::string upper = to_upper(g.name);
+    const std::string upper = ascii_upper(g.name);
     if (upper == "___BLANK") {
       // A model glass: nd and Vd are the glass (Vd 0 = no dispersion, as in OpticStudio).
       if (!g.nd || *g.nd < 1.0 || *g.nd > kMaxPlausibleIndex) {
@@ -646,6 +674,18 @@ class ZemaxParser {
                        "), the same glass type made lead-free, whose index differs slightly from the original's");
       return MaterialSpec::catalog(next->name(), next->vendor());
     }
+    // A moulded-lens vendor's name for a moulding glass ("L-TIM28_MOLD" in RPO's catalogue): the glass
+    // itself, whose index a moulding lowers by the mould house's annealing (typically 1e-3 to 3e-3 in nd).
+    constexpr std::string_view kMouldSuffix = "_MOLD";
+    if (upper.size() > kMouldSuffix.size() && upper.ends_with(kMouldSuffix)) {
+      const std::string base = g.name.substr(0, g.name.size() - kMouldSuffix.size());
+      if (const Glass* found = catalogue_.find(base, {}, vendor_order_)) {
+        warn(g.line, "glass \"" + g.name + "\" is a moulded variant of " + found->vendor() + " " + found->name() +
+                         " (nd " + format_rounded(found->nd(), 6) + "), used here; the moulded lens's index is lower by its "
+                         "moulding's index drop (typically 0.001 to 0.003), which lensmith does not know");
+        return MaterialSpec::catalog(found->name(), found->vendor());
+      }
+    }
     const bool placeholder = g.nd && g.vd && *g.nd == kPlaceholderNd && *g.vd == kPlaceholderVd;
     const bool usable_nd = g.nd && *g.nd >= 1.0 && *g.nd <= kMaxPlausibleIndex && !placeholder;
     if (usable_nd && (!g.vd || *g.vd >= 0.0)) {
@@ -660,7 +700,7 @@ class ZemaxParser {
     std::string why = placeholder ? "its GLAS line carries only OpticStudio's placeholder nd 1.5 / Vd 40"
                                   : "its GLAS line gives no usable nd/Vd to fall back on";
     fail(g.line, g.column,
-         "GLAS: unknown glass \"" + shown(g.name, 64) + "\": in no catalogue and " + why +
+         "GLAS: unknown glass \"" + shown_text(g.name, 64) + "\": in no catalogue and " + why +
              "; closest catalogue names: " + (names.empty() ? "(none)" : names));
   }
 
@@ -684,6 +724,7 @@ class ZemaxParser {
     }
     if (message.rfind("primary", 0) == 0 && primary_) return primary_->line;
     if (message.rfind("aperture", 0) == 0 && aperture_) return aperture_->line;
+    if (message.rfind("object_space_telecentric", 0) == 0 && field_type_) return field_type_->line;
     if (message.rfind("field", 0) == 0 && field_type_) return field_type_->line;
     if (message.rfind("object", 0) == 0) return surfaces_.front().disz_line;
     return 0;
@@ -707,7 +748,7 @@ class ZemaxParser {
     }
     LensReadResult result;
     Prescription& p = result.prescription;
-    p.name = name_.empty() ? file_stem() : name_;  // OpticStudio often leaves NAME blank
+    p.name = name_.empty() ? lens_name_from_path(file_) : name_;  // OpticStudio often leaves NAME blank
     p.notes = std::string(trim_lines(notes_));
 
     const ZmxSurface& object = surfaces_.front();
@@ -736,25 +777,20 @@ class ZemaxParser {
     set_aperture(p);
     set_field(p);
     set_wavelengths(p);
+    p.ray_aiming = ray_aiming_;
+    if (field_type_ && field_type_->telecentric) {
+      p.object_space_telecentric = true;
+      if (ray_aiming_ == RayAiming::RealStop) {
+        note(field_type_->line, "object-space telecentric: rays are aimed by their object-space direction (the entrance "
+                                "pupil is at infinity), not onto the real stop");
+        p.ray_aiming = RayAiming::ParaxialEntrancePupil;
+      }
+    }
 
     resolve_and_validate(p, catalogue_, file_, [this](const std::string& m) { return line_for_prescription_message(m); });
-    for (const auto& [keyword, u] : unknown_) {
-      warn(u.first_line, "unknown keyword " + keyword + " ignored" +
-                             (u.count > 1 ? " (" + std::to_string(u.count) + " lines)" : std::string()));
-    }
-    if (unknown_overflow_ > 0) {
-      warn(0, std::to_string(unknown_overflow_) + " more lines with unknown keywords ignored");
-    }
+    unknown_.report(diagnostics_, file_, "lines");
     result.diagnostics = std::move(diagnostics_);
     return result;
-  }
-
-  std::string file_stem() const {
-    const std::size_t slash = file_.find_last_of("/\\");
-    std::string stem = slash == std::string::npos ? file_ : file_.substr(slash + 1);
-    const std::size_t dot = stem.find_last_of('.');
-    if (dot != std::string::npos && dot > 0) stem.resize(dot);
-    return stem;
   }
 
   Surface make_surface(const ZmxSurface& z) {
@@ -766,10 +802,38 @@ class ZemaxParser {
     }
     s.thickness_mm = mm(*z.disz);
     if (z.glass) s.material = material_for(*z.glass);
-    if (z.clap_max) {
-      s.semi_diameter_mm = mm(*z.clap_max);
-    } else if (z.diam && *z.diam > 0.0) {
-      s.semi_diameter_mm = mm(*z.diam);  // DIAM 0 means "not computed": no limit
+    // Clipping follows the file, as OpticStudio's sequential ray trace does: a DIAM semi-diameter
+    // sizes the surface but stops no ray unless a floating aperture (FLAP) makes it a clear aperture;
+    // explicit apertures (CLAP, SQAP, ELAP, OBSC, OBSQ, ELOB, decentred by OBDC) clip.
+    if (z.diam && *z.diam > 0.0) {
+      s.semi_diameter_mm = mm(*z.diam);  // DIAM 0 means "not computed": no size
+      s.clips_rays = z.floating_aperture;
+    }
+    if (z.aperture) {
+      SurfaceAperture a = *z.aperture;
+      if (z.aperture_decenter) {
+        a.decenter_x_mm = mm((*z.aperture_decenter)[0]);
+        a.decenter_y_mm = mm((*z.aperture_decenter)[1]);
+      }
+      const bool plain_circle = a.shape == SurfaceAperture::Shape::Circular && !a.obscuration && a.min_radius_mm == 0.0 &&
+                                a.decenter_x_mm == 0.0 && a.decenter_y_mm == 0.0;
+      if (plain_circle) {
+        // A centred circular aperture is the clear semi-diameter itself.
+        s.semi_diameter_mm = a.half_x_mm;
+        s.clips_rays = true;
+      } else {
+        s.aperture = a;
+        if (!s.semi_diameter_mm && !a.obscuration) {
+          s.semi_diameter_mm = a.outer_radius_mm();  // the surface's size when the file gives no DIAM
+          s.clips_rays = false;
+        }
+        if (s.semi_diameter_mm && !a.obscuration && a.outer_radius_mm() > *s.semi_diameter_mm) {
+          // Everything the aperture passes must lie on the surface as drawn.
+          s.semi_diameter_mm = std::min(a.outer_radius_mm(), s.max_semi_diameter_mm());
+        }
+      }
+    } else if (z.aperture_decenter && ((*z.aperture_decenter)[0] != 0.0 || (*z.aperture_decenter)[1] != 0.0)) {
+      warn(z.decenter_line, "OBDC: an aperture decentre on SURF " + std::to_string(z.number) + ", which has no explicit aperture: ignored");
     }
     s.is_stop = z.stop;
     s.conic = z.conic;
@@ -824,8 +888,10 @@ class ZemaxParser {
       fail(field_line_, 0, "more than " + std::to_string(kMaxFieldCount) + " field points");
     }
     FieldSpec field;
-    field.kind = type == 0 ? FieldSpec::Kind::AngleDeg
-                           : (type == 1 ? FieldSpec::Kind::ObjectHeightMm : FieldSpec::Kind::ImageHeightMm);
+    field.kind = type == 0   ? FieldSpec::Kind::AngleDeg
+                 : type == 1 ? FieldSpec::Kind::ObjectHeightMm
+                 : type == 2 ? FieldSpec::Kind::ImageHeightMm
+                             : FieldSpec::Kind::RealImageHeightMm;
     bool folded = false;
     for (std::size_t i = 0; i < count; ++i) {
       const double y = i < y_fields_.size() ? y_fields_[i].value : 0.0;
@@ -833,10 +899,7 @@ class ZemaxParser {
       double radial = y;
       if (x != 0.0) {
         folded = true;
-        // A rotationally symmetric lens sees only the distance of a field point from the axis; for
-        // angles that is the angle whose tangent is the length of (tan x, tan y).
-        radial = type == 0 ? deg_from_rad(std::atan(std::hypot(std::tan(rad_from_deg(x)), std::tan(rad_from_deg(y)))))
-                           : std::hypot(x, y);
+        radial = radial_field_value(field.kind, x, y);  // what a rotationally symmetric lens sees
       }
       field.values.push_back(type == 0 ? radial : mm(radial));
     }
@@ -909,12 +972,12 @@ class ZemaxParser {
   std::vector<Located> x_fields_;
   std::vector<Located> y_fields_;
   int field_line_ = 0;  // the last XFLN/YFLN line
+  RayAiming ray_aiming_ = RayAiming::ParaxialEntrancePupil;
   std::map<int, Located> wavm_;
   std::vector<Located> wavl_;
   std::optional<Located> primary_;
   std::vector<Located> wavelength_sources_;  // the wavelengths in use, where the file gives them
-  std::map<std::string, UnknownKeyword> unknown_;
-  std::size_t unknown_overflow_ = 0;
+  UnknownKeywords unknown_;
 };
 
 }  // namespace

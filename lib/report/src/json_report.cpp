@@ -73,6 +73,9 @@ ojson info_json(const Prescription& lens, const ParaxialSystem& p) {
   o["name"] = lens.name;
   o["wavelength_nm"] = p.wavelength_nm();
   o["object_distance_mm"] = number_or_null(p.object_distance_mm());
+  o["aperture"] = lens.aperture.to_string();  // as the file specifies it; the pupils below are what it gives
+  o["field"] = lens.field ? ojson(lens.field->to_string()) : ojson(nullptr);
+  o["ray_aiming"] = lens.ray_aiming == RayAiming::RealStop ? "real" : "paraxial";
   o["efl_mm"] = p.efl_mm();
   o["bfl_mm"] = p.bfl_mm();
   o["ffl_mm"] = p.ffl_mm();
@@ -87,9 +90,14 @@ ojson info_json(const Prescription& lens, const ParaxialSystem& p) {
   o["z_last_surface_mm"] = p.z_last_surface_mm();
   o["stop_surface"] = p.stop_surface();
   o["stop_flagged"] = p.stop_was_flagged();
-  o["entrance_pupil"] = {{"z_mm", p.entrance_pupil().z_mm}, {"diameter_mm", p.entrance_pupil().diameter_mm}};
+  if (p.entrance_pupil_at_infinity()) {
+    // Object-space telecentric: no finite pupil, and no infinite-conjugate F-number.
+    o["entrance_pupil"] = {{"z_mm", nullptr}, {"diameter_mm", nullptr}, {"at_infinity", true}};
+  } else {
+    o["entrance_pupil"] = {{"z_mm", p.entrance_pupil().z_mm}, {"diameter_mm", p.entrance_pupil().diameter_mm}};
+  }
   o["exit_pupil"] = {{"z_mm", p.exit_pupil().z_mm}, {"diameter_mm", p.exit_pupil().diameter_mm}};
-  o["f_number"] = p.f_number();
+  o["f_number"] = p.entrance_pupil_at_infinity() ? ojson(nullptr) : ojson(p.f_number());
   o["working_f_number"] = p.working_f_number();
   o["image_space_na"] = p.image_space_na();
   auto h = p.lagrange_invariant();
@@ -128,6 +136,7 @@ ojson seidel_json(const Prescription& lens, const SeidelAnalysis& seidel) {
   o["lagrange_invariant"] = seidel.lagrange_invariant();
   o["image_space_slope"] = seidel.image_slope();
   o["sums"] = sums_json(seidel.sums());
+  o["colour_wavelengths_nm"] = {seidel.colour_wavelengths_nm()[0], seidel.colour_wavelengths_nm()[1]};
   ojson surfaces = ojson::array();
   for (std::size_t k = 0; k < seidel.surfaces().size(); ++k) {
     ojson row = sums_json(seidel.surfaces()[k]);

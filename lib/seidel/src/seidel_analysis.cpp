@@ -1,5 +1,6 @@
 #include "lensmith/seidel/seidel_analysis.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -83,6 +84,13 @@ std::string FieldCurvatures::to_string() const {
 }
 
 void SeidelOptions::validate() const {
+  if (colour_wavelengths_nm) {
+    const auto [s, l] = *colour_wavelengths_nm;
+    if (!(s > 100.0 && l < 20000.0 && s < l)) {
+      throw OptionsError("SeidelOptions::colour_wavelengths_nm = (" + format("%g", s) + ", " + format("%g", l) +
+                         "): must be short < long within (100, 20000) nm");
+    }
+  }
   if (wavelength_nm != 0.0 && !(wavelength_nm > 100.0 && wavelength_nm < 20000.0)) {
     throw OptionsError("SeidelOptions::wavelength_nm = " + format("%g", wavelength_nm) + ": must lie in (100, 20000) nm or be 0");
   }
@@ -129,8 +137,16 @@ SeidelAnalysis::SeidelAnalysis(const Prescription& lens, const SeidelOptions& op
   surfaces_.resize(count);
   aspheric_.resize(count);
   const double lambda = paraxial_.wavelength_nm();
+  if (options.colour_wavelengths_nm) {
+    colour_wavelengths_nm_ = *options.colour_wavelengths_nm;
+  } else if (p.wavelengths_nm.size() >= 2) {
+    const auto [lo, hi] = std::minmax_element(p.wavelengths_nm.begin(), p.wavelengths_nm.end());
+    colour_wavelengths_nm_ = {*lo, *hi};
+  }
+  const double short_nm = colour_wavelengths_nm_[0], long_nm = colour_wavelengths_nm_[1];
+  auto dispersion = [&](const Glass& g) { return g.index(short_nm) - g.index(long_nm); };
   double n = p.object_medium.index(lambda);
-  double dn = p.object_medium.principal_dispersion();  // n_F - n_C of the medium before the surface
+  double dn = dispersion(p.object_medium);  // n(short) - n(long) of the medium before the surface
   double u = marginal.object_slope;
   double ubar = chief.object_slope;
 
@@ -139,7 +155,7 @@ SeidelAnalysis::SeidelAnalysis(const Prescription& lens, const SeidelOptions& op
     const ParaxialRayRow& m = marginal.rows[k];
     const ParaxialRayRow& c = chief.rows[k];
     const double n_after = m.n_after;
-    const double dn_after = s.medium.principal_dispersion();
+    const double dn_after = dispersion(s.medium);
     const double curvature = s.paraxial_curvature_per_mm();
     const double y = m.y_mm;
     const double ybar = c.y_mm;
@@ -242,7 +258,8 @@ std::string SeidelAnalysis::to_string() const {
   char line[256];
   os << "Third-order (Seidel) aberrations at " << format("%.4f", wavelength_nm()) << " nm, object "
      << (std::isinf(paraxial_.object_distance_mm()) ? std::string("at infinity") : format("%.6g mm from surface 1", paraxial_.object_distance_mm()))
-     << "\n  Welford sums (mm; S_I > 0 = undercorrected spherical aberration)\n";
+     << "\n  Welford sums (mm; S_I > 0 = undercorrected spherical aberration; C_I, C_II from n(" << format("%.4f", colour_wavelengths_nm_[0])
+     << " nm) - n(" << format("%.4f", colour_wavelengths_nm_[1]) << " nm))\n";
   std::snprintf(line, sizeof line, "  %5s %12s %12s %12s %12s %12s %12s %12s\n", "surf", "S_I", "S_II", "S_III", "S_IV", "S_V", "C_I", "C_II");
   os << line;
   for (std::size_t k = 0; k < surfaces_.size(); ++k) {

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <vector>
 
@@ -751,6 +752,7 @@ FieldPoint RayAimer::field_at(double relative) const {
       // The object point on the chief ray of this slope: below the axis for a rising chief ray.
       return FieldPoint::object_height_mm(-slope * (paraxial_.object_distance_mm() + paraxial_.entrance_pupil().z_mm));
     }
+    case FieldSpec::Kind::RealImageHeightMm: break;  // ParaxialSystem refused it: resolve_real_image_height_field first
   }
   return FieldPoint::angle_deg(0.0);
 }
@@ -797,6 +799,84 @@ AimedRay RayAimer::make_ray(const FieldPoint& field, const PupilCoordinate& pupi
     return out;
   }
   return aimed;
+}
+
+namespace {
+
+// How closely a resolved field point's real chief ray must land on its image height: 1e-9 mm, relative
+// above 1 mm, far below the 1e-6 digits OpticStudio prints and far above the rounding of a trace.
+constexpr double kRealImageHeightTolerance = 1e-9;
+constexpr int kMaxRealImageHeightIterations = 60;
+
+}  // namespace
+
+Prescription resolve_real_image_height_field(const Prescription& lens) {
+  if (!lens.field || lens.field->kind != FieldSpec::Kind::RealImageHeightMm) return lens;
+  Prescription probe = lens;
+  probe.field->kind = FieldSpec::Kind::ImageHeightMm;  // the paraxial estimate starts each solve
+  for (double& v : probe.field->values) v = std::abs(v);
+  TracerOptions free;
+  free.clip_apertures = false;
+  const SequentialTracer tracer(probe, free);
+  AimOptions aim;
+  aim.aiming = lens.ray_aiming;
+  const RayAimer aimer(tracer, aim);
+  const bool at_infinity = std::isinf(lens.object_distance_mm);
+  const double wavelength_nm = lens.primary_wavelength_nm();
+  const double max_height = probe.field->max_value();
+
+  auto field_point = [&](double t) { return at_infinity ? FieldPoint::angle_deg(t) : FieldPoint::object_height_mm(t); };
+  // The real chief ray's image height for the field parameter t (deg or mm); NaN when it cannot be traced.
+  auto landing = [&](double t) {
+    if (at_infinity && !(std::abs(t) < 90.0)) return std::numeric_limits<double>::quiet_NaN();
+    const AimedRay aimed = aimer.make_ray(field_point(t), {0.0, 0.0}, wavelength_nm);
+    if (!aimed.ok()) return std::numeric_limits<double>::quiet_NaN();
+    const TraceResult r = tracer.trace_forward(aimed.ray);
+    return r.ok() ? r.ray.position_mm.y() : std::numeric_limits<double>::quiet_NaN();
+  };
+
+  Prescription out = lens;
+  out.field->kind = at_infinity ? FieldSpec::Kind::AngleDeg : FieldSpec::Kind::ObjectHeightMm;
+  for (std::size_t i = 0; i < probe.field->values.size(); ++i) {
+    const double height = probe.field->values[i];
+    if (height == 0.0) {
+      out.field->values[i] = 0.0;
+      continue;
+    }
+    const FieldPoint guess = aimer.field_at(height / max_height);
+    double t0 = guess.y;
+    double y0 = landing(t0);
+    auto unreachable = [&](const std::string& why) {
+      return ComputationError("field: real image height " + std::to_string(height) + " mm: " + why +
+                              " (beyond the image circle of the lens?)");
+    };
+    if (!std::isfinite(y0)) throw unreachable("the chief ray of its paraxial estimate cannot be traced");
+    const double target = std::copysign(height, y0);
+    const double tolerance = kRealImageHeightTolerance * std::max(1.0, height);
+    double t1 = t0 * (1.0 + 1e-4);
+    double y1 = landing(t1);
+    bool done = std::abs(y0 - target) <= tolerance;
+    double best = t0;
+    for (int k = 0; !done && k < kMaxRealImageHeightIterations; ++k) {
+      if (!std::isfinite(y1) || y1 == y0) {
+        t1 = 0.5 * (t0 + t1);  // back off towards the last good point
+        y1 = landing(t1);
+        continue;
+      }
+      const double t2 = t1 - (y1 - target) * (t1 - t0) / (y1 - y0);
+      t0 = t1;
+      y0 = y1;
+      t1 = t2;
+      y1 = landing(t1);
+      if (std::isfinite(y1) && std::abs(y1 - target) <= tolerance) {
+        best = t1;
+        done = true;
+      }
+    }
+    if (!done) throw unreachable("no chief ray lands there");
+    out.field->values[i] = std::abs(best);
+  }
+  return out;
 }
 
 }  // namespace lensmith

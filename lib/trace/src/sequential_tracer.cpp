@@ -68,6 +68,9 @@ struct SurfaceGeometry {
   std::array<double, 8> asphere{};           // a2, a4, ..., a16 (r^2 ... r^16)
   int asphere_terms = 0;                     // highest non-zero coefficient + 1
   double clip_radius2_mm2 = std::numeric_limits<double>::infinity();  // (semi-diameter)^2 with tolerance
+  bool has_aperture = false;                 // an explicit (non-circular, annular, obscuring or decentred) aperture
+  SurfaceAperture aperture;                  // used when has_aperture
+  double aperture_tolerance_mm = 0.0;        // its rim tolerance
 };
 
 // A ray in the inner loop: position (global frame), unit direction, optical path so far.
@@ -518,7 +521,8 @@ template <bool kForward, bool kRecord>
                                  Eigen::Vector3d(hit.nx, hit.ny, hit.nz), r.opl});
     }
   };
-  if (r.x * r.x + r.y * r.y > g.clip_radius2_mm2) {
+  if (r.x * r.x + r.y * r.y > g.clip_radius2_mm2 ||
+      (g.has_aperture && !g.aperture.passes(r.x, r.y, g.aperture_tolerance_mm))) {
     record();
     return RayStatus::Vignetted;
   }
@@ -735,7 +739,13 @@ SequentialTracer::SequentialTracer(const Prescription& lens, const TracerOptions
     } else {
       g.shape = s.conic == 0.0 ? Shape::Sphere : Shape::Conic;
     }
-    if (options_.clip_apertures && s.semi_diameter_mm) {
+    // What clips (docs/lens-format.md, "Apertures"): an explicit aperture where the surface has one,
+    // else the semi-diameter where it is a clear aperture (clips_rays), with the rim tolerance above.
+    if (options_.clip_apertures && s.aperture) {
+      g.has_aperture = true;
+      g.aperture = *s.aperture;
+      g.aperture_tolerance_mm = kClipRelativeTolerance * std::max(s.aperture->half_x_mm, s.aperture->half_y_mm);
+    } else if (options_.clip_apertures && s.semi_diameter_mm && s.clips_rays) {
       const double limit = *s.semi_diameter_mm * (1.0 + kClipRelativeTolerance);
       g.clip_radius2_mm2 = limit * limit;
     }

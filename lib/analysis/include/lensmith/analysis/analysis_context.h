@@ -23,11 +23,12 @@ struct AnalysisOptions {
   // Object-space half field angle that relative field 1 stands for, deg, in (0, 90). Overrides the
   // prescription's field; required for off-axis fields when the prescription has none.
   std::optional<double> max_field_angle_deg;
-  // Paraxial entrance-pupil aiming by default (OpticStudio's "ray aiming off"). lensmith clips rays
-  // at every clear semi-diameter, the stop's included, so where the pupil has spherical aberration
-  // the outermost rays aimed this way can be cut by the stop itself even on axis (they are counted
-  // as vignetted); RealStop fills the real stop exactly.
-  RayAiming aiming = RayAiming::ParaxialEntrancePupil;
+  // Empty: the aiming the lens file asks for (Prescription::ray_aiming: paraxial entrance pupil,
+  // OpticStudio's "ray aiming off", unless a Zemax RAIM line or a CODE V file asks for real aiming).
+  // lensmith clips rays at every clear aperture, so where the pupil has spherical aberration the
+  // outermost paraxially aimed rays can be cut by a clipping stop even on axis (they are counted as
+  // vignetted); RealStop fills the real stop exactly.
+  std::optional<RayAiming> aiming;
   // Where rays are evaluated: the prescription's image plane or the paraxial focus (primary).
   TracerOptions::ImagePlane image_plane = TracerOptions::ImagePlane::AsPrescribed;
 

@@ -17,7 +17,7 @@ struct RayTraceOptions {
   FieldPoint field;                      // default: on axis
   PupilCoordinate pupil;                 // normalised, inside the unit disc
   std::optional<double> wavelength_nm;   // default: the primary wavelength; (100, 20000)
-  RayAiming aiming = RayAiming::ParaxialEntrancePupil;  // as AnalysisOptions::aiming
+  std::optional<RayAiming> aiming;  // as AnalysisOptions::aiming: empty = the lens file's
   TracerOptions::ImagePlane image_plane = TracerOptions::ImagePlane::AsPrescribed;
   void validate() const;                 // throws OptionsError ("pupil (2, 0): must lie in the unit disc")
 };

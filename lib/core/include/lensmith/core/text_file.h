@@ -17,6 +17,14 @@ std::string read_file_bytes(const std::string& path);
 // malformed UTF-16 sequence.
 std::string decode_text(std::string_view bytes, const std::string& file_name);
 
+// `text` with its ASCII letters upper-cased and every other byte unchanged: keywords and glass names
+// in lens files, compared case-insensitively.
+std::string ascii_upper(std::string_view text);
+
+// A display form of user text for messages: at most `max_length` bytes, then "...", so that a
+// megabyte "keyword" from a garbage file does not become a megabyte error message.
+std::string shown_text(std::string_view text, std::size_t max_length = 32);
+
 // Whether the bytes are well-formed UTF-8 (RFC 3629: no overlong forms, surrogates or code points
 // above U+10FFFF).
 bool is_valid_utf8(std::string_view bytes);

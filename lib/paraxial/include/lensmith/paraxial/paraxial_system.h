@@ -81,9 +81,15 @@ class ParaxialSystem {
 
   int stop_surface() const { return stop_surface_; }  // 1-based
   bool stop_was_flagged() const { return stop_flagged_; }
+  // For an object-space telecentric lens the entrance pupil stands at z = 1e12 mm with the diameter
+  // the NA gives there, so that every formula for a finite pupil holds; entrance_pupil_at_infinity()
+  // says so, and reports print "at infinity".
   const Pupil& entrance_pupil() const { return entrance_pupil_; }
+  bool entrance_pupil_at_infinity() const { return telecentric_; }
   const Pupil& exit_pupil() const { return exit_pupil_; }
-  double f_number() const;             // EFL / EPD (object at infinity, "image-space F/#")
+  // f' / EPD, f' = n' EFL the image-space focal length (object at infinity; OpticStudio's "Image Space
+  // F/#"; in air EFL / EPD). Irradiance and diffraction follow working_f_number() and image_space_na().
+  double f_number() const;
   double working_f_number() const;     // 1 / (2 n' |u'|) of the marginal ray for this object distance
   double image_space_na() const;       // n' |u'| of the marginal ray
 
@@ -138,6 +144,7 @@ class ParaxialSystem {
   double z_front_nodal_mm_ = 0.0;
   double z_rear_nodal_mm_ = 0.0;
   std::optional<double> stop_semi_diameter_mm_;  // the stop's clear semi-diameter, when given
+  bool telecentric_ = false;                     // object-space telecentric: the entrance pupil at infinity
   std::string field_description_;    // the maximum field as the prescription states it, for to_string()
 };
 

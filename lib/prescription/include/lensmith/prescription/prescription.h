@@ -19,8 +19,18 @@ namespace lensmith {
 struct ApertureSpec {
   enum class Kind {
     EntrancePupilDiameter,  // value = entrance-pupil diameter, mm
-    ImageSpaceFNumber,      // value = EFL / EPD for an object at infinity (Zemax "Image Space F/#")
-    FloatByStop,            // the stop's clear semi-diameter sets the beam; value unused
+    // value = f' / EPD for an object at infinity, f' = n' EFL the image-space focal length (OpticStudio's
+    // "Image Space F/#"; in air f' = EFL)
+    ImageSpaceFNumber,
+    FloatByStop,            // the stop's semi-diameter sets the beam; value unused
+    // value = 1 / (2 n' |u'|) of the paraxial marginal ray at the prescription's object distance
+    // (OpticStudio's "Paraxial Working F/#")
+    ParaxialWorkingFNumber,
+    // value = n sin(theta) of the ray from the axial object point to the edge of the paraxial
+    // entrance pupil (finite object only; OpticStudio's "Object Space NA")
+    ObjectSpaceNA,
+    // value = theta in degrees, the same ray's angle to the axis (finite object; "Object Cone Angle")
+    ObjectConeAngleDeg,
   };
   Kind kind = Kind::FloatByStop;
   double value = 0.0;
@@ -35,6 +45,10 @@ struct FieldSpec {
     AngleDeg,        // object-space chief-ray angle, degrees (object at infinity or finite)
     ObjectHeightMm,  // object height, mm (finite object only)
     ImageHeightMm,   // paraxial image height, mm
+    // real image height, mm: where the real chief ray meets the image plane. Only ray tracing can turn
+    // it into object-space field points: resolve_real_image_height_field (lensmith/trace/ray_aiming.h)
+    // does, and lens loading calls it; paraxial optics refuses a lens whose field is still of this kind.
+    RealImageHeightMm,
   };
   Kind kind = Kind::AngleDeg;
   std::vector<double> values;  // field points, at least one; units per kind
@@ -42,6 +56,15 @@ struct FieldSpec {
   double max_value() const;    // largest |value|
   friend bool operator==(const FieldSpec&, const FieldSpec&) = default;
   std::string to_string() const;
+};
+
+// How rays are made from pupil coordinates (the file's "ray aiming": Zemax RAIM, CODE V's default).
+enum class RayAiming {
+  ParaxialEntrancePupil,  // aim at (px, py) * EP radius on the paraxial entrance-pupil plane (Zemax "off")
+  // Solve for the real ray that crosses the stop surface at (px, py) * stop radius: backward from the stop point
+  // by damped Newton on its stop-space direction, with continuation in pupil and field, then a forward check
+  // (docs/trace.md, "Real-stop aiming"). Fails cleanly where no physical ray exists.
+  RealStop,
 };
 
 struct Prescription {
@@ -63,6 +86,12 @@ struct Prescription {
   std::optional<FieldSpec> field;       // absent when the source gives none
   std::vector<double> wavelengths_nm{kWavelengthF_nm, kWavelengthD_nm, kWavelengthC_nm};
   std::size_t primary_wavelength_index = 1;  // into wavelengths_nm
+  // The ray aiming the file asks for: real-ray analyses use it unless told otherwise (--aim).
+  RayAiming ray_aiming = RayAiming::ParaxialEntrancePupil;
+  // Object-space telecentric (OpticStudio's FTYP flag): the entrance pupil is at infinity, every chief
+  // ray leaves the object parallel to the axis whatever the stop's position. Needs a finite object, an
+  // object-space NA or cone-angle aperture and an object- or image-height field.
+  bool object_space_telecentric = false;
 
   double primary_wavelength_nm() const { return wavelengths_nm.at(primary_wavelength_index); }
   // 0-based index of the surface flagged as stop, or empty when none is flagged.

@@ -6,6 +6,7 @@
 // (conventions.h). Formulas in docs/seidel.md.
 #pragma once
 
+#include <array>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -23,8 +24,8 @@ struct SeidelSums {
   double S3 = 0.0;  // astigmatism
   double S4 = 0.0;  // Petzval curvature
   double S5 = 0.0;  // distortion
-  double C1 = 0.0;  // axial (longitudinal) colour, n_F - n_C
-  double C2 = 0.0;  // lateral (transverse) colour
+  double C1 = 0.0;  // axial (longitudinal) colour, from dn = n(short) - n(long) (SeidelAnalysis::colour_wavelengths_nm)
+  double C2 = 0.0;  // lateral (transverse) colour, the same dn
 
   SeidelSums& operator+=(const SeidelSums& o);
   friend SeidelSums operator+(SeidelSums a, const SeidelSums& b) { return a += b; }
@@ -80,6 +81,10 @@ struct SeidelOptions {
   std::optional<double> f_number;              // override the aperture (image-space F/#)
   std::optional<double> field_angle_deg;       // override the maximum field (object-space angle)
   std::optional<double> object_height_mm;      // override the maximum field (finite object)
+  // The short and long wavelengths (nm) whose index difference dn the colour sums C_I and C_II use.
+  // Empty: the lens's own shortest and longest wavelengths, as CODE V computes its first-order colour
+  // (F and C, hence n_F - n_C, for a lens at F, d, C or with fewer than two wavelengths).
+  std::optional<std::array<double, 2>> colour_wavelengths_nm;
   void validate() const;                       // throws OptionsError naming the field
 };
 
@@ -99,6 +104,8 @@ class SeidelAnalysis {
   double lagrange_invariant() const { return lagrange_; }
   double image_slope() const { return image_slope_; }   // u' of the marginal ray in image space
   double image_index() const { return image_index_; }   // n' in image space
+  // The short and long wavelengths (nm) of the colour sums' dn.
+  const std::array<double, 2>& colour_wavelengths_nm() const { return colour_wavelengths_nm_; }
 
   WavefrontCoefficients wavefront() const;
   TransverseAberrations transverse() const;
@@ -119,6 +126,7 @@ class SeidelAnalysis {
   FieldCurvatures curvatures_;  // from the sums, or (on the axis, H = 0) from a nominal field
   double image_slope_ = 0.0;
   double image_index_ = 1.0;
+  std::array<double, 2> colour_wavelengths_nm_{kWavelengthF_nm, kWavelengthC_nm};
 };
 
 }  // namespace lensmith

@@ -45,13 +45,7 @@ struct PupilCoordinate {
   double py = 0.0;  // normalised, y (the tangential direction for a y field)
 };
 
-enum class RayAiming {
-  ParaxialEntrancePupil,  // aim at (px, py) * EP radius on the paraxial entrance-pupil plane
-  // Solve for the real ray that crosses the stop surface at (px, py) * stop radius: backward from the stop point
-  // by damped Newton on its stop-space direction, with continuation in pupil and field, then a forward check
-  // (docs/trace.md, "Real-stop aiming"). Fails cleanly where no physical ray exists.
-  RealStop,
-};
+// RayAiming (paraxial entrance pupil or real stop) is in lensmith/prescription/prescription.h: a lens file sets it.
 
 struct AimOptions {
   RayAiming aiming = RayAiming::ParaxialEntrancePupil;
@@ -103,5 +97,14 @@ class RayAimer {
   struct StopSolver;
   std::shared_ptr<const StopSolver> stop_solver_;
 };
+
+// A lens whose field is given as real image heights (FieldSpec::Kind::RealImageHeightMm, OpticStudio's
+// field type 3) with each field point turned into the object-space angle (object at infinity) or
+// object height (finite object) whose real chief ray, aimed as the lens asks (Prescription::ray_aiming),
+// meets the image plane as prescribed at that height for the primary wavelength; other lenses come back
+// unchanged. Heights are radial: the result's values are >= 0. The solve is a secant iteration from the
+// paraxial estimate to 1e-9 mm (relative for heights above 1 mm). Throws ComputationError naming the
+// height when no chief ray reaches it (beyond the lens's image circle).
+Prescription resolve_real_image_height_field(const Prescription& lens);
 
 }  // namespace lensmith
