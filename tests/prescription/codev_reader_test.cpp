@@ -531,10 +531,10 @@ TEST_CASE("CODE V: an unknown keyword is a warning naming it once, and the file 
   CHECK_THAT(r.diagnostics[0].message, Contains("2 commands"));
 }
 
-TEST_CASE("CODE V: non-zero vignetting factors are noted as ignored", "[prescription][codev]") {
-  const LensReadResult r = read_codev(mini_seq("VUY 0 0.2\nVLY 0 0.25\n"), "t.seq");
+TEST_CASE("CODE V: a rotated vignetted pupil (VRO) is noted as ignored", "[prescription][codev]") {
+  const LensReadResult r = read_codev(mini_seq("VRO 0 10\n"), "t.seq");
   REQUIRE(r.diagnostics.size() == 1);
-  CHECK_THAT(r.diagnostics[0].message, Contains("vignetting"));
+  CHECK_THAT(r.diagnostics[0].message, Contains("VRO"));
 }
 
 TEST_CASE("CODE V: TEM other than 20 C is a warning", "[prescription][codev]") {
@@ -601,4 +601,17 @@ TEST_CASE("CODE V: a sequence without SI keeps CODE V's default image plane at t
   bool noted = false;
   for (const Diagnostic& d : r.diagnostics) noted = noted || d.message.find("no SI line") != std::string::npos;
   CHECK(noted);
+}
+
+TEST_CASE("CODE V: VUY/VLY/VUX/VLX become OpticStudio-style vignetting factors per field", "[prescription][codev]") {
+  // The pupil spans [-(1 - VLY), 1 - VUY]: centre (VLY - VUY) / 2, compression (VUY + VLY) / 2.
+  const std::string text = replaced(mini_seq(), "YAN 0 5\n", "YAN 0 5\nVUY 0 0.2\nVLY 0 0.3\nVUX 0 0.1\nVLX 0 0.1\n");
+  const Prescription p = read_codev(text, "t.seq").prescription;
+  REQUIRE(p.field->vignetting.size() == 2);
+  CHECK(p.field->vignetting[0].is_none());
+  const VignettingFactors& v = p.field->vignetting[1];
+  CHECK_THAT(v.vdy, WithinRel(0.05, 1e-12));
+  CHECK_THAT(v.vcy, WithinRel(0.25, 1e-12));
+  CHECK(v.vdx == 0.0);
+  CHECK_THAT(v.vcx, WithinRel(0.1, 1e-12));
 }

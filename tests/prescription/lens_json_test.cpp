@@ -203,6 +203,7 @@ TEST_CASE("lens JSON: apertures, non-clipping semi-diameters, ray aiming and the
   p.ray_aiming = RayAiming::RealStop;
   p.object_distance_mm = 800.0;
   p.field = FieldSpec{FieldSpec::Kind::RealImageHeightMm, {0, 10, 21}};
+  p.field->vignetting = {VignettingFactors{}, VignettingFactors{0.0, 0.05, 0.0, 0.1, 0.0}, VignettingFactors{0.01, 0.1, 0.02, 0.3, 4.0}};
   for (const ApertureSpec& a : {ApertureSpec{ApertureSpec::Kind::ParaxialWorkingFNumber, 5.6}, ApertureSpec{ApertureSpec::Kind::ObjectSpaceNA, 0.02},
                                 ApertureSpec{ApertureSpec::Kind::ObjectConeAngleDeg, 1.5}}) {
     p.aperture = a;

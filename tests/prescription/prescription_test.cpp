@@ -79,3 +79,4 @@ TEST_CASE("Geometry a glassmaker cannot build is warned about, naming the surfac
   CHECK(negative.front().message.find("negative centre thickness") != std::string::npos);
   CHECK(sasian().geometry_warnings().empty());
 }
+

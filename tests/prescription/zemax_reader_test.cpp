@@ -709,3 +709,17 @@ TEST_CASE("Zemax: a moulding vendor's \"_MOLD\" glass reads as its base glass wi
   CHECK(r.prescription.surfaces[1].material == MaterialSpec::catalog("L-TIM28", "OHARA"));
   CHECK(has_diagnostic(r.diagnostics, Diagnostic::Severity::Warning, line_of(text, "L-TIM28_MOLD"), "moulded"));
 }
+
+TEST_CASE("Zemax: vignetting factors VDXN..VANN become the field's, one set per field in use", "[prescription][zemax]") {
+  const std::string text = mini_zmx("VDXN 0 0.01 0 0\nVDYN 0 6.2E-2 0 0\nVCXN 0 2.4E-3 0 0\nVCYN 0 1.5E-1 0 0\nVANN 0 0 0 0\n");
+  const LensReadResult r = read_zemax(text, "t.zmx");
+  REQUIRE(r.prescription.field);
+  REQUIRE(r.prescription.field->vignetting.size() == 2);
+  CHECK(r.prescription.field->vignetting[0].is_none());
+  CHECK(r.prescription.field->vignetting[1] == VignettingFactors{0.01, 0.062, 0.0024, 0.15, 0.0});
+  CHECK(has_diagnostic(r.diagnostics, Diagnostic::Severity::Note, line_of(text, "VANN"), "vignetting factors"));
+  // All zero (what OpticStudio writes for an unvignetted lens): none.
+  CHECK(read_zemax(mini_zmx("VDYN 0 0 0 0\n"), "t.zmx").prescription.field->vignetting.empty());
+  const std::string closed = mini_zmx("VCYN 0 1 0 0\n");
+  CHECK_THAT(zemax_error(closed).what(), Contains("closes the pupil"));
+}

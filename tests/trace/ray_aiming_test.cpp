@@ -55,10 +55,8 @@ constexpr int kMeridionalSamples = 20000;
 constexpr int kSkewCells = 200;
 
 // The paraxial marginal-ray height at the stop: what pupil coordinate 1 means.
-double stop_radius_of(const RayAimer& aimer) {
-  const int stop = aimer.paraxial().stop_surface();
-  return std::abs(aimer.paraxial().marginal_ray().rows[static_cast<std::size_t>(stop) - 1].y_mm);
-}
+// The stop radius pupil coordinate 1 means; how it is chosen is checked against OpticStudio's below.
+double stop_radius_of(const RayAimer& aimer) { return aimer.stop_radius_mm(); }
 
 // True when no refracting crossing of `path` lies behind the previous one: a real ray never runs backward through
 // glass or air between two surfaces. Planes with the same index on both sides (a stop, a dummy) are skipped:
@@ -257,8 +255,9 @@ TEST_CASE("real-stop aiming puts the real ray on the stop at (px, py) x stop rad
     unclipped.clip_apertures = false;  // to see where the aimed ray crosses the stop even if a rim cuts it later
     const SequentialTracer tracer(lens, unclipped);
     const RayAimer aimer(tracer, real_stop());
-    // Pupil coordinate 1 is the beam edge the aperture specification defines: the paraxial marginal
-    // height at the stop (Smith's triplet: 10.298 mm inside its 10.3 mm stop rim).
+    // Pupil coordinate 1 is the beam edge the aperture specification defines: for an EPD, where the real
+    // axial ray through the paraxial pupil's edge crosses the stop (Smith's triplet: 10.477 mm, beyond its
+    // 10.3-mm stop rim, which these unclipped traces ignore).
     const std::vector<double> fields = lens.field ? std::vector<double>{0.0, 0.5, 1.0} : std::vector<double>{0.0};
     std::vector<SurfaceHit> path;
     for (double relative : fields) {
@@ -815,4 +814,44 @@ TEST_CASE("object-space telecentric: the aimed chief ray leaves the object paral
   REQUIRE(marginal.ok());
   // n sin(theta) = NA in air for the ray to the pupil's edge.
   CHECK_THAT(marginal.ray.direction.y(), WithinRel(0.05, 1e-9));
+}
+
+TEST_CASE("vignetting factors: pupil coordinates sample the field's vignetted pupil, interpolated between field points",
+          "[trace][aiming][vignetting]") {
+  // OpticStudio's definition (Px' = VDX + Px (1 - VCX), Py' = VDY + Py (1 - VCY)) checked against the
+  // same lens without factors aimed at the transformed coordinate: an independent route to the same ray.
+  Prescription lens = smith_cooke_triplet();
+  lens.field = FieldSpec{FieldSpec::Kind::AngleDeg, {0.0, 10.0, 20.0}};
+  lens.field->vignetting = {VignettingFactors{}, VignettingFactors{0.0, 0.05, 0.0, 0.1, 0.0},
+                            VignettingFactors{0.01, 0.1, 0.02, 0.3, 0.0}};
+  Prescription plain = lens;
+  plain.field->vignetting.clear();
+  const SequentialTracer tracer(lens), plain_tracer(plain);
+  const RayAimer aimer(tracer), plain_aimer(plain_tracer);
+  const double nm = lens.primary_wavelength_nm();
+  struct Case {
+    double angle_deg, px, py, expect_px, expect_py;
+  };
+  for (const Case& c : {Case{20.0, 0.0, 1.0, 0.01, 0.1 + 0.7}, Case{20.0, 0.5, -1.0, 0.01 + 0.5 * 0.98, 0.1 - 0.7},
+                        Case{15.0, 0.0, 1.0, 0.005, 0.075 + 0.8}, Case{0.0, 0.3, 0.4, 0.3, 0.4}}) {
+    INFO(c.angle_deg << " deg, pupil " << c.px << ", " << c.py);
+    const FieldPoint field = FieldPoint::angle_deg(c.angle_deg);
+    const PupilCoordinate v = aimer.vignetted_pupil(field, {c.px, c.py});
+    CHECK_THAT(v.px, WithinAbs(c.expect_px, 1e-12));
+    CHECK_THAT(v.py, WithinAbs(c.expect_py, 1e-12));
+    const AimedRay a = aimer.make_ray(field, {c.px, c.py}, nm);
+    const AimedRay b = plain_aimer.make_ray(field, {c.expect_px, c.expect_py}, nm);
+    REQUIRE(a.ok());
+    REQUIRE(b.ok());
+    CHECK((a.ray.position_mm - b.ray.position_mm).norm() < 1e-9);
+    CHECK((a.ray.direction - b.ray.direction).norm() < 1e-12);
+  }
+  // A field below the axis mirrors the decentre.
+  const PupilCoordinate below = aimer.vignetted_pupil(FieldPoint::angle_deg(-20.0), {0.0, 1.0});
+  CHECK_THAT(below.py, WithinAbs(-0.1 + 0.7, 1e-12));
+  // Switched off, the whole pupil.
+  AimOptions off;
+  off.use_vignetting_factors = false;
+  const PupilCoordinate whole = RayAimer(tracer, off).vignetted_pupil(FieldPoint::angle_deg(20.0), {0.0, 1.0});
+  CHECK(whole.py == 1.0);
 }

@@ -555,13 +555,19 @@ class CodeVParser {
       if (r.keyword == k) fail_keyword(c, std::string(r.why));
     }
     if (contains(kVignettingKeywords, k)) {
-      for (std::size_t i = 0; i < c.args.size(); ++i) {
-        auto v = parse_finite_number(c.args[i].text);
-        if (v && *v != 0.0 && !vignetting_noted_) {
-          vignetting_noted_ = true;
-          note(c.keyword.line, "vignetting factors (" + k + ") ignored: lensmith vignettes rays at the surfaces' apertures");
+      // VUY/VLY/VUX/VLX: the fraction of the pupil cut from its upper, lower, +x and -x edges, per field.
+      std::vector<Located> values = numbers_from(c, 0, "a vignetting factor", kMaxFields);
+      if (k == "VRO") {
+        for (const Located& v : values) {
+          if (v.value != 0.0 && !vignetting_noted_) {
+            vignetting_noted_ = true;
+            note(c.keyword.line, "VRO (rotated vignetting) ignored: the vignetted pupils are not turned");
+          }
         }
+        return;
       }
+      vignetting_[k] = std::move(values);
+      vignetting_line_ = c.keyword.line;
       return;
     }
     if (contains(kIgnoredKeywords, k)) return;
@@ -1191,6 +1197,28 @@ class CodeVParser {
       field.values.push_back(kind == FieldSpec::Kind::AngleDeg ? radial : mm(radial));
     }
     if (folded) note(later.line, "fields with an x component were folded into radial fields (the lens is rotationally symmetric)");
+    // CODE V's vignetting factors as OpticStudio's: the pupil spans [-(1 - VLY), 1 - VUY] in y, so its
+    // centre is (VLY - VUY) / 2 and its half height 1 - (VUY + VLY) / 2; the same in x.
+    auto factor = [&](const char* key, std::size_t i) {
+      auto it = vignetting_.find(key);
+      return it != vignetting_.end() && i < it->second.size() ? it->second[i].value : 0.0;
+    };
+    std::vector<VignettingFactors> vignetting(count);
+    bool any = false;
+    for (std::size_t i = 0; i < count; ++i) {
+      const double uy = factor("VUY", i), ly = factor("VLY", i), ux = factor("VUX", i), lx = factor("VLX", i);
+      vignetting[i] = {(lx - ux) / 2.0, (ly - uy) / 2.0, (ux + lx) / 2.0, (uy + ly) / 2.0, 0.0};
+      if (vignetting[i].is_none()) continue;
+      any = true;
+      if (!(vignetting[i].vcx < 1.0 && vignetting[i].vcy < 1.0)) {
+        fail(vignetting_line_, 0, "vignetting of field " + std::to_string(i + 1) + " closes the pupil (VUY + VLY or VUX + VLX >= 2)");
+      }
+      if (i < x_field_.values.size() && x_field_.values[i].value != 0.0) {
+        vignetting[i] = {};  // defined in that field's own frame, not along +y
+        warn(vignetting_line_, "vignetting of field " + std::to_string(i + 1) + ", which has an x component, is not used");
+      }
+    }
+    if (any) field.vignetting = std::move(vignetting);
     p.field = std::move(field);
   }
 
@@ -1255,6 +1283,8 @@ class CodeVParser {
   int wavelength_line_ = 0;
   std::optional<Located> reference_;
   bool vignetting_noted_ = false;
+  std::map<std::string, std::vector<Located>> vignetting_;  // VUY, VLY, VUX, VLX as given, per field
+  int vignetting_line_ = 0;
 
   bool in_private_ = false;
   std::vector<Located> private_wavelengths_;

@@ -145,7 +145,27 @@ std::optional<FieldSpec> read_field(const LocatedJson& doc, JsonObjectReader& to
     f = {FieldSpec::Kind::RealImageHeightMm, read_number_list(r, "real_image_height_mm")};
     ++given;
   }
-  r.finish({"angle_deg", "object_height_mm", "image_height_mm", "real_image_height_mm"});
+  if (r.has("vignetting")) {
+    const std::size_t count = r.get_array_size("vignetting");
+    if (count != f.values.size()) {
+      r.fail("vignetting", "gives " + std::to_string(count) + " sets of factors for " + std::to_string(f.values.size()) +
+                               " field points; give one per point");
+    }
+    for (std::size_t i = 0; i < count; ++i) {
+      JsonObjectReader v(doc, r.child_pointer("vignetting") + "/" + std::to_string(i), r.child_path("vignetting") + "[" + std::to_string(i) + "]");
+      VignettingFactors factors;
+      factors.vdx = v.get_optional_number("vdx").value_or(0.0);
+      factors.vdy = v.get_optional_number("vdy").value_or(0.0);
+      factors.vcx = v.get_optional_number("vcx").value_or(0.0);
+      factors.vcy = v.get_optional_number("vcy").value_or(0.0);
+      factors.van_deg = v.get_optional_number("van_deg").value_or(0.0);
+      if (!(factors.vcx < 1.0)) v.fail("vcx", "must be below 1 (1 closes the pupil)");
+      if (!(factors.vcy < 1.0)) v.fail("vcy", "must be below 1 (1 closes the pupil)");
+      v.finish({"vdx", "vdy", "vcx", "vcy", "van_deg"});
+      f.vignetting.push_back(factors);
+    }
+  }
+  r.finish({"angle_deg", "object_height_mm", "image_height_mm", "real_image_height_mm", "vignetting"});
   if (given != 1) r.fail("", "give exactly one of angle_deg, object_height_mm, image_height_mm, real_image_height_mm");
   return f;
 }
@@ -385,6 +405,18 @@ std::string write_lens_json(const Prescription& p) {
                       : p.field->kind == FieldSpec::Kind::ImageHeightMm  ? "image_height_mm"
                                                                          : "real_image_height_mm";
     o["field"] = ojson{{key, write_numbers(p.field->values)}};
+    if (!p.field->vignetting.empty()) {
+      ojson list = ojson::array();
+      for (const VignettingFactors& v : p.field->vignetting) {
+        ojson one = ojson::object();
+        for (const auto& [name, value] : {std::pair{"vdx", v.vdx}, std::pair{"vdy", v.vdy}, std::pair{"vcx", v.vcx},
+                                          std::pair{"vcy", v.vcy}, std::pair{"van_deg", v.van_deg}}) {
+          if (value != 0.0) one[name] = value;
+        }
+        list.push_back(one);
+      }
+      o["field"]["vignetting"] = list;
+    }
   }
   o["wavelengths_nm"] = write_numbers(p.wavelengths_nm);
   o["primary_wavelength_nm"] = p.primary_wavelength_nm();

@@ -1,5 +1,6 @@
 #include "lensmith/prescription/prescription.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -48,6 +49,27 @@ double FieldSpec::max_value() const {
   double m = 0.0;
   for (double v : values) m = std::max(m, std::abs(v));
   return m;
+}
+
+VignettingFactors FieldSpec::vignetting_at(double value) const {
+  if (vignetting.empty() || vignetting.size() != values.size()) return {};
+  // Field points sorted by |value|; interpolate between the two that bracket |value|.
+  std::vector<std::size_t> order(values.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return std::abs(values[a]) < std::abs(values[b]); });
+  const double v = std::abs(value);
+  if (v <= std::abs(values[order.front()])) return vignetting[order.front()];
+  for (std::size_t k = 1; k < order.size(); ++k) {
+    const double lo = std::abs(values[order[k - 1]]), hi = std::abs(values[order[k]]);
+    if (v <= hi) {
+      const double t = hi > lo ? (v - lo) / (hi - lo) : 1.0;
+      const VignettingFactors& a = vignetting[order[k - 1]];
+      const VignettingFactors& b = vignetting[order[k]];
+      auto mix = [t](double p, double q) { return p + t * (q - p); };
+      return {mix(a.vdx, b.vdx), mix(a.vdy, b.vdy), mix(a.vcx, b.vcx), mix(a.vcy, b.vcy), mix(a.van_deg, b.van_deg)};
+    }
+  }
+  return vignetting[order.back()];
 }
 
 std::string FieldSpec::to_string() const {
@@ -241,6 +263,20 @@ void Prescription::validate() const {
       if (!std::isfinite(v)) reject_system("field.values[" + std::to_string(i) + "]", v, "must be finite");
       if (field->kind == FieldSpec::Kind::AngleDeg && std::abs(v) >= 90.0) {
         reject_system("field.max_angle_deg", v, "must lie in (-90, 90) degrees");
+      }
+    }
+    if (!field->vignetting.empty() && field->vignetting.size() != field->values.size()) {
+      throw PrescriptionError("field.vignetting: " + std::to_string(field->vignetting.size()) + " sets of vignetting factors for " +
+                              std::to_string(field->values.size()) + " field points; give one per point");
+    }
+    for (std::size_t i = 0; i < field->vignetting.size(); ++i) {
+      const VignettingFactors& v = field->vignetting[i];
+      const std::string at = "field.vignetting[" + std::to_string(i) + "].";
+      for (const auto& [key, value] : {std::pair{"vdx", v.vdx}, std::pair{"vdy", v.vdy}, std::pair{"van_deg", v.van_deg}}) {
+        if (!std::isfinite(value)) reject_system(at + key, value, "must be finite");
+      }
+      for (const auto& [key, value] : {std::pair{"vcx", v.vcx}, std::pair{"vcy", v.vcy}}) {
+        if (!(value < 1.0) || !std::isfinite(value)) reject_system(at + key, value, "must be finite and below 1 (1 closes the pupil)");
       }
     }
     if (field->kind == FieldSpec::Kind::ObjectHeightMm && std::isinf(object_distance_mm)) {

@@ -45,7 +45,7 @@ constexpr auto kIgnoredKeywords = std::to_array<std::string_view>({
     "GSTD", "HIDE", "HYPR", "ISNA", "LANG", "MAZH", "MEMA", "MIRR", "MNCA", "MNCG", "MNEA", "MNEG", "MOFF",
     "MXCA", "MXCG", "NSCD", "OEMA", "OMMA", "OPDX", "PFIL", "PICB", "PKUP", "PMAG", "POLS", "POPS", "PPAR",
     "PUPD", "PUSH", "PZUP", "RGLA", "ROPD", "SDMA", "SLAB", "TCED", "TCMM", "TOL", "TOLE", "TOTR",
-    "TRAC", "VANN", "VCON", "VCXN", "VCYN", "VDSZ", "VDXN", "VDYN", "VERS", "VPAR", "WAVN", "WWGN", "WWGT",
+    "TRAC", "VCON", "VDSZ", "VERS", "VPAR", "WAVN", "WWGN", "WWGT",
     "ZVAN", "ZVCX", "ZVCY", "ZVDX", "ZVDY",
 });
 // Surface apertures lensmith cannot represent (spiders, user-defined aperture files): always an error.
@@ -144,6 +144,12 @@ struct ParmRecord {
 };
 
 // One SURF block as written, in lens units; converted to millimetres when the prescription is built.
+struct Located {
+  double value = 0.0;
+  int line = 0;
+  int column = 0;
+};
+
 struct ZmxSurface {
   int number = 0;
   int line = 0;
@@ -182,12 +188,6 @@ struct FieldTypeLine {
   long long wavelength_count = 0;
   bool telecentric = false;  // object space
   int line = 0;
-};
-
-struct Located {
-  double value = 0.0;
-  int line = 0;
-  int column = 0;
 };
 
 
@@ -384,6 +384,12 @@ class ZemaxParser {
       field_line_ = l.number;
       return;
     }
+    if (k == "VDXN" || k == "VDYN" || k == "VCXN" || k == "VCYN" || k == "VANN") {
+      // Vignetting factors, one per field slot as XFLN/YFLN list them (older files: VDXF ... are unknown).
+      vignetting_[std::string(k)] = all_numbers(l, "a vignetting factor");
+      vignetting_line_ = l.number;
+      return;
+    }
     if (k == "WAVM") {
       const long long slot = integer(l, 0, "the wavelength number", 1, kMaxWavelengthSlot);
       const double um = number(l, 1, "the wavelength (micrometres)");
@@ -468,6 +474,7 @@ class ZemaxParser {
     const Token& t = required_arg(l, 0, "the surface type");
     if (t.text != "STANDARD" && t.text != "EVENASPH") {
       std::string why = "only STANDARD and EVENASPH surfaces are read";
+      if (t.text == "QED_TYPE") why = "Forbes Q-type aspheres are not supported yet; " + why;
       if (t.text == "COORDBRK") why = "coordinate breaks (tilts and decentres) are not supported; " + why;
       fail_at(l, t,
               "surface type " + shown_text(t.text) + " on SURF " + std::to_string(s.number) + " is not supported: " + why);
@@ -907,6 +914,33 @@ class ZemaxParser {
       note(field_line_,
            "fields with an x component were folded into radial fields (the lens is rotationally symmetric)");
     }
+    // Vignetting factors of the fields in use, when any is not zero.
+    auto factor = [&](const char* key, std::size_t i) {
+      auto it = vignetting_.find(key);
+      return it != vignetting_.end() && i < it->second.size() ? it->second[i].value : 0.0;
+    };
+    std::vector<VignettingFactors> vignetting(count);
+    bool any = false;
+    bool on_folded = false;
+    for (std::size_t i = 0; i < count; ++i) {
+      vignetting[i] = {factor("VDXN", i), factor("VDYN", i), factor("VCXN", i), factor("VCYN", i), factor("VANN", i)};
+      if (vignetting[i].is_none()) continue;
+      any = true;
+      if (i < x_fields_.size() && x_fields_[i].value != 0.0) {
+        on_folded = true;  // OpticStudio's factors are in that field's own x-y frame, not along +y
+        vignetting[i] = {};
+      }
+      if (!(vignetting[i].vcx < 1.0 && vignetting[i].vcy < 1.0)) {
+        fail(vignetting_line_, 0, "vignetting factors of field " + std::to_string(i + 1) + ": a compression VCX or VCY of 1 or more closes the pupil");
+      }
+    }
+    if (on_folded) {
+      warn(vignetting_line_, "vignetting factors of fields with an x component are not used (their pupils are sampled whole)");
+    }
+    if (any) {
+      field.vignetting = std::move(vignetting);
+      note(vignetting_line_, "vignetting factors read: real-ray analyses sample each field's vignetted pupil, as OpticStudio does");
+    }
     p.field = std::move(field);
   }
 
@@ -972,6 +1006,8 @@ class ZemaxParser {
   std::vector<Located> x_fields_;
   std::vector<Located> y_fields_;
   int field_line_ = 0;  // the last XFLN/YFLN line
+  std::map<std::string, std::vector<Located>> vignetting_;  // VDXN, VDYN, VCXN, VCYN, VANN
+  int vignetting_line_ = 0;
   RayAiming ray_aiming_ = RayAiming::ParaxialEntrancePupil;
   std::map<int, Located> wavm_;
   std::vector<Located> wavl_;

@@ -16,6 +16,7 @@
 
 #include "lensmith/core/errors.h"
 #include "lensmith/core/units.h"
+#include "lensmith/prescription/lens_file.h"
 
 namespace lensmith {
 
@@ -707,9 +708,9 @@ RayAimer::RayAimer(const SequentialTracer& tracer, const AimOptions& options)
   options_.validate();
   const Prescription& lens = tracer_.lens();
   const int stop = paraxial_.stop_surface();
-  // Pupil coordinate 1 is the edge of the beam the aperture specification defines (as in Zemax):
-  // the paraxial marginal height at the stop. With an aperture that floats by the stop this is the
-  // stop's semi-diameter; with an EPD or F/# it may be smaller than the stop's clear aperture.
+  // Pupil coordinate 1 is the edge of the beam the aperture specification defines (as in Zemax): the
+  // paraxial marginal height at the stop, which is the stop's semi-diameter when the aperture floats by
+  // it; under RealStop aiming with an EPD, F/# or NA, the real axial ray's height (below).
   stop_radius_mm_ = std::abs(paraxial_.marginal_ray().rows[static_cast<std::size_t>(stop) - 1].y_mm);
 
   // The front-most point of surface 1 over its clear aperture (or twice the EP radius without one).
@@ -727,6 +728,22 @@ RayAimer::RayAimer(const SequentialTracer& tracer, const AimOptions& options)
   if (options_.aiming == RayAiming::RealStop) {
     const BeamGeometry geometry{paraxial_.entrance_pupil().z_mm, paraxial_.object_distance_mm(), front_z_mm_,
                                 beam_radius_mm_};
+    if (lens.aperture.kind != ApertureSpec::Kind::FloatByStop) {
+      // An EPD, F/# or NA sets the beam in object space, and OpticStudio's real ray aiming fills the stop to
+      // where the real axial ray through the edge of the paraxial entrance pupil crosses it (its automatic
+      // stop semi-diameter is that height: 4.215000 mm against the paraxial 4.250827 in the US 583,336
+      // double Gauss of tests/data/zemax/real). The paraxial height stays where no such ray gets there.
+      const bool at_infinity = std::isinf(paraxial_.object_distance_mm());
+      const Beam beam = beam_of(at_infinity ? FieldPoint::angle_deg(0.0) : FieldPoint::object_height_mm(0.0), 1.0, geometry);
+      Ray axial;
+      std::vector<SurfaceHit> path;
+      if (ray_through(beam, 0.0, ep_radius_mm, geometry.z_ep_mm, lens.primary_wavelength_nm(), axial)) {
+        tracer_.trace_forward(axial, &path);
+        for (const SurfaceHit& hit : path) {
+          if (hit.surface == stop && std::isfinite(hit.point_mm.y())) stop_radius_mm_ = std::hypot(hit.point_mm.x(), hit.point_mm.y());
+        }
+      }
+    }
     stop_solver_ =
         std::make_shared<const StopSolver>(tracer_, paraxial_, stop_radius_mm_, ep_radius_mm, geometry, options_);
   }
@@ -757,7 +774,53 @@ FieldPoint RayAimer::field_at(double relative) const {
   return FieldPoint::angle_deg(0.0);
 }
 
-AimedRay RayAimer::make_ray(const FieldPoint& field, const PupilCoordinate& pupil, double wavelength_nm) const {
+PupilCoordinate RayAimer::vignetted_pupil(const FieldPoint& field, const PupilCoordinate& pupil) const {
+  const std::optional<FieldSpec>& spec = tracer_.lens().field;
+  if (!options_.use_vignetting_factors || !spec || spec->vignetting.empty()) return pupil;
+  // The field point's value in the units of the lens's field, to interpolate its factors.
+  double value = std::numeric_limits<double>::quiet_NaN();
+  const double radial_angle_deg = radial_field_value(FieldSpec::Kind::AngleDeg, field.x, field.y);
+  // The field's azimuth (from +y toward +x) in the frame the file's factors hold in: that of the
+  // object point or angle, except for image-height fields, whose points field_at() puts at the object
+  // point below the axis that images above it.
+  double phi = (field.x == 0.0 && field.y >= 0.0) ? 0.0 : std::atan2(field.x, field.y);
+  switch (spec->kind) {
+    case FieldSpec::Kind::AngleDeg:
+      if (field.kind == FieldPoint::Kind::AngleDeg) value = radial_angle_deg;
+      break;
+    case FieldSpec::Kind::ObjectHeightMm:
+      if (field.kind == FieldPoint::Kind::ObjectHeightMm) value = std::hypot(field.x, field.y);
+      break;
+    case FieldSpec::Kind::ImageHeightMm: {
+      // Paraxial image heights are linear in the chief ray's object-space slope.
+      const double max_slope = paraxial_.chief_ray() ? std::abs(paraxial_.chief_ray()->object_slope) : 0.0;
+      double slope = std::numeric_limits<double>::quiet_NaN();
+      if (field.kind == FieldPoint::Kind::AngleDeg) slope = std::tan(rad_from_deg(radial_angle_deg));
+      if (field.kind == FieldPoint::Kind::ObjectHeightMm) {
+        slope = std::hypot(field.x, field.y) / std::abs(paraxial_.object_distance_mm() + paraxial_.entrance_pupil().z_mm);
+        phi = (field.x == 0.0 && field.y <= 0.0) ? 0.0 : std::atan2(-field.x, -field.y);
+      }
+      if (max_slope > 0.0) value = slope / max_slope * spec->max_value();
+      break;
+    }
+    case FieldSpec::Kind::RealImageHeightMm: break;  // resolved into angles or heights before any aiming
+  }
+  if (!std::isfinite(value)) return pupil;
+  const VignettingFactors v = spec->vignetting_at(value);
+  if (v.is_none()) return pupil;
+  // The factors hold for a field along +y; a field at azimuth phi turns them with it.
+  const double c = std::cos(phi), s = std::sin(phi);
+  // Into the field's frame, scale and shift there, turn by VAN about the vignetted centre, and back.
+  const double u = c * pupil.px - s * pupil.py, w = s * pupil.px + c * pupil.py;
+  const double a = rad_from_deg(v.van_deg);
+  const double du = u * (1.0 - v.vcx), dw = w * (1.0 - v.vcy);
+  const double fu = v.vdx + std::cos(a) * du - std::sin(a) * dw;
+  const double fw = v.vdy + std::sin(a) * du + std::cos(a) * dw;
+  return {c * fu + s * fw, -s * fu + c * fw};
+}
+
+AimedRay RayAimer::make_ray(const FieldPoint& field, const PupilCoordinate& requested, double wavelength_nm) const {
+  const PupilCoordinate pupil = vignetted_pupil(field, requested);
   AimedRay out;
   out.ray.wavelength_nm = wavelength_nm;
   const bool finite_inputs = std::isfinite(field.x) && std::isfinite(field.y) &&

@@ -39,6 +39,21 @@ struct ApertureSpec {
   std::string to_string() const;
 };
 
+// OpticStudio's vignetting factors of one field point: they shrink and shift the pupil that real-ray
+// analyses sample, so that normalised pupil coordinates (px, py) mean the ray at
+// (vdx + px (1 - vcx), vdy + py (1 - vcy)), turned by van_deg about the pupil centre. CODE V's VUY, VLY,
+// VUX, VLX (the pupil cut from its upper, lower, right and left edges) are vdy = (VLY - VUY) / 2,
+// vcy = (VUY + VLY) / 2 and the same in x. Fields lie along +y here: x is sagittal, y tangential.
+struct VignettingFactors {
+  double vdx = 0.0;
+  double vdy = 0.0;
+  double vcx = 0.0;
+  double vcy = 0.0;
+  double van_deg = 0.0;
+  bool is_none() const { return vdx == 0.0 && vdy == 0.0 && vcx == 0.0 && vcy == 0.0 && van_deg == 0.0; }
+  friend bool operator==(const VignettingFactors&, const VignettingFactors&) = default;
+};
+
 // The field of view: a kind and the field points (the largest |value| is the maximum field).
 struct FieldSpec {
   enum class Kind {
@@ -52,6 +67,11 @@ struct FieldSpec {
   };
   Kind kind = Kind::AngleDeg;
   std::vector<double> values;  // field points, at least one; units per kind
+  // Empty, or one set per field point: the pupil real-ray analyses sample at that field (between field
+  // points the factors are interpolated linearly in |field|, beyond the last one held).
+  std::vector<VignettingFactors> vignetting{};
+  // The factors at a field value (units of the kind): none when the field has none.
+  VignettingFactors vignetting_at(double value) const;
 
   double max_value() const;    // largest |value|
   friend bool operator==(const FieldSpec&, const FieldSpec&) = default;

@@ -56,6 +56,10 @@ struct AimOptions {
   // RealStop: Newton iterations one ray may use over all its solves (direct attempt, continuation steps, forward
   // check); NotConverged when they run out (>= 1).
   int max_iterations = 50;
+  // Sample each field's vignetted pupil when the lens's field carries vignetting factors
+  // (FieldSpec::vignetting, OpticStudio's VDX/VDY/VCX/VCY/VAN): (px, py) then mean the ray at
+  // (vdx + px (1 - vcx), vdy + py (1 - vcy)) in the field's frame. Off: the whole pupil.
+  bool use_vignetting_factors = true;
   void validate() const;  // throws OptionsError
 };
 
@@ -71,9 +75,10 @@ struct AimedRay {
 
 class RayAimer {
  public:
-  // Uses the paraxial system at the primary wavelength for the pupil and the stop. The stop radius
-  // that pupil coordinate 1 means is the paraxial marginal-ray height at the stop: the beam the
-  // aperture specification defines (equal to the stop's semi-diameter when the aperture floats by it).
+  // Uses the paraxial system at the primary wavelength for the pupil and the stop. The stop radius that
+  // pupil coordinate 1 means under RealStop aiming is, as in OpticStudio, the stop's semi-diameter when
+  // the aperture floats by it, and otherwise the height at which the real axial ray through the edge of
+  // the paraxial entrance pupil crosses the stop (the beam the EPD, F/# or NA defines in object space).
   RayAimer(const SequentialTracer& tracer, const AimOptions& options = {});
 
   AimedRay make_ray(const FieldPoint& field, const PupilCoordinate& pupil, double wavelength_nm) const;
@@ -83,6 +88,11 @@ class RayAimer {
 
   const ParaxialSystem& paraxial() const { return paraxial_; }
   const SequentialTracer& tracer() const { return tracer_; }
+  // The stop radius (mm) that pupil coordinate 1 means under RealStop aiming (see the constructor).
+  double stop_radius_mm() const { return stop_radius_mm_; }
+  // The pupil coordinate `make_ray` really aims at for `pupil` at `field`: `pupil` itself unless the lens's
+  // vignetting factors apply (AimOptions::use_vignetting_factors).
+  PupilCoordinate vignetted_pupil(const FieldPoint& field, const PupilCoordinate& pupil) const;
 
  private:
   const SequentialTracer& tracer_;
