@@ -268,7 +268,7 @@ class Lens:
 
     @classmethod
     def load(cls, path_or_name):
-        """A lens file (.json, .zmx, .dat, a lentil 'lenses.json#id') or the id of a shipped lens
+        """A lens file (.json, .zmx, .seq, .dat, a lentil 'lenses.json#id') or the id of a shipped lens
         (``lensmith.lenses()``). Readers' warnings are issued as ``LensWarning``. Raises
         ``LensFileError`` (with ``file``, ``line``, ``column``), ``GlassError``, ``IoError``."""
         handle, warnings = _lensmith.Lens.load(str(path_or_name))
