@@ -297,7 +297,7 @@ TEST_CASE("CODE V: commands that change the optics beyond lensmith's model are r
     const char* line;
     const char* feature;
   };
-  const Case cases[] = {{"ZOO 3\n", "zoom"},         {"NAO 0.1\n", "NA"},          {"YRI 0 5\n", "real image height"},
+  const Case cases[] = {{"ZOO 3\n", "zoom"},         {"NA 0.1\n", "NA"},          {"YRI 0 5\n", "real image height"},
                         {"  RET S1\n", "RET"},       {"  XTO\n", "toroidal"},      {"  DIF DOE\n", "diffractive"},
                         {"  RDX 40\n", "toroidal"},  {"  CUF 0.01\n", "Fresnel"}};
   for (const Case& c : cases) {
@@ -593,7 +593,7 @@ TEST_CASE("CODE V: a .seq path reads through read_lens_file", "[prescription][co
 
 TEST_CASE("CODE V: a sequence without SI keeps CODE V's default image plane at the last thickness, with a note", "[prescription][codev]") {
   // Hand-written sequences insert S lines into CODE V's default lens, which already has an image surface.
-  const std::string text = "dim m\nso 0 1e11\ns 0.1 1 nbk7_schott ! curvature mode is not on: radii\n"
+  const std::string text = "dim m\nso 0 1e11\ns 0.1 1 nbk7_schott ! curvatures: no RDM\n"
                            "s -0.05 &\n2\nepd 2.5; wl 650 550 450\n";
   const LensReadResult r = read_codev(text, "t.seq");
   REQUIRE(r.prescription.surfaces.size() == 2);
@@ -614,4 +614,13 @@ TEST_CASE("CODE V: VUY/VLY/VUX/VLX become OpticStudio-style vignetting factors p
   CHECK_THAT(v.vcy, WithinRel(0.25, 1e-12));
   CHECK(v.vdx == 0.0);
   CHECK_THAT(v.vcx, WithinRel(0.1, 1e-12));
+}
+
+TEST_CASE("CODE V: NAO is an object-space NA aperture; with the object at infinity it is refused on its line", "[prescription][codev]") {
+  const Prescription p = read_codev(replaced(mini_seq("NAO 0.05\n", "", "SO 0 400"), "EPD 10\n", ""), "t.seq").prescription;
+  CHECK(p.aperture == ApertureSpec{ApertureSpec::Kind::ObjectSpaceNA, 0.05});
+  const std::string at_infinity = replaced(mini_seq("NAO 0.05\n"), "EPD 10\n", "");
+  const LensFileError e = codev_error(at_infinity);
+  CHECK(e.where().line == line_of(at_infinity, "NAO"));
+  CHECK_THAT(e.what(), Contains("finite object"));
 }

@@ -452,6 +452,7 @@ double ParaxialSystem::f_number() const { return std::abs(rear_focal_length_mm()
 double ParaxialSystem::working_f_number() const { return 1.0 / (2.0 * image_space_na()); }
 
 double ParaxialSystem::image_space_na() const { return n_image_ * std::abs(marginal_.rows.back().u_after); }
+double ParaxialSystem::image_space_na_of_angle() const { return n_image_ * std::sin(std::atan(std::abs(marginal_.rows.back().u_after))); }
 
 std::optional<double> ParaxialSystem::lagrange_invariant() const {
   if (!chief_) return std::nullopt;
@@ -543,7 +544,7 @@ std::string ParaxialSystem::to_string() const {
        "magnification " + number(exit_pupil_.magnification, 5) + " of the stop");
   if (!telecentric_) line("F-number", number(f_number(), 4), n_image_ == 1.0 ? "EFL/EPD" : "f'/EPD (image space)");
   line("Working F-number", number(working_f_number(), 4), "1/(2 n'|u'|), this object distance");
-  line("Image-space NA", number(image_space_na(), 6), "n'|u'|");
+  line("Image-space NA", number(image_space_na(), 6), "n'|u'|; n' sin(atan|u'|) = " + number(image_space_na_of_angle(), 6) + " as OpticStudio prints it");
   line("Image distance", number(image_distance_mm_, 4) + " mm", "last surface to paraxial image");
   line("Image plane distance", number(image_plane_distance_mm_, 4) + " mm", "last surface to image plane");
   line("Magnification", number(magnification_, 6), std::isinf(object_distance_mm_) ? "object at infinity" : "");

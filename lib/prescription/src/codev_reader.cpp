@@ -51,7 +51,7 @@ constexpr auto kIgnoredKeywords = std::to_array<std::string_view>({
     "AC", "BC", "CA", "CC", "CCX", "CCY", "CLS", "CUM", "CWL", "DC", "DER", "EC", "FC", "GC", "GLC", "HC",
     "INI", "JC", "KC", "PIK", "PIM", "POL", "PUI", "PUX", "PUY", "THC", "THM", "WID", "WTF", "WTW",
 });
-// Vignetting factors: CODE V shrinks its off-axis ray bundles by them; lensmith vignettes at the apertures.
+// Vignetting factors: CODE V shrinks its off-axis pupils by them; they become FieldSpec::vignetting (VRO: noted).
 constexpr auto kVignettingKeywords = std::to_array<std::string_view>({"VLX", "VLY", "VRO", "VUX", "VUY"});
 // Decentres and tilts: an error unless zero.
 constexpr auto kDecentreKeywords = std::to_array<std::string_view>({"ADE", "BDE", "CDE", "XDE", "YDE", "ZDE"});
@@ -76,7 +76,6 @@ constexpr auto kRefusedKeywords = std::to_array<Refusal>({
     {"HWL", "diffractive (holographic) surfaces are not supported"},
     {"INS", "editing commands that insert surfaces are not read; save the lens from CODE V and read that file"},
     {"NA", "image-space NA apertures are not supported (use EPD or FNO)"},
-    {"NAO", "object-space NA apertures are not supported (use EPD or FNO)"},
     {"RDX", "x radii (toroidal and cylindrical surfaces) are not supported"},
     {"RET", "returning to another surface's coordinate system (RET) is not supported (rotationally symmetric systems only)"},
     {"SPS", "special surface types are not supported (only SPH, CON and ASP surfaces are read)"},
@@ -437,11 +436,14 @@ class CodeVParser {
       return;
     }
     if (k == "DIM") return handle_dim(c);
-    if (k == "EPD" || k == "FNO") {
-      const Located v = located_number(c, 0, k == "EPD" ? "the entrance-pupil diameter" : "the F-number");
+    if (k == "EPD" || k == "FNO" || k == "NAO") {
+      // NAO: the object-space NA, n sin of the axial marginal ray's angle (finite objects; validation says so).
+      const Located v = located_number(c, 0, k == "EPD" ? "the entrance-pupil diameter" : k == "FNO" ? "the F-number" : "the object-space NA");
       no_more_args(c, 1);
       if (!(v.value > 0.0)) fail_at(c, c.args[0], format_number(v.value) + ": must be > 0");
-      aperture_kind_ = k == "EPD" ? ApertureSpec::Kind::EntrancePupilDiameter : ApertureSpec::Kind::ImageSpaceFNumber;
+      aperture_kind_ = k == "EPD"   ? ApertureSpec::Kind::EntrancePupilDiameter
+                       : k == "FNO" ? ApertureSpec::Kind::ImageSpaceFNumber
+                                    : ApertureSpec::Kind::ObjectSpaceNA;
       aperture_ = v;
       return;
     }

@@ -100,6 +100,7 @@ ojson info_json(const Prescription& lens, const ParaxialSystem& p) {
   o["f_number"] = p.entrance_pupil_at_infinity() ? ojson(nullptr) : ojson(p.f_number());
   o["working_f_number"] = p.working_f_number();
   o["image_space_na"] = p.image_space_na();
+  o["image_space_na_of_angle"] = p.image_space_na_of_angle();  // n' sin(atan u'), OpticStudio's Image Space NA
   auto h = p.lagrange_invariant();
   o["lagrange_invariant"] = h ? ojson(*h) : ojson(nullptr);
   o["image_distance_mm"] = number_or_null(p.image_distance_mm());

@@ -91,7 +91,10 @@ class ParaxialSystem {
   // F/#"; in air EFL / EPD). Irradiance and diffraction follow working_f_number() and image_space_na().
   double f_number() const;
   double working_f_number() const;     // 1 / (2 n' |u'|) of the marginal ray for this object distance
-  double image_space_na() const;       // n' |u'| of the marginal ray
+  double image_space_na() const;       // n' |u'| of the marginal ray (Smith's paraxial NA)
+  // n' sin(arctan |u'|): the paraxial marginal ray's slope taken as an angle, as OpticStudio reports its
+  // "Image Space NA" (Smith's triplet: 0.142822 against n'|u'| = 0.144296).
+  double image_space_na_of_angle() const;
 
   const ParaxialRayTable& marginal_ray() const { return marginal_; }
   // Chief ray for the maximum field; empty when the prescription has no field.
