@@ -94,6 +94,7 @@ struct AnalysisContext::Impl {
   static AimOptions aim_options(const Prescription& lens, const AnalysisOptions& options) {
     AimOptions a;
     a.aiming = options.aiming.value_or(lens.ray_aiming);
+    a.use_vignetting_factors = options.use_vignetting_factors;
     return a;
   }
   // The aimers keep references to the tracers: Impl lives on the heap and never moves.
@@ -207,6 +208,15 @@ TracedRay AnalysisContext::reference_ray(const FieldPoint& field, double wavelen
                            "); the field lies beyond what this lens can image");
   }
   return ray;
+}
+
+const AnalysisContext& whole_pupil(const AnalysisContext& context, std::optional<AnalysisContext>& storage) {
+  const auto& field = context.lens().field;
+  if (!context.options().use_vignetting_factors || !field || field->vignetting.empty()) return context;
+  AnalysisOptions whole = context.options();
+  whole.use_vignetting_factors = false;
+  storage.emplace(context.lens(), whole);
+  return *storage;
 }
 
 }  // namespace lensmith

@@ -61,7 +61,10 @@ PupilCoordinate boundary_along(const AnalysisContext& context, const FieldPoint&
 
 }  // namespace
 
-PupilShape compute_pupil_shape(const AnalysisContext& context, const PupilShapeOptions& options) {
+PupilShape compute_pupil_shape(const AnalysisContext& given, const PupilShapeOptions& options) {
+  // The shape of what passes: the whole pupil, clipped by the apertures.
+  std::optional<AnalysisContext> storage;
+  const AnalysisContext& context = whole_pupil(given, storage);
   options.validate();
   PupilShape out;
   out.lens_name = context.lens().name;

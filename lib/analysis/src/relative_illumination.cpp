@@ -44,8 +44,11 @@ double direction_cosine_jacobian(const AnalysisContext& context, const FieldPoin
 
 }  // namespace
 
-RelativeIllumination compute_relative_illumination(const AnalysisContext& context, const IlluminationOptions& options) {
+RelativeIllumination compute_relative_illumination(const AnalysisContext& given, const IlluminationOptions& options) {
   options.validate();
+  // The illumination measures the vignetting: the whole pupil, clipped by the apertures.
+  std::optional<AnalysisContext> storage;
+  const AnalysisContext& context = whole_pupil(given, storage);
   RelativeIllumination out;
   out.lens_name = context.lens().name;
   out.wavelength_nm = context.reference_wavelength_nm();

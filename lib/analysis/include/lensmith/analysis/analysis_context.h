@@ -29,6 +29,10 @@ struct AnalysisOptions {
   // outermost paraxially aimed rays can be cut by a clipping stop even on axis (they are counted as
   // vignetted); RealStop fills the real stop exactly.
   std::optional<RayAiming> aiming;
+  // Sample each field's vignetted pupil where the lens's field carries vignetting factors (OpticStudio's
+  // VDX/VDY/VCX/VCY/VAN), as OpticStudio's spots, fans and ray traces do. Analyses that measure the
+  // vignetting itself (relative illumination, pupil shape) sample the whole pupil whatever this says.
+  bool use_vignetting_factors = true;
   // Where rays are evaluated: the prescription's image plane or the paraxial focus (primary).
   TracerOptions::ImagePlane image_plane = TracerOptions::ImagePlane::AsPrescribed;
 
@@ -119,5 +123,9 @@ class AnalysisContext {
   double reference_wavelength_nm_ = 0.0;
   std::string field_unit_;
 };
+
+// `context` itself, or, when it applies the lens file's vignetting factors, an equal context in `storage`
+// that samples the whole pupil: for the analyses that measure vignetting (illumination, pupil shape).
+const AnalysisContext& whole_pupil(const AnalysisContext& context, std::optional<AnalysisContext>& storage);
 
 }  // namespace lensmith
