@@ -26,7 +26,14 @@ void print_diagnostics(const Diagnostics& diagnostics, const GlobalOptions& glob
   for (const Diagnostic& d : diagnostics) std::cerr << d << "\n";
 }
 
+namespace {
+// The lens the command loaded, so that a computation the lens cannot support (an afocal system, a field
+// beyond its reach) names the file it came from.
+std::string loaded_lens;
+}  // namespace
+
 Prescription load_lens(const std::string& lens, const GlobalOptions& global, bool resolve_field) {
+  loaded_lens = lens;
   LensReadResult result = LensLibrary::load_path_or_name(lens);
   print_diagnostics(result.diagnostics, global);
   if (!resolve_field || !result.prescription.field || result.prescription.field->kind != FieldSpec::Kind::RealImageHeightMm) {
@@ -616,7 +623,9 @@ int main(int argc, char** argv) {
   } catch (const lensmith::UsageError& e) {
     return fail(kExitUsage, e.what());
   } catch (const lensmith::ComputationError& e) {
-    return fail(kExitComputation, e.what());
+    const std::string message = e.what();
+    const bool names_lens = loaded_lens.empty() || message.find(loaded_lens) != std::string::npos;
+    return fail(kExitComputation, names_lens ? message : loaded_lens + ": " + message);
   } catch (const lensmith::IoError& e) {
     return fail(kExitIo, e.what());
   } catch (const lensmith::Error& e) {
