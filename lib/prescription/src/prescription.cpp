@@ -53,23 +53,22 @@ double FieldSpec::max_value() const {
 
 VignettingFactors FieldSpec::vignetting_at(double value) const {
   if (vignetting.empty() || vignetting.size() != values.size()) return {};
-  // Field points sorted by |value|; interpolate between the two that bracket |value|.
-  std::vector<std::size_t> order(values.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return std::abs(values[a]) < std::abs(values[b]); });
+  // The field points nearest below and above |value| by |field| (called per ray: no allocation).
   const double v = std::abs(value);
-  if (v <= std::abs(values[order.front()])) return vignetting[order.front()];
-  for (std::size_t k = 1; k < order.size(); ++k) {
-    const double lo = std::abs(values[order[k - 1]]), hi = std::abs(values[order[k]]);
-    if (v <= hi) {
-      const double t = hi > lo ? (v - lo) / (hi - lo) : 1.0;
-      const VignettingFactors& a = vignetting[order[k - 1]];
-      const VignettingFactors& b = vignetting[order[k]];
-      auto mix = [t](double p, double q) { return p + t * (q - p); };
-      return {mix(a.vdx, b.vdx), mix(a.vdy, b.vdy), mix(a.vcx, b.vcx), mix(a.vcy, b.vcy), mix(a.van_deg, b.van_deg)};
-    }
+  std::size_t below = values.size(), above = values.size();
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const double f = std::abs(values[i]);
+    if (f <= v && (below == values.size() || f > std::abs(values[below]))) below = i;
+    if (f >= v && (above == values.size() || f < std::abs(values[above]))) above = i;
   }
-  return vignetting[order.back()];
+  if (below == values.size()) return vignetting[above];  // below the first point: held
+  if (above == values.size()) return vignetting[below];  // beyond the last: held
+  const double lo = std::abs(values[below]), hi = std::abs(values[above]);
+  const double t = hi > lo ? (v - lo) / (hi - lo) : 0.0;
+  const VignettingFactors& a = vignetting[below];
+  const VignettingFactors& b = vignetting[above];
+  auto mix = [t](double p, double q) { return p + t * (q - p); };
+  return {mix(a.vdx, b.vdx), mix(a.vdy, b.vdy), mix(a.vcx, b.vcx), mix(a.vcy, b.vcy), mix(a.van_deg, b.van_deg)};
 }
 
 std::string FieldSpec::to_string() const {

@@ -143,13 +143,13 @@ struct ParmRecord {
   int column = 0;
 };
 
-// One SURF block as written, in lens units; converted to millimetres when the prescription is built.
 struct Located {
   double value = 0.0;
   int line = 0;
   int column = 0;
 };
 
+// One SURF block as written, in lens units; converted to millimetres when the prescription is built.
 struct ZmxSurface {
   int number = 0;
   int line = 0;
