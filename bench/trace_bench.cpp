@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "lensmith/paraxial/paraxial_system.h"
+#include "lensmith/glass/glass_catalog.h"
 #include "lensmith/prescription/lens_library.h"
 #include "lensmith/trace/ray_aiming.h"
 #include "lensmith/trace/sequential_tracer.h"
@@ -139,6 +140,87 @@ void BM_AimRay(benchmark::State& state, RayAiming aiming) {
   }
 }
 
+// The cost of one surface crossing per surface type (issue 18): a stack of 12 weak surfaces alternating
+// glass (n = 1.5) and air, 4 mm apart, as spheres on the coaxial path, the same spheres on the general path
+// (an identity coordinate break in front moves the lens there), toroids, biconics, spheres each between a
+// tilting break and its inverse, and a stack of 12 flat-and-curved mirrors (a beam folded back and forth).
+enum class StackKind { CoaxialSpheres, GeneralSpheres, Toroids, Biconics, TiltedSpheres, Mirrors };
+
+Prescription surface_stack(StackKind kind) {
+  Prescription p;
+  p.name = "stack";
+  Surface stop;
+  stop.thickness_mm = 4.0;
+  stop.semi_diameter_mm = 5.0;
+  stop.is_stop = true;
+  p.surfaces.push_back(stop);
+  if (kind == StackKind::GeneralSpheres) {
+    Surface b;
+    b.kind = SurfaceKind::CoordinateBreak;
+    p.surfaces.push_back(b);
+  }
+  for (int k = 0; k < 12; ++k) {
+    Surface s;
+    s.curvature_per_mm = (k % 2 == 0 ? 1.0 : -1.0) / 200.0;
+    s.thickness_mm = 4.0;
+    if (kind == StackKind::Mirrors) {
+      s.mirror = true;
+      s.thickness_mm = k % 2 == 0 ? -4.0 : 4.0;
+      s.curvature_per_mm = k % 2 == 0 ? 0.0 : 1.0 / 400.0;
+    } else if (k % 2 == 0) {
+      s.material = MaterialSpec::model(1.5, std::nullopt);
+    }
+    if (kind == StackKind::Toroids || kind == StackKind::Biconics) {
+      s.kind = kind == StackKind::Toroids ? SurfaceKind::Toroidal : SurfaceKind::Biconic;
+      s.curvature_x_per_mm = 1.3 * s.curvature_per_mm;
+    }
+    if (kind == StackKind::TiltedSpheres) {
+      Surface tilt;
+      tilt.kind = SurfaceKind::CoordinateBreak;
+      tilt.coordinate_break = CoordinateBreak{0.01, 0.0, 0.2, 0.0, 0.0, false};
+      Surface untilt = tilt;
+      untilt.coordinate_break = tilt.coordinate_break.inverse();
+      untilt.thickness_mm = s.thickness_mm;
+      s.thickness_mm = 0.0;
+      p.surfaces.push_back(tilt);
+      p.surfaces.push_back(s);
+      p.surfaces.push_back(untilt);
+      continue;
+    }
+    p.surfaces.push_back(s);
+  }
+  p.surfaces.back().thickness_mm = 20.0;
+  p.aperture = ApertureSpec{ApertureSpec::Kind::EntrancePupilDiameter, 8.0};
+  p.resolve_materials(GlassCatalog::builtin());
+  return p;
+}
+
+void BM_TraceSurfaceKind(benchmark::State& state, StackKind kind) {
+  const Prescription lens = surface_stack(kind);
+  const SequentialTracer tracer(lens);
+  std::vector<Ray> rays;
+  for (int i = 0; rays.size() < 4096 && i < 100000; ++i) {
+    Ray r;
+    const double a = 2.39996322972865332 * i, rho = 3.5 * std::sqrt((i + 0.5) / 4096.0);
+    r.position_mm = Eigen::Vector3d(rho * std::cos(a), rho * std::sin(a), -1.0);
+    r.direction = Eigen::Vector3d(0.0, 0.02, 1.0).normalized();
+    r.wavelength_nm = kWavelengthD_nm;
+    if (tracer.trace_forward(r).ok()) rays.push_back(r);
+  }
+  if (rays.empty()) {
+    state.SkipWithError("no ray gets through the stack");
+    return;
+  }
+  std::size_t next = 0;
+  for (auto _ : state) {
+    const TraceResult r = tracer.trace_forward(rays[next]);
+    benchmark::DoNotOptimize(r.ray.position_mm.data());
+    next = (next + 1) % rays.size();
+  }
+  state.counters["time_per_surface"] =
+      benchmark::Counter(static_cast<double>(state.iterations()) * 12.0, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
 // Median of 5 repetitions, as docs/performance.md reports.
 const int kRegistered = [] {
   for (const ShippedLens& lens : LensLibrary::list()) {
@@ -163,6 +245,14 @@ const int kRegistered = [] {
       ->UseRealTime()
       ->Repetitions(5)
       ->ReportAggregatesOnly(true);
+  for (const auto& [name, kind] : {std::pair{"coaxial_spheres", StackKind::CoaxialSpheres}, std::pair{"general_spheres", StackKind::GeneralSpheres},
+                                   std::pair{"toroids", StackKind::Toroids}, std::pair{"biconics", StackKind::Biconics},
+                                   std::pair{"tilted_spheres", StackKind::TiltedSpheres}, std::pair{"mirrors", StackKind::Mirrors}}) {
+    benchmark::RegisterBenchmark((std::string("BM_TraceSurfaceKind/") + name).c_str(), BM_TraceSurfaceKind, kind)
+        ->Unit(benchmark::kNanosecond)
+        ->Repetitions(5)
+        ->ReportAggregatesOnly(true);
+  }
   benchmark::RegisterBenchmark("BM_AimRay/smith-cooke-triplet/paraxial_pupil", BM_AimRay,
                                RayAiming::ParaxialEntrancePupil)
       ->Unit(benchmark::kNanosecond)

@@ -11,6 +11,10 @@ namespace lensmith::cli {
 int run_layout(const LayoutCommandOptions& options, const GlobalOptions& global) {
   const Prescription lens = load_lens(options.common.lens, global);
   AnalysisOptions analysis = make_analysis_options(options.common);
+  // Drawn bundles fill the real stop where real aiming exists (rotationally symmetric refracting lenses).
+  if (options.common.aim.empty()) {
+    analysis.aiming = lens.has_mirrors() || !lens.is_rotationally_symmetric() ? RayAiming::ParaxialEntrancePupil : RayAiming::RealStop;
+  }
   // Without a field the bundles are drawn on axis only (a lens file need not give one).
   if (!lens.field && !options.common.field_angle_deg) analysis.relative_fields = {0.0};
   const AnalysisContext context(lens, analysis);

@@ -243,7 +243,6 @@ int main(int argc, char** argv) {
   seidel_cmd->add_flag("--json", seidel.json, "Print one JSON object (schema: docs/cli.md)");
 
   LayoutCommandOptions layout;
-  layout.common.aim = "real";
   CLI::App* layout_cmd = app.add_subcommand("layout", "The lens drawn in section with its stop, image plane and real ray bundles per field");
   layout_cmd->add_option("lens", layout.common.lens, lens_help)->required();
   layout_cmd->add_option("--fields", layout.common.relative_fields,
@@ -253,7 +252,7 @@ int main(int argc, char** argv) {
   layout_cmd->add_option("--field-angle", layout.common.field_angle_deg, "The half field angle that field 1 means, degrees (default: the lens's)")
       ->check(CLI::Range(1e-9, 89.999999));
   layout_cmd->add_option("--rays", layout.rays, "Rays per bundle from pupil edge to edge (default 5; 1-101)")->check(CLI::Range(1, 101));
-  layout_cmd->add_option("--aim", layout.common.aim, "Ray aiming: real (default: rays fill the real stop) or paraxial")->check(aim_words);
+  layout_cmd->add_option("--aim", layout.common.aim, "Ray aiming: real (the default where the lens allows it: rays fill the real stop) or paraxial (the default for mirror systems and those with tilts or toroids)")->check(aim_words);
   layout_cmd->add_option("--png", layout.common.png, "Write the drawing to this PNG file (written atomically; never the input)");
 
   FanCommandOptions fan;

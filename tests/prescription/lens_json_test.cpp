@@ -230,3 +230,40 @@ TEST_CASE("lens JSON: conic, aspheric terms and curvatures that do not invert ex
   const Prescription again = read_lens_json(write_lens_json(p), "w.json").prescription;
   CHECK(again == p);
 }
+
+TEST_CASE("lens JSON: mirrors, coordinate breaks, toroidal and biconic surfaces read and write back unchanged",
+          "[prescription][json][mirror]") {
+  const std::string text =
+      "{\"format\": \"lensmith-lens\", \"version\": 1, \"name\": \"folded\",\n"
+      " \"aperture\": {\"entrance_pupil_diameter_mm\": 10},\n"
+      " \"surfaces\": [\n"
+      "  {\"radius_mm\": \"flat\", \"thickness_mm\": 20, \"stop\": true, \"semi_diameter_mm\": 6},\n"
+      "  {\"coordinate_break\": {\"tilt_x_deg\": 45}, \"thickness_mm\": 0},\n"
+      "  {\"radius_mm\": \"flat\", \"thickness_mm\": 0, \"mirror\": true},\n"
+      "  {\"coordinate_break\": {\"tilt_x_deg\": 45, \"decenter_y_mm\": 0.5, \"order\": \"tilt_first\"}, \"thickness_mm\": -30},\n"
+      "  {\"radius_mm\": -50, \"thickness_mm\": -5, \"material\": {\"nd\": 1.5}, \"toroidal\": {\"radius_of_rotation_mm\": -80}},\n"
+      "  {\"radius_mm\": 50, \"thickness_mm\": -40, \"biconic\": {\"radius_x_mm\": \"flat\", \"conic_x\": -0.5}, \"conic\": -1}\n"
+      " ]}\n";
+  const Prescription p = read_lens_json(text, "t.json").prescription;
+  REQUIRE(p.surfaces.size() == 6);
+  CHECK(p.surfaces[1].is_coordinate_break());
+  CHECK(p.surfaces[1].coordinate_break.tilt_x_deg == 45.0);
+  CHECK(p.surfaces[2].mirror);
+  CHECK(p.surfaces[3].coordinate_break == CoordinateBreak{0.0, 0.5, 45.0, 0.0, 0.0, true});
+  CHECK(p.surfaces[4].kind == SurfaceKind::Toroidal);
+  CHECK(p.surfaces[4].curvature_x_per_mm == 1.0 / -80.0);
+  CHECK(p.surfaces[5].kind == SurfaceKind::Biconic);
+  CHECK(p.surfaces[5].conic_x == -0.5);
+  CHECK(read_lens_json(write_lens_json(p), "again.json").prescription == p);
+}
+
+TEST_CASE("lens JSON: a mirror with a material, or a coordinate break with a shape, is refused", "[prescription][json][mirror]") {
+  CHECK_THAT(read_error(lens_with("{\"radius_mm\": -100, \"thickness_mm\": -50, \"mirror\": true, \"material\": \"N-BK7\"}")).what(),
+             Contains("a mirror has no material"));
+  CHECK_THAT(read_error(lens_with("{\"coordinate_break\": {\"tilt_x_deg\": 5}, \"radius_mm\": 20, \"thickness_mm\": 50}")).what(),
+             Contains("a coordinate break has no radius_mm"));
+  CHECK_THAT(read_error(lens_with("{\"coordinate_break\": {\"order\": \"sideways\"}, \"thickness_mm\": 50}")).what(),
+             Contains("tilt_first"));
+  CHECK_THAT(read_error(lens_with("{\"radius_mm\": 20, \"thickness_mm\": 50, \"toroidal\": {}, \"biconic\": {\"radius_x_mm\": 9}}")).what(),
+             Contains("not several"));
+}

@@ -244,26 +244,62 @@ TEST_CASE("Zemax: an unknown UNIT is an error naming it", "[prescription][zemax]
   CHECK_THAT(e.what(), Contains("FURLONG"));
 }
 
-TEST_CASE("Zemax: TYPE COORDBRK is an error naming the type and its line", "[prescription][zemax]") {
+TEST_CASE("Zemax: a STOP on a coordinate break is an error naming its line", "[prescription][zemax]") {
   const std::string path = data_file("coordbrk.zmx");
   try {
     read_zemax(read_file_bytes(path), path);
     FAIL("expected a LensFileError");
   } catch (const LensFileError& e) {
     CHECK(e.where().file == path);
-    CHECK(e.where().line == 16);
-    CHECK_THAT(e.what(), Contains("COORDBRK"));
+    CHECK(e.where().line == 15);  // the STOP line of SURF 1, a COORDBRK
+    CHECK_THAT(e.what(), Contains("coordinate break"));
   }
 }
 
-TEST_CASE("Zemax: a surface type other than STANDARD and EVENASPH is refused", "[prescription][zemax]") {
-  for (const char* type : {"TOROIDAL", "BICONICX", "PARAXIAL", "GRID_SAG", "XOSPHERE"}) {
+TEST_CASE("Zemax: a surface type other than STANDARD, EVENASPH, TOROIDAL, BICONICX and COORDBRK is refused", "[prescription][zemax]") {
+  for (const char* type : {"PARAXIAL", "GRID_SAG", "XOSPHERE", "BICONICZ"}) {
     std::string text = mini_zmx();
     text.replace(text.find("  TYPE STANDARD\n  CURV 0.02"), 15, std::string("  TYPE ") + type);
     const LensFileError e = zemax_error(text);
     CHECK(e.where().line == line_of(text, std::string("TYPE ") + type));
     CHECK_THAT(e.what(), Contains(type));
   }
+}
+
+TEST_CASE("Zemax: COORDBRK reads its decentres, tilts and order from PARM 1-6", "[prescription][zemax]") {
+  std::string text = mini_zmx();
+  text.replace(text.find("SURF 3\n"), 7,
+               "SURF 3\n  TYPE COORDBRK\n  CURV 0.0 0 0.0 0.0 0\n  PARM 1 1.5\n  PARM 2 -2\n  PARM 3 45\n  PARM 4 -3\n"
+               "  PARM 5 10\n  PARM 6 1\n  DISZ 0\nSURF 99\n");
+  text.replace(text.find("SURF 99"), 7, "SURF 4");
+  text.replace(text.rfind("SURF 4\n  TYPE STANDARD\n  CURV 0.0"), 6, "SURF 5");
+  const Prescription p = read_zemax(text, "t.zmx").prescription;
+  REQUIRE(p.surfaces.size() == 4);
+  REQUIRE(p.surfaces[2].is_coordinate_break());
+  CHECK(p.surfaces[2].coordinate_break == CoordinateBreak{1.5, -2.0, 45.0, -3.0, 10.0, true});
+  // A PARM beyond 6 on a break is an error naming it.
+  std::string bad = text;
+  bad.replace(bad.find("  PARM 6 1\n"), 11, "  PARM 7 1\n");
+  CHECK(zemax_error(bad).where().line == line_of(bad, "PARM 7"));
+}
+
+TEST_CASE("Zemax: TOROIDAL and BICONICX read their x radius, conic and y terms", "[prescription][zemax]") {
+  std::string text = mini_zmx("", "  PARM 1 80\n  PARM 2 1e-5\n");
+  text.replace(text.find("  TYPE STANDARD\n  CURV 0.02"), 15, "  TYPE TOROIDAL");
+  const Prescription toroid = read_zemax(text, "t.zmx").prescription;
+  CHECK(toroid.surfaces[1].kind == SurfaceKind::Toroidal);
+  CHECK(toroid.surfaces[1].curvature_x_per_mm == 1.0 / 80.0);
+  CHECK(toroid.surfaces[1].even_asphere[0] == 1e-5);  // PARM 2: the y^2 term
+  std::string biconic = mini_zmx("", "  PARM 1 0\n  PARM 2 -1\n");
+  biconic.replace(biconic.find("  TYPE STANDARD\n  CURV 0.02"), 15, "  TYPE BICONICX");
+  const Prescription b = read_zemax(biconic, "t.zmx").prescription;
+  CHECK(b.surfaces[1].kind == SurfaceKind::Biconic);
+  CHECK(b.surfaces[1].curvature_x_per_mm == 0.0);  // x radius 0: flat in x, a cylinder
+  CHECK(b.surfaces[1].conic_x == -1.0);
+  // Zernike terms on a toroid are refused.
+  std::string zernike = mini_zmx("", "  XDAT 1 3 0 0 1 0 0 \"\"\n");
+  zernike.replace(zernike.find("  TYPE STANDARD\n  CURV 0.02"), 15, "  TYPE TOROIDAL");
+  CHECK(zemax_error(zernike).where().line == line_of(zernike, "XDAT 1"));
 }
 
 TEST_CASE("Zemax: a glass in no catalogue falls back to the nd/Vd on its GLAS line, with a warning",
@@ -324,12 +360,14 @@ TEST_CASE("Zemax: GCAT sets the vendor searched first", "[prescription][zemax]")
   CHECK(p.surfaces[1].material == MaterialSpec::catalog("BAF10", "HIKARI"));
 }
 
-TEST_CASE("Zemax: GLAS MIRROR is an error (mirrors are not supported)", "[prescription][zemax]") {
+TEST_CASE("Zemax: GLAS MIRROR makes a mirror, in the medium before it", "[prescription][zemax]") {
   std::string text = mini_zmx();
   text.replace(text.find("N-BK7 0 0 1.5 40"), 16, "MIRROR 0 0 1.5 40");
-  const LensFileError e = zemax_error(text);
-  CHECK(e.where().line == line_of(text, "GLAS MIRROR"));
-  CHECK_THAT(e.what(), Contains("mirror"));
+  text.replace(text.find("  DISZ 90\n"), 10, "  DISZ -90\n");
+  const Prescription p = read_zemax(text, "t.zmx").prescription;
+  CHECK(p.surfaces[1].mirror);
+  CHECK(p.surfaces[1].medium.index(550.0) == 1.0);
+  CHECK(p.has_mirrors());
 }
 
 TEST_CASE("Zemax: MIRR (the mirror substrate drawn) alone does not make a mirror", "[prescription][zemax]") {
@@ -569,9 +607,17 @@ TEST_CASE("Zemax: DIAM 0 leaves a surface unlimited", "[prescription][zemax]") {
   CHECK_FALSE(read_zemax(text, "t.zmx").prescription.surfaces[1].semi_diameter_mm);
 }
 
-TEST_CASE("Zemax: decentres and tilts are refused unless zero", "[prescription][zemax]") {
+TEST_CASE("Zemax: a surface tilt before the surface (SCBD 1) is a coordinate break; others are refused unless zero",
+          "[prescription][zemax]") {
   const std::string tilted = mini_zmx("", "  SCBD 1 0 0 0.0 0.0 90 0 0\n");
-  CHECK(zemax_error(tilted).where().line == line_of(tilted, "SCBD"));
+  const LensReadResult r = read_zemax(tilted, "t.zmx");
+  REQUIRE(r.prescription.surfaces.size() == 4);
+  CHECK(r.prescription.surfaces[1].is_coordinate_break());
+  CHECK(r.prescription.surfaces[1].coordinate_break.tilt_x_deg == 90.0);
+  CHECK(r.prescription.surfaces[2].curvature_per_mm == 0.02);
+  CHECK(has_diagnostic(r.diagnostics, Diagnostic::Severity::Note, line_of(tilted, "SCBD"), "coordinate break"));
+  const std::string after = mini_zmx("", "  SCBD 2 0 0 0.0 0.0 90 0 0\n");
+  CHECK(zemax_error(after).where().line == line_of(after, "SCBD"));
   CHECK_NOTHROW(read_zemax(mini_zmx("", "  SCBD 1 0 0 0 0 0 0 0\n"), "t.zmx"));
   const std::string decentred = mini_zmx("", "  DECX 1.906000000000E+02\n");
   CHECK(zemax_error(decentred).where().line == line_of(decentred, "DECX"));

@@ -23,11 +23,17 @@ constexpr double kRimInset = 1e-4;
 // Keeps the drawn semi-diameter where the sag is defined (a hemisphere is drawn to 99.9 % of R).
 constexpr double kInsideSagDomain = 0.999;
 
-std::vector<LayoutPoint> profile_of(const Surface& s, double vertex_z_mm, double semi_diameter_mm) {
+// The surface's section by its local y-z plane, placed by its frame and drawn in the global y-z plane (a
+// coaxial surface: its sag curve at its vertex; a tilted or folded one where it lies).
+// Drawn from y_min to y_max (mm, local): the semi-diameter either side, or a decentred aperture's extent.
+std::vector<LayoutPoint> profile_of(const Surface& s, const SurfaceFrame& frame, double y_min_mm, double y_max_mm) {
   std::vector<LayoutPoint> points;
   for (int i = 0; i <= kProfileSamples; ++i) {
-    const double y = semi_diameter_mm * (2.0 * i / kProfileSamples - 1.0);
-    points.push_back({vertex_z_mm + s.sag_mm(std::abs(y)), y});
+    const double y = y_min_mm + (y_max_mm - y_min_mm) * i / kProfileSamples;
+    double sag = 0.0, dx = 0.0, dy = 0.0;
+    if (!s.sag_and_slope(0.0, y, sag, dx, dy)) sag = s.sag_mm(std::abs(y));
+    const Eigen::Vector3d p = frame.to_global(Eigen::Vector3d(0.0, y, sag));
+    points.push_back({p.z(), p.y()});
   }
   return points;
 }
@@ -88,7 +94,8 @@ LensLayout compute_lens_layout(const AnalysisContext& context, const LayoutOptio
         h = std::max(h, std::abs(hit.point_mm.y()));
       }
       if (traced.ok()) {
-        ray.path.push_back({traced.image_ray.position_mm.z(), traced.image_ray.position_mm.y()});
+        const Eigen::Vector3d on_image = tracer.image_point_in_global_frame(traced.image_ray.position_mm);
+        ray.path.push_back({on_image.z(), on_image.y()});
         out.image_half_height_mm = std::max(out.image_half_height_mm, std::abs(traced.image_ray.position_mm.y()));
       }
       out.rays.push_back(std::move(ray));
@@ -102,7 +109,8 @@ LensLayout compute_lens_layout(const AnalysisContext& context, const LayoutOptio
     ls.surface = k;
     ls.vertex_z_mm = tracer.vertex_z_mm(k);
     ls.is_stop = out.stop_surface && *out.stop_surface == k;
-    ls.glass_after = !s.medium.is_air();
+    ls.glass_after = !s.medium.is_air() && !s.mirror;
+    ls.mirror = s.mirror;
     ls.semi_diameter_given = s.semi_diameter_mm.has_value();
     double h = s.semi_diameter_mm.value_or(ray_height[static_cast<std::size_t>(k)]);
     if (!(h > 0.0)) {
@@ -110,7 +118,16 @@ LensLayout compute_lens_layout(const AnalysisContext& context, const LayoutOptio
       if (paraxial.chief_ray()) h += std::abs(paraxial.chief_ray()->rows.at(static_cast<std::size_t>(k - 1)).y_mm);
     }
     ls.semi_diameter_mm = std::min(h, kInsideSagDomain * s.max_semi_diameter_mm());
-    ls.profile = profile_of(s, ls.vertex_z_mm, ls.semi_diameter_mm);
+    if (!s.is_coordinate_break()) {
+      double y_min = -ls.semi_diameter_mm, y_max = ls.semi_diameter_mm;
+      if (s.aperture && !s.aperture->obscuration && s.aperture->decenter_y_mm != 0.0) {
+        // An off-axis mirror or a decentred element: only the part its aperture keeps.
+        const double half = s.aperture->shape == SurfaceAperture::Shape::Circular ? s.aperture->half_x_mm : s.aperture->half_y_mm;
+        y_min = std::max(y_min, s.aperture->decenter_y_mm - half);
+        y_max = std::min(y_max, s.aperture->decenter_y_mm + half);
+      }
+      ls.profile = profile_of(s, tracer.surface_frame(k), y_min, y_max);
+    }
     out.surfaces.push_back(std::move(ls));
   }
   // A ray stopped outside a clear aperture met the surface's sphere beyond the lens's rim: end it
@@ -126,6 +143,12 @@ LensLayout compute_lens_layout(const AnalysisContext& context, const LayoutOptio
   }
   if (out.image_half_height_mm <= 0.0) {
     for (const LayoutSurface& s : out.surfaces) out.image_half_height_mm = std::max(out.image_half_height_mm, 0.25 * s.semi_diameter_mm);
+  }
+  for (std::size_t e = 0; e < 2; ++e) {
+    const double sign = e == 0 ? -1.0 : 1.0;
+    const Eigen::Vector3d end =
+        tracer.image_point_in_global_frame(Eigen::Vector3d(0.0, sign * out.image_half_height_mm, out.image_plane_z_mm));
+    out.image_plane_ends[e] = {end.z(), end.y()};
   }
 
   for (int k = 1; k < count; ++k) {

@@ -95,6 +95,14 @@ Camera Camera::thin_lens(double focal_length_mm, const CameraOptions& options, i
 
 Camera Camera::from_lens(const Prescription& lens, const CameraOptions& options, int width_px, int height_px) {
   options.validate();
+  if (lens.has_mirrors() || !lens.is_rotationally_symmetric()) {
+    // Not implemented yet: the ray models, pupil meshes and fits assume a rotationally symmetric refracting lens.
+    const auto why = lens.why_not_rotationally_symmetric();
+    throw ComputationError("the bokeh camera does not take this lens yet (" +
+                           (why ? *why : std::string("it has mirrors")) +
+                           "): mirror lenses, coordinate breaks and toroidal or biconic surfaces are read, traced and analysed, "
+                           "but not yet photographed through (not implemented)");
+  }
   // A camera's pupil is where its stop images, at its f-number: a lens file's object-space telecentric
   // flag (a measuring lens's) is dropped.
   Prescription as_camera = lens;

@@ -6,9 +6,12 @@
 
 #include <cstddef>
 #include <span>
+#include <vector>
 #include <string>
 
 #include "lensmith/paraxial/paraxial_system.h"
+
+#include "lensmith/prescription/prescription.h"
 
 namespace lensmith::paraxial_detail {
 
@@ -16,6 +19,10 @@ namespace lensmith::paraxial_detail {
 // length would exceed the longest surface focal length by more than 10^10, which no lens has and
 // which rounding alone produces for a telescope whose powers cancel.
 inline constexpr double kAfocalRelativePower = 1.0e-10;
+
+// +1 or -1 per surface: the sign of the index after it in the unfolded system (-1 after an odd number of
+// mirrors, counting the surface itself).
+std::vector<double> reflection_signs(const Prescription& lens);
 
 // |n' u'| of the axial ray below this fraction of its two terms means "image at infinity" (the
 // object sits in the front focal plane); the same relative test is used for pupils at infinity.

@@ -55,6 +55,7 @@ ParaxialSpectralTable::ParaxialSpectralTable(const Prescription& lens, const Spe
   const std::size_t count = lens.surfaces.size();
   std::vector<double> curvatures(count), thicknesses(count), indices(count);
   std::vector<const Glass*> media(count);
+  const std::vector<double> signs = paraxial_detail::reflection_signs(lens);
   for (std::size_t k = 0; k < count; ++k) {
     curvatures[k] = lens.surfaces[k].paraxial_curvature_per_mm();
     thicknesses[k] = lens.surfaces[k].thickness_mm;
@@ -70,7 +71,7 @@ ParaxialSpectralTable::ParaxialSpectralTable(const Prescription& lens, const Spe
                                      : options.min_wavelength_nm + step_nm * static_cast<double>(s);
     bool extrapolated = !lens.object_medium.covers(wavelength_nm);
     for (std::size_t k = 0; k < count; ++k) {
-      indices[k] = media[k]->index(wavelength_nm);
+      indices[k] = signs[k] * media[k]->index(wavelength_nm);
       extrapolated = extrapolated || !media[k]->covers(wavelength_nm);
     }
     const double n_object = lens.object_medium.index(wavelength_nm);

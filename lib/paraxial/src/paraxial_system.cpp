@@ -49,6 +49,16 @@ KernelMatrices compose_matrices(std::span<const double> curvatures_per_mm, std::
   return out;
 }
 
+std::vector<double> reflection_signs(const Prescription& lens) {
+  std::vector<double> signs(lens.surfaces.size());
+  double sign = 1.0;
+  for (std::size_t k = 0; k < lens.surfaces.size(); ++k) {
+    if (lens.surfaces[k].mirror) sign = -sign;
+    signs[k] = sign;
+  }
+  return signs;
+}
+
 CardinalPoints cardinal_points(const KernelMatrices& m, double n_object, double n_image, double z_last_mm) {
   const SystemMatrix& a = m.system;
   const double power = -a.a12;
@@ -152,9 +162,11 @@ std::string label(const std::string& text, std::size_t width) {
   return s;
 }
 
+// The unfolded indices after each surface (negative after an odd number of mirrors).
 std::vector<double> indices_at(const Prescription& lens, double wavelength_nm) {
   std::vector<double> indices(lens.surfaces.size());
-  for (std::size_t k = 0; k < lens.surfaces.size(); ++k) indices[k] = lens.surfaces[k].medium.index(wavelength_nm);
+  const std::vector<double> signs = paraxial_detail::reflection_signs(lens);
+  for (std::size_t k = 0; k < lens.surfaces.size(); ++k) indices[k] = signs[k] * lens.surfaces[k].medium.index(wavelength_nm);
   return indices;
 }
 
@@ -240,7 +252,7 @@ ParaxialSystem::ParaxialSystem(const Prescription& lens, const ParaxialOptions& 
   curvatures_.resize(count);
   thicknesses_.resize(count);
   for (std::size_t k = 0; k < count; ++k) {
-    curvatures_[k] = lens.surfaces[k].paraxial_curvature_per_mm();
+    curvatures_[k] = lens.surfaces[k].paraxial_curvature_per_mm(options.section);
     thicknesses_[k] = lens.surfaces[k].thickness_mm;
   }
   indices_ = indices_at(lens, wavelength_nm_);
@@ -279,6 +291,8 @@ ParaxialSystem::ParaxialSystem(const Prescription& lens, const ParaxialOptions& 
   z_rear_nodal_mm_ = cardinal.z_rear_nodal_mm;
   paraxial_detail::PupilImages pupils = paraxial_detail::pupil_images(m, n_object_, n_image_, z_last_mm_);
   telecentric_ = lens.object_space_telecentric;
+  mirrors_ = lens.has_mirrors();
+  breaks_ignored_ = !lens.is_coaxial();
   if (telecentric_) pupils.z_entrance_mm = kTelecentricPupilZ_mm;
   if (!std::isfinite(pupils.z_entrance_mm)) {
     throw ComputationError("the entrance pupil lies at infinity (stop at the rear focal point of the surfaces "
@@ -319,7 +333,7 @@ ParaxialSystem::ParaxialSystem(const Prescription& lens, const ParaxialOptions& 
                                               unit_slope, 0.0, start_height, thicknesses_.back());
       const double u_image = std::abs(unit.rows.back().u_after);
       if (!(u_image > 0.0)) throw ComputationError("the marginal ray leaves the lens parallel to the axis: no paraxial working F/#");
-      epd_mm_ = 2.0 / (2.0 * primary_indices.back() * lens.aperture.value * u_image);
+      epd_mm_ = 2.0 / (2.0 * std::abs(primary_indices.back()) * lens.aperture.value * u_image);
       break;
     }
     case ApertureSpec::Kind::ObjectSpaceNA:
@@ -451,8 +465,11 @@ double ParaxialSystem::f_number() const { return std::abs(rear_focal_length_mm()
 
 double ParaxialSystem::working_f_number() const { return 1.0 / (2.0 * image_space_na()); }
 
-double ParaxialSystem::image_space_na() const { return n_image_ * std::abs(marginal_.rows.back().u_after); }
-double ParaxialSystem::image_space_na_of_angle() const { return n_image_ * std::sin(std::atan(std::abs(marginal_.rows.back().u_after))); }
+// |n'|: after an odd number of mirrors the unfolded index is negative.
+double ParaxialSystem::image_space_na() const { return std::abs(n_image_) * std::abs(marginal_.rows.back().u_after); }
+double ParaxialSystem::image_space_na_of_angle() const {
+  return std::abs(n_image_) * std::sin(std::atan(std::abs(marginal_.rows.back().u_after)));
+}
 
 std::optional<double> ParaxialSystem::lagrange_invariant() const {
   if (!chief_) return std::nullopt;
@@ -501,7 +518,12 @@ std::string ParaxialSystem::to_string() const {
                                          : number(object_distance_mm_, 4) + " mm in front of surface 1")
      << '\n';
   os << "  z: mm from the vertex of surface 1, +z toward the image; last surface at z = " << number(z_last_mm_, 4)
-     << " mm\n\n";
+     << " mm\n";
+  if (mirrors_) os << "  mirrors unfolded: the index after a reflection is -n, thicknesses after one are negative\n";
+  if (breaks_ignored_) {
+    os << "  coordinate breaks ignored (as OpticStudio's paraxial trace by default): the surfaces taken on one axis, z along it\n";
+  }
+  os << "\n";
 
   line("System matrix (n u, y)", matrix_.to_string());
   line("Power", number(power_per_mm(), 8) + " 1/mm");
@@ -542,7 +564,7 @@ std::string ParaxialSystem::to_string() const {
   }
   line("Exit pupil diameter", number(exit_pupil_.diameter_mm, 4) + " mm",
        "magnification " + number(exit_pupil_.magnification, 5) + " of the stop");
-  if (!telecentric_) line("F-number", number(f_number(), 4), n_image_ == 1.0 ? "EFL/EPD" : "f'/EPD (image space)");
+  if (!telecentric_) line("F-number", number(f_number(), 4), std::abs(n_image_) == 1.0 ? "EFL/EPD" : "f'/EPD (image space)");
   line("Working F-number", number(working_f_number(), 4), "1/(2 n'|u'|), this object distance");
   line("Image-space NA", number(image_space_na(), 6), "n'|u'|; n' sin(atan|u'|) = " + number(image_space_na_of_angle(), 6) + " as OpticStudio prints it");
   line("Image distance", number(image_distance_mm_, 4) + " mm", "last surface to paraxial image");

@@ -1,6 +1,8 @@
 // The lens layout picture (layout_plot.h).
 #include "lensmith/plot/layout_plot.h"
 
+#include "lensmith/core/units.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -36,24 +38,30 @@ Rgb field_colour(std::size_t field_index) {
 
 Canvas plot_lens_layout(const LensLayout& layout, const PlotOptions& o, LayoutFrame* frame_out) {
   // The section's extent: every surface, the image plane, and every drawn ray.
-  double z_lo = layout.image_plane_z_mm, z_hi = layout.image_plane_z_mm, y_hi = layout.image_half_height_mm;
+  // A coaxial lens is drawn symmetric about its axis; a folded or tilted one over what it occupies.
+  double z_lo = kInfinity, z_hi = -kInfinity, y_lo = kInfinity, y_hi = -kInfinity;
+  auto include = [&](const LayoutPoint& p) {
+    z_lo = std::min(z_lo, p.z_mm);
+    z_hi = std::max(z_hi, p.z_mm);
+    y_lo = std::min(y_lo, p.y_mm);
+    y_hi = std::max(y_hi, p.y_mm);
+  };
+  for (const LayoutPoint& p : layout.image_plane_ends) include(p);
   for (const LayoutSurface& s : layout.surfaces) {
-    for (const LayoutPoint& p : s.profile) {
-      z_lo = std::min(z_lo, p.z_mm);
-      z_hi = std::max(z_hi, p.z_mm);
-    }
-    y_hi = std::max(y_hi, s.semi_diameter_mm);
+    for (const LayoutPoint& p : s.profile) include(p);
   }
   for (const LayoutRay& r : layout.rays) {
-    for (const LayoutPoint& p : r.path) {
-      z_lo = std::min(z_lo, p.z_mm);
-      z_hi = std::max(z_hi, p.z_mm);
-      y_hi = std::max(y_hi, std::abs(p.y_mm));
-    }
+    for (const LayoutPoint& p : r.path) include(p);
   }
-  const double stop_bar_mm = 0.12 * y_hi;
+  const double reach = std::max(std::abs(y_lo), std::abs(y_hi));
+  if (y_lo < 0.0 && y_hi > 0.0 && std::min(-y_lo, y_hi) > 0.5 * reach) {
+    y_lo = -reach;  // about the axis
+    y_hi = reach;
+  }
+  const double stop_bar_mm = 0.12 * 0.5 * std::max(y_hi - y_lo, 1e-3);
   y_hi += stop_bar_mm;
-  const double z_span = std::max(z_hi - z_lo, 1e-3), y_span = 2.0 * std::max(y_hi, 1e-3);
+  y_lo -= stop_bar_mm;
+  const double z_span = std::max(z_hi - z_lo, 1e-3), y_span = std::max(y_hi - y_lo, 1e-3);
   const double scale = std::min((kWidthPx - 2.0 * kMarginPx) / z_span, kMaxSectionHeightPx / y_span);
   const double legend_y = header_height(o) + 0.6 * o.font_px;
   const double top = legend_y + 1.6 * o.font_px + 16.0;
@@ -64,7 +72,7 @@ Canvas plot_lens_layout(const LensLayout& layout, const PlotOptions& o, LayoutFr
   frame.px_per_mm = scale;
   frame.z_min_mm = z_lo;
   frame.left_px = 0.5 * (kWidthPx - z_span * scale);
-  frame.axis_y_px = top + 0.5 * section_px;
+  frame.axis_y_px = top + y_hi * scale;  // y = 0
   if (frame_out) *frame_out = frame;
 
   std::string details = "meridional section, equal scales; " + std::to_string(layout.rays.size() / std::max<std::size_t>(1, layout.relative_fields.size())) +
@@ -86,21 +94,30 @@ Canvas plot_lens_layout(const LensLayout& layout, const PlotOptions& o, LayoutFr
     canvas.polyline(outline, LineStyle{kSurface, 1.6});
   }
   for (const LayoutSurface& s : layout.surfaces) {
-    const bool in_element = s.glass_after || (s.surface > 1 && layout.surfaces[static_cast<std::size_t>(s.surface - 2)].glass_after);
+    const bool in_element =
+        !s.mirror && (s.glass_after || (s.surface > 1 && layout.surfaces[static_cast<std::size_t>(s.surface - 2)].glass_after));
     if (in_element) continue;  // drawn with its element
     // An air-to-air surface (a dummy, or the stop's plane): a thin grey line; the stop gets bars below.
-    if (!s.is_stop) canvas.polyline(to_pixels(s.profile, frame), LineStyle{kDummy, 1.0, 4.0, 3.0});
+    if (s.mirror && s.profile.size() >= 2) {
+      canvas.polyline(to_pixels(s.profile, frame), LineStyle{kSurface, 2.4});  // a mirror: solid
+    } else if (!s.is_stop && s.profile.size() >= 2) {
+      canvas.polyline(to_pixels(s.profile, frame), LineStyle{kDummy, 1.0, 4.0, 3.0});
+    }
   }
   if (layout.stop_surface) {
     const LayoutSurface& s = layout.surfaces[static_cast<std::size_t>(*layout.stop_surface - 1)];
-    const double z = s.edge_z_mm();
-    for (double sign : {1.0, -1.0}) {
-      canvas.line(frame.to_pixel(z, sign * s.semi_diameter_mm), frame.to_pixel(z, sign * (s.semi_diameter_mm + stop_bar_mm)),
-                  LineStyle{kBlack, 3.5});
+    // Bars outward from both ends of the stop's section, along it (a tilted stop's bars tilt with it).
+    if (s.profile.size() >= 2) {
+      for (const auto& [end, before] : {std::pair{s.profile.back(), s.profile[s.profile.size() - 2]}, std::pair{s.profile.front(), s.profile[1]}}) {
+        const double dz = end.z_mm - before.z_mm, dy = end.y_mm - before.y_mm, length = std::hypot(dz, dy);
+        if (!(length > 0.0)) continue;
+        canvas.line(frame.to_pixel(end.z_mm, end.y_mm),
+                    frame.to_pixel(end.z_mm + stop_bar_mm * dz / length, end.y_mm + stop_bar_mm * dy / length), LineStyle{kBlack, 3.5});
+      }
     }
   }
-  canvas.line(frame.to_pixel(layout.image_plane_z_mm, -layout.image_half_height_mm),
-              frame.to_pixel(layout.image_plane_z_mm, layout.image_half_height_mm), LineStyle{kBlack, 2.5});
+  canvas.line(frame.to_pixel(layout.image_plane_ends[0].z_mm, layout.image_plane_ends[0].y_mm),
+              frame.to_pixel(layout.image_plane_ends[1].z_mm, layout.image_plane_ends[1].y_mm), LineStyle{kBlack, 2.5});
 
   // Rays: the fields in order, outermost last so it stays on top; a dot where a ray was stopped.
   std::vector<LegendEntry> legend;

@@ -20,7 +20,9 @@ const std::vector<std::string> kTopKeys = {"format", "version", "name", "source"
                                            "object_material", "aperture", "field", "wavelengths_nm",
                                            "primary_wavelength_nm", "ray_aiming", "object_space_telecentric", "surfaces"};
 const std::vector<std::string> kSurfaceKeys = {"radius_mm", "curvature_per_mm", "thickness_mm", "material", "semi_diameter_mm",
-                                               "clips_rays", "aperture", "stop", "conic", "even_asphere", "comment"};
+                                               "clips_rays", "aperture", "stop", "conic", "even_asphere", "mirror",
+                                               "toroidal", "biconic", "coordinate_break", "comment"};
+const std::vector<std::string> kBreakKeys = {"decenter_x_mm", "decenter_y_mm", "tilt_x_deg", "tilt_y_deg", "tilt_z_deg", "order"};
 const std::vector<std::string> kApertureKeys = {"shape", "radius_mm", "half_x_mm", "half_y_mm", "min_radius_mm",
                                                 "obscuration", "decenter_x_mm", "decenter_y_mm"};
 const std::vector<std::string> kAsphereKeys = {"a2", "a4", "a6", "a8", "a10", "a12", "a14", "a16"};
@@ -201,12 +203,77 @@ SurfaceAperture read_surface_aperture(const LocatedJson& doc, const std::string&
   return a;
 }
 
+// A radius (mm) or "flat" as a curvature (1/mm).
+double read_radius(JsonObjectReader& r, const std::string& key) {
+  const json* v = r.get(key);
+  if (v->is_string() && v->get<std::string>() == "flat") return 0.0;
+  if (v->is_number()) {
+    const double radius = v->get<double>();
+    if (radius == 0.0 || !std::isfinite(radius)) r.fail(key, "must be finite and non-zero; write \"flat\" for a plane");
+    return 1.0 / radius;
+  }
+  r.fail(key, "expected a number (mm) or \"flat\", got " + json_type_phrase(*v));
+}
+
 Surface read_surface(const LocatedJson& doc, const std::string& pointer, const std::string& path, bool last, bool* thickness_given) {
   JsonObjectReader r(doc, pointer, path);
   Surface s;
   const bool has_radius = r.has("radius_mm");
   const bool has_curvature = r.has("curvature_per_mm");
   if (has_radius && has_curvature) r.fail("curvature_per_mm", "give radius_mm or curvature_per_mm, not both");
+  const int kinds = int(r.has("toroidal")) + int(r.has("biconic")) + int(r.has("coordinate_break"));
+  if (kinds > 1) r.fail("", "a surface is one of toroidal, biconic or coordinate_break, not several");
+  if (r.has("coordinate_break")) {
+    // A coordinate break has no shape: only its decentres, tilts and thickness.
+    for (const char* key : {"radius_mm", "curvature_per_mm", "material", "conic", "even_asphere", "mirror", "stop", "semi_diameter_mm",
+                            "aperture", "clips_rays"}) {
+      if (r.has(key)) r.fail(key, "a coordinate break has no " + std::string(key) + " (it only moves and turns the surfaces after it)");
+    }
+    r.get("coordinate_break");
+    JsonObjectReader b(doc, r.child_pointer("coordinate_break"), r.child_path("coordinate_break"));
+    s.kind = SurfaceKind::CoordinateBreak;
+    CoordinateBreak& cb = s.coordinate_break;
+    cb.decenter_x_mm = b.get_optional_number("decenter_x_mm").value_or(0.0);
+    cb.decenter_y_mm = b.get_optional_number("decenter_y_mm").value_or(0.0);
+    cb.tilt_x_deg = b.get_optional_number("tilt_x_deg").value_or(0.0);
+    cb.tilt_y_deg = b.get_optional_number("tilt_y_deg").value_or(0.0);
+    cb.tilt_z_deg = b.get_optional_number("tilt_z_deg").value_or(0.0);
+    const std::string order = b.get_optional_string("order").value_or("decenter_first");
+    if (order != "decenter_first" && order != "tilt_first") {
+      b.fail("order", "expected \"decenter_first\" (Zemax order 0) or \"tilt_first\" (order 1), got \"" + order + "\"");
+    }
+    cb.tilt_first = order == "tilt_first";
+    b.finish(kBreakKeys);
+    auto thickness = r.get_optional_number("thickness_mm");
+    *thickness_given = thickness.has_value();
+    if (thickness) {
+      s.thickness_mm = *thickness;
+    } else if (!last) {
+      r.fail("", "missing thickness_mm (distance to the next vertex along the new z axis, mm)");
+    }
+    s.comment = r.get_optional_string("comment").value_or("");
+    r.finish(kSurfaceKeys);
+    return s;
+  }
+  if (r.has("toroidal")) {
+    r.get("toroidal");
+    JsonObjectReader t(doc, r.child_pointer("toroidal"), r.child_path("toroidal"));
+    s.kind = SurfaceKind::Toroidal;
+    if (!t.has("radius_of_rotation_mm")) t.fail("", "missing radius_of_rotation_mm (mm, or \"flat\" for a cylinder)");
+    s.curvature_x_per_mm = read_radius(t, "radius_of_rotation_mm");
+    t.finish({"radius_of_rotation_mm"});
+  }
+  if (r.has("biconic")) {
+    r.get("biconic");
+    JsonObjectReader b(doc, r.child_pointer("biconic"), r.child_path("biconic"));
+    s.kind = SurfaceKind::Biconic;
+    if (!b.has("radius_x_mm")) b.fail("", "missing radius_x_mm (mm, or \"flat\")");
+    s.curvature_x_per_mm = read_radius(b, "radius_x_mm");
+    s.conic_x = b.get_optional_number("conic_x").value_or(0.0);
+    b.finish({"radius_x_mm", "conic_x"});
+  }
+  s.mirror = r.get_optional_bool("mirror").value_or(false);
+  if (s.mirror && r.has("material")) r.fail("material", "a mirror has no material: the medium before it continues after the reflection");
   if (has_radius) {
     const json* v = r.get("radius_mm");
     if (v->is_string() && v->get<std::string>() == "flat") {
@@ -355,6 +422,12 @@ namespace {
 
 using ojson = nlohmann::ordered_json;
 
+ojson radius_value(double curvature_per_mm) {
+  if (curvature_per_mm == 0.0) return "flat";
+  return 1.0 / curvature_per_mm;
+}
+
+
 ojson write_material(const MaterialSpec& m) {
   switch (m.kind) {
     case MaterialSpec::Kind::Air: return "air";
@@ -426,6 +499,22 @@ std::string write_lens_json(const Prescription& p) {
   for (std::size_t i = 0; i < p.surfaces.size(); ++i) {
     const Surface& s = p.surfaces[i];
     ojson j;
+    const bool last = i + 1 == p.surfaces.size();
+    if (s.is_coordinate_break()) {
+      const CoordinateBreak& b = s.coordinate_break;
+      ojson cb = ojson::object();
+      if (b.decenter_x_mm != 0.0) cb["decenter_x_mm"] = b.decenter_x_mm;
+      if (b.decenter_y_mm != 0.0) cb["decenter_y_mm"] = b.decenter_y_mm;
+      if (b.tilt_x_deg != 0.0) cb["tilt_x_deg"] = b.tilt_x_deg;
+      if (b.tilt_y_deg != 0.0) cb["tilt_y_deg"] = b.tilt_y_deg;
+      if (b.tilt_z_deg != 0.0) cb["tilt_z_deg"] = b.tilt_z_deg;
+      if (b.tilt_first) cb["order"] = "tilt_first";
+      j["coordinate_break"] = cb;
+      if (!(last && p.image_at_paraxial_focus)) j["thickness_mm"] = s.thickness_mm;
+      if (!s.comment.empty()) j["comment"] = s.comment;
+      surfaces.push_back(j);
+      continue;
+    }
     if (s.curvature_per_mm == 0.0) {
       j["radius_mm"] = "flat";
     } else if (1.0 / (1.0 / s.curvature_per_mm) == s.curvature_per_mm) {
@@ -433,9 +522,19 @@ std::string write_lens_json(const Prescription& p) {
     } else {
       j["curvature_per_mm"] = s.curvature_per_mm;
     }
-    const bool last = i + 1 == p.surfaces.size();
     if (!(last && p.image_at_paraxial_focus)) j["thickness_mm"] = s.thickness_mm;
-    j["material"] = write_material(s.material);
+    if (s.mirror) {
+      j["mirror"] = true;
+    } else {
+      j["material"] = write_material(s.material);
+    }
+    if (s.kind == SurfaceKind::Toroidal) j["toroidal"] = ojson{{"radius_of_rotation_mm", radius_value(s.curvature_x_per_mm)}};
+    if (s.kind == SurfaceKind::Biconic) {
+      ojson b;
+      b["radius_x_mm"] = radius_value(s.curvature_x_per_mm);
+      if (s.conic_x != 0.0) b["conic_x"] = s.conic_x;
+      j["biconic"] = b;
+    }
     if (s.semi_diameter_mm) j["semi_diameter_mm"] = *s.semi_diameter_mm;
     if (s.semi_diameter_mm && !s.clips_rays) j["clips_rays"] = false;
     if (s.aperture) {

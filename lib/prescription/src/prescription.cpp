@@ -94,6 +94,30 @@ double Prescription::vertex_z_mm(std::size_t surface_index) const {
   return z;
 }
 
+bool Prescription::has_mirrors() const {
+  return std::any_of(surfaces.begin(), surfaces.end(), [](const Surface& s) { return s.mirror; });
+}
+
+bool Prescription::is_coaxial() const {
+  return std::none_of(surfaces.begin(), surfaces.end(),
+                      [](const Surface& s) { return s.is_coordinate_break() && !s.coordinate_break.is_identity(); });
+}
+
+bool Prescription::is_rotationally_symmetric() const {
+  return is_coaxial() && std::all_of(surfaces.begin(), surfaces.end(), [](const Surface& s) { return s.is_rotationally_symmetric(); });
+}
+
+std::optional<std::string> Prescription::why_not_rotationally_symmetric() const {
+  for (std::size_t i = 0; i < surfaces.size(); ++i) {
+    const Surface& s = surfaces[i];
+    if (s.is_coordinate_break() && !s.coordinate_break.is_identity()) {
+      return "surface " + std::to_string(i + 1) + " is a coordinate break (" + s.coordinate_break.to_string() + ")";
+    }
+    if (!s.is_rotationally_symmetric()) return "surface " + std::to_string(i + 1) + " is " + std::string(lensmith::to_string(s.kind));
+  }
+  return std::nullopt;
+}
+
 double Prescription::last_vertex_z_mm() const { return surfaces.empty() ? 0.0 : vertex_z_mm(surfaces.size() - 1); }
 
 Diagnostics Prescription::geometry_warnings() const {
@@ -108,10 +132,23 @@ Diagnostics Prescription::geometry_warnings() const {
   };
   // Tolerance for a crossing at the edge (mm): the rounding of thicknesses and radii in lens files.
   constexpr double kEdgeToleranceMm = 1e-4;
+  // After an odd number of mirrors light travels toward -z and a glass's thickness is negative.
+  double sense = 1.0;
+  bool tilted = false;
   for (std::size_t i = 0; i + 1 < surfaces.size(); ++i) {
     const Surface& s = surfaces[i];
     const Surface& next = surfaces[i + 1];
+    if (s.mirror) sense = -sense;
+    tilted = tilted || (s.is_coordinate_break() && !s.coordinate_break.is_identity());
+    if (s.is_coordinate_break() || next.is_coordinate_break() || tilted) continue;  // no common axis to measure along
     const bool glass = s.material.kind != MaterialSpec::Kind::Air;
+    if (sense < 0.0) {
+      if (glass && s.thickness_mm > 0.0) {
+        warn("surface " + std::to_string(i + 1) + ": the glass after it (" + s.material.to_string() + ") follows an odd number of "
+             "mirrors but has a positive thickness, " + format_rounded(s.thickness_mm, 4) + " mm: after a reflection thicknesses are negative");
+      }
+      continue;  // the edge check below assumes light travelling toward +z
+    }
     if (glass && s.thickness_mm < 0.0) {
       warn("surface " + std::to_string(i + 1) + ": the glass after it (" + s.material.to_string() + ") has a negative centre thickness, " +
            format_rounded(s.thickness_mm, 4) + " mm: no element can be made so");
@@ -181,6 +218,45 @@ void Prescription::validate() const {
       }
     }
     if (s.is_stop) ++stops;
+    if (!std::isfinite(s.curvature_x_per_mm)) reject_surface(i, "curvature_x_per_mm", s.curvature_x_per_mm, "must be finite (0: flat in x)");
+    if (!std::isfinite(s.conic_x)) reject_surface(i, "conic_x", s.conic_x, "must be finite");
+    if (s.kind == SurfaceKind::Biconic && s.has_asphere()) {
+      throw PrescriptionError("surface " + std::to_string(i + 1) + ": a biconic surface takes no even-asphere terms (use a toroidal "
+                              "surface for a polynomial y profile)");
+    }
+    if (s.kind != SurfaceKind::Toroidal && s.kind != SurfaceKind::Biconic && (s.curvature_x_per_mm != 0.0 || s.conic_x != 0.0)) {
+      throw PrescriptionError("surface " + std::to_string(i + 1) + ": curvature_x_per_mm and conic_x belong to toroidal and biconic "
+                              "surfaces, not to a " + std::string(lensmith::to_string(s.kind)) + " surface");
+    }
+    if (s.kind == SurfaceKind::Toroidal && s.conic_x != 0.0) {
+      throw PrescriptionError("surface " + std::to_string(i + 1) + ": a toroidal surface has no x conic (its x section is the circle "
+                              "of its radius of rotation); use a biconic surface");
+    }
+    if (s.is_coordinate_break()) {
+      const CoordinateBreak& b = s.coordinate_break;
+      const std::string at = "coordinate_break.";
+      for (const auto& [key, value] : {std::pair{"decenter_x_mm", b.decenter_x_mm}, std::pair{"decenter_y_mm", b.decenter_y_mm},
+                                       std::pair{"tilt_x_deg", b.tilt_x_deg}, std::pair{"tilt_y_deg", b.tilt_y_deg},
+                                       std::pair{"tilt_z_deg", b.tilt_z_deg}}) {
+        if (!std::isfinite(value)) reject_surface(i, at + key, value, "must be finite");
+      }
+      if (s.mirror) throw PrescriptionError("surface " + std::to_string(i + 1) + ": a coordinate break cannot be a mirror (it has no shape)");
+      if (s.is_stop) throw PrescriptionError("surface " + std::to_string(i + 1) + ": a coordinate break cannot be the stop (it has no aperture)");
+      if (s.curvature_per_mm != 0.0 || s.conic != 0.0 || s.has_asphere()) {
+        throw PrescriptionError("surface " + std::to_string(i + 1) + ": a coordinate break has no shape (curvature, conic and "
+                                "asphere terms must be 0)");
+      }
+      if (s.material.kind != MaterialSpec::Kind::Air) {
+        throw PrescriptionError("surface " + std::to_string(i + 1) + ": a coordinate break has no material of its own (the medium "
+                                "before it continues); give it none");
+      }
+    } else if (!s.coordinate_break.is_identity()) {
+      throw PrescriptionError("surface " + std::to_string(i + 1) + ": decentres and tilts belong to a coordinate break surface");
+    }
+    if (s.mirror && s.material.kind != MaterialSpec::Kind::Air) {
+      throw PrescriptionError("surface " + std::to_string(i + 1) + ": a mirror has no material of its own (the medium before it "
+                              "continues after the reflection); give it none");
+    }
   }
   if (stops > 1) throw PrescriptionError("surfaces: " + std::to_string(stops) + " surfaces are flagged as the stop; at most one may be");
 
@@ -291,6 +367,11 @@ void Prescription::resolve_materials(const GlassCatalog& catalogue) {
     throw GlassError(std::string("object space: ") + e.what());
   }
   for (std::size_t i = 0; i < surfaces.size(); ++i) {
+    if (surfaces[i].mirror || surfaces[i].is_coordinate_break()) {
+      // The medium before it continues: after a mirror the light goes back into it.
+      surfaces[i].medium = i == 0 ? object_medium : surfaces[i - 1].medium;
+      continue;
+    }
     try {
       surfaces[i].medium = surfaces[i].material.resolve(catalogue);
     } catch (const GlassError& e) {
@@ -304,6 +385,9 @@ Prescription Prescription::scaled(double factor) const {
   Prescription p = *this;
   for (Surface& s : p.surfaces) {
     s.curvature_per_mm /= factor;
+    s.curvature_x_per_mm /= factor;
+    s.coordinate_break.decenter_x_mm *= factor;
+    s.coordinate_break.decenter_y_mm *= factor;
     s.thickness_mm *= factor;
     if (s.semi_diameter_mm) *s.semi_diameter_mm *= factor;
     if (s.aperture) {

@@ -9,6 +9,124 @@
 
 namespace lensmith {
 
+std::string_view to_string(SurfaceKind kind) {
+  switch (kind) {
+    case SurfaceKind::Standard: return "standard";
+    case SurfaceKind::Toroidal: return "toroidal";
+    case SurfaceKind::Biconic: return "biconic";
+    case SurfaceKind::CoordinateBreak: return "coordinate_break";
+  }
+  return "standard";
+}
+
+CoordinateBreak CoordinateBreak::inverse() const {
+  return CoordinateBreak{-decenter_x_mm, -decenter_y_mm, -tilt_x_deg, -tilt_y_deg, -tilt_z_deg, !tilt_first};
+}
+
+std::string CoordinateBreak::to_string() const {
+  char buffer[200];
+  std::snprintf(buffer, sizeof buffer, "decentre (%.6g, %.6g) mm, tilt (%.6g, %.6g, %.6g) deg, %s", decenter_x_mm, decenter_y_mm,
+                tilt_x_deg, tilt_y_deg, tilt_z_deg, tilt_first ? "tilt first" : "decentre first");
+  return buffer;
+}
+
+bool Surface::is_rotationally_symmetric() const {
+  switch (kind) {
+    case SurfaceKind::Standard:
+    case SurfaceKind::CoordinateBreak: return true;
+    case SurfaceKind::Toroidal:
+      // A toroid whose radius of rotation equals its y radius, without y terms, is a sphere.
+      return conic == 0.0 && !has_asphere() && curvature_x_per_mm == curvature_per_mm;
+    case SurfaceKind::Biconic: return curvature_x_per_mm == curvature_per_mm && conic_x == conic;
+  }
+  return true;
+}
+
+double Surface::paraxial_curvature_per_mm(Section section) const {
+  switch (kind) {
+    case SurfaceKind::Standard: return curvature_per_mm + 2.0 * even_asphere[0];
+    case SurfaceKind::CoordinateBreak: return 0.0;
+    case SurfaceKind::Toroidal: return section == Section::Y ? curvature_per_mm + 2.0 * even_asphere[0] : curvature_x_per_mm;
+    case SurfaceKind::Biconic: return section == Section::Y ? curvature_per_mm : curvature_x_per_mm;
+  }
+  return curvature_per_mm;
+}
+
+namespace {
+
+// The conic-plus-even-polynomial profile z(u), u = r^2, and dz/du (Standard surfaces, and a toroid's y curve
+// with u = y^2); false outside the conic's domain.
+bool profile(double c, double conic, const Surface::EvenAsphere& a, double u, double& z, double& dz_du) {
+  const double d = 1.0 - (1.0 + conic) * c * c * u;
+  if (!(d > 0.0)) return false;  // beyond the conic's rim, or on it where the slope is infinite
+  const double root = std::sqrt(d);
+  double q = 0.0, dq = 0.0;
+  for (std::size_t j = a.size(); j-- > 0;) {
+    dq = dq * u + q;
+    q = q * u + a[j];
+  }
+  z = c * u / (1.0 + root) + u * q;
+  dz_du = 0.5 * c / root + q + u * dq;
+  return std::isfinite(z) && std::isfinite(dz_du);
+}
+
+}  // namespace
+
+bool Surface::sag_and_slope(double x, double y, double& sag, double& dz_dx, double& dz_dy) const {
+  switch (kind) {
+    case SurfaceKind::CoordinateBreak:
+      sag = dz_dx = dz_dy = 0.0;
+      return true;
+    case SurfaceKind::Standard: {
+      double z = 0.0, dz_du = 0.0;
+      if (!profile(curvature_per_mm, conic, even_asphere, x * x + y * y, z, dz_du)) return false;
+      sag = z;
+      dz_dx = 2.0 * x * dz_du;
+      dz_dy = 2.0 * y * dz_du;
+      return true;
+    }
+    case SurfaceKind::Toroidal: {
+      double zy = 0.0, dzy_du = 0.0;
+      if (!profile(curvature_per_mm, conic, even_asphere, y * y, zy, dzy_du)) return false;
+      const double dzy = 2.0 * y * dzy_du;
+      if (curvature_x_per_mm == 0.0) {  // a cylinder: the y curve swept along x
+        sag = zy;
+        dz_dx = 0.0;
+        dz_dy = dzy;
+        return true;
+      }
+      const double radius = 1.0 / curvature_x_per_mm;
+      const double a = radius - zy;  // distance of the y curve from the axis of rotation
+      const double q2 = a * a - x * x;
+      if (!(q2 > 0.0)) return false;
+      const double q = std::sqrt(q2);
+      const double s = a > 0.0 ? 1.0 : -1.0;
+      // z = R - s q: at x = 0, z = R - |a| s = z_y.  dz/dx = s x / q, dz/dy = s a z_y' / q.
+      sag = radius - s * q;
+      dz_dx = s * x / q;
+      dz_dy = s * a * dzy / q;
+      return std::isfinite(sag);
+    }
+    case SurfaceKind::Biconic: {
+      const double cx = curvature_x_per_mm, cy = curvature_per_mm;
+      const double d = 1.0 - (1.0 + conic_x) * cx * cx * x * x - (1.0 + conic) * cy * cy * y * y;
+      if (d < 0.0) return false;
+      const double root = std::sqrt(d);
+      const double numerator = cx * x * x + cy * y * y;
+      const double denominator = 1.0 + root;
+      sag = numerator / denominator;
+      if (root == 0.0) return false;  // the rim of the domain: the slope is infinite
+      // dz/dx = (2 cx x (1 + S) - N dS/dx) / (1 + S)^2 with dS/dx = -(1 + kx) cx^2 x / S.
+      const double ds_dx = -(1.0 + conic_x) * cx * cx * x / root;
+      const double ds_dy = -(1.0 + conic) * cy * cy * y / root;
+      dz_dx = (2.0 * cx * x * denominator - numerator * ds_dx) / (denominator * denominator);
+      dz_dy = (2.0 * cy * y * denominator - numerator * ds_dy) / (denominator * denominator);
+      return std::isfinite(sag);
+    }
+  }
+  return false;
+}
+
 double Surface::radius_mm() const { return curvature_per_mm == 0.0 ? kInfinity : 1.0 / curvature_per_mm; }
 
 double Surface::max_semi_diameter_mm() const {
@@ -122,6 +240,20 @@ std::string Surface::to_string() const {
     s += " ]";
   }
   if (aperture) s += " aperture[" + aperture->to_string() + "]";
+  if (mirror) s += " MIRROR";
+  if (kind == SurfaceKind::Toroidal || kind == SurfaceKind::Biconic) {
+    std::snprintf(buffer, sizeof buffer, " %s Rx=%.6g", kind == SurfaceKind::Toroidal ? "toroidal" : "biconic",
+                  curvature_x_per_mm == 0.0 ? kInfinity : 1.0 / curvature_x_per_mm);
+    s += buffer;
+    if (kind == SurfaceKind::Biconic && conic_x != 0.0) {
+      std::snprintf(buffer, sizeof buffer, " kx=%.6g", conic_x);
+      s += buffer;
+    }
+  }
+  if (kind == SurfaceKind::CoordinateBreak) {
+    std::snprintf(buffer, sizeof buffer, "coordinate break: %s, t=%.6g mm", coordinate_break.to_string().c_str(), thickness_mm);
+    return buffer;
+  }
   return s;
 }
 

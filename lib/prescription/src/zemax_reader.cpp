@@ -173,6 +173,11 @@ struct ZmxSurface {
   int stop_line = 0;
   double conic = 0.0;
   std::vector<ParmRecord> parms;
+  std::vector<ParmRecord> xdat;  // TOROIDAL's extra data (XDAT index value)
+  bool mirror = false;           // GLAS MIRROR
+  // SCBD 1 (a tilt and decentre before the surface, as a coordinate break): order, dx, dy, tx, ty, tz.
+  std::optional<CoordinateBreak> break_before;  // in lens units until make_surface
+  int break_line = 0;
   std::string comment;
 };
 
@@ -421,15 +426,7 @@ class ZemaxParser {
       }
       return;
     }
-    if (k == "SCBD") {
-      // SCBD carries a tilt/decentre before or after the surface; its first field is a flag.
-      for (std::size_t i = 1; i < l.args.size(); ++i) {
-        if (number(l, i, "a decentre or tilt value") != 0.0) {
-          fail_at(l, l.args[i], "surface decentres and tilts are not supported (rotationally symmetric systems only)");
-        }
-      }
-      return;
-    }
+    if (k == "SCBD") return handle_scbd(l);
     if (contains(kRefusedApertureKeywords, k)) {
       fail(l.number, l.keyword.column,
            std::string(k) + ": spiders and user-defined apertures are not supported (circular, annular, rectangular and "
@@ -439,6 +436,13 @@ class ZemaxParser {
       // XDAT/YDAT are "index value ...": only the value matters. The others are values throughout.
       std::size_t first = 0;
       std::size_t last = l.args.size();
+      if (k == "XDAT" && !surfaces_.empty() && surfaces_.back().type == "TOROIDAL") {
+        // XDAT 1: the number of Zernike terms, 2: their normalisation radius, 3...: the terms.
+        ZmxSurface& s = surfaces_.back();
+        s.xdat.push_back(ParmRecord{integer(l, 0, "the extra-data number", 0, 1000), number(l, 1, "the extra-data value"), l.number,
+                                    l.args.size() > 1 ? l.args[1].column : 0});
+        return;
+      }
       if (k == "XDAT" || k == "YDAT") {
         first = 1;
         last = std::min<std::size_t>(2, last);
@@ -472,10 +476,9 @@ class ZemaxParser {
   void handle_type(const ZmxLine& l) {
     ZmxSurface& s = current_surface(l);
     const Token& t = required_arg(l, 0, "the surface type");
-    if (t.text != "STANDARD" && t.text != "EVENASPH") {
-      std::string why = "only STANDARD and EVENASPH surfaces are read";
+    if (t.text != "STANDARD" && t.text != "EVENASPH" && t.text != "COORDBRK" && t.text != "TOROIDAL" && t.text != "BICONICX") {
+      std::string why = "STANDARD, EVENASPH, TOROIDAL, BICONICX and COORDBRK surfaces are read";
       if (t.text == "QED_TYPE") why = "Forbes Q-type aspheres are not supported yet; " + why;
-      if (t.text == "COORDBRK") why = "coordinate breaks (tilts and decentres) are not supported; " + why;
       fail_at(l, t,
               "surface type " + shown_text(t.text) + " on SURF " + std::to_string(s.number) + " is not supported: " + why);
     }
@@ -500,8 +503,9 @@ class ZemaxParser {
     ZmxSurface& s = current_surface(l);
     const Token& t = required_arg(l, 0, "the glass name");
     if (ascii_upper(t.text) == "MIRROR") {
-      fail_at(l, t,
-              "mirrors are not supported (SURF " + std::to_string(s.number) + "; lensmith models refracting systems)");
+      s.mirror = true;
+      s.glass.reset();
+      return;
     }
     GlassRef g;
     g.name = std::string(t.text);
@@ -513,6 +517,38 @@ class ZemaxParser {
     if (l.args.size() > 4) g.vd = parse_finite_number(l.args[4].text);
     if (l.args.size() > 5) g.dpgf = parse_finite_number(l.args[5].text).value_or(0.0);
     s.glass = std::move(g);
+  }
+
+  // SCBD flag order dx dy tx ty tz ...: OpticStudio's surface tilt and decentre. Flag 1 is the coordinate
+  // change before the surface, which is a coordinate break before it; other flags (the change after the
+  // surface) are refused unless every value is zero.
+  void handle_scbd(const ZmxLine& l) {
+    ZmxSurface& s = current_surface(l);
+    const long long flag = integer(l, 0, "the tilt/decentre flag", 0, 1000);
+    std::array<double, 5> v{};
+    bool any = false;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      v[i] = l.args.size() > i + 3 ? number(l, i + 3, "a decentre or tilt value") : 0.0;
+      any = any || v[i] != 0.0;
+    }
+    for (std::size_t i = 8; i < l.args.size(); ++i) {
+      if (number(l, i, "a tilt/decentre value") != 0.0) any = true;
+    }
+    if (!any) return;
+    if (flag != 1) {
+      fail(l.number, l.keyword.column,
+           "SCBD: a tilt or decentre after SURF " + std::to_string(s.number) +
+               " is not supported (give it as a coordinate break surface after it)");
+    }
+    CoordinateBreak b;
+    b.tilt_first = l.args.size() > 1 && number(l, 1, "the order flag") != 0.0;
+    b.decenter_x_mm = v[0];
+    b.decenter_y_mm = v[1];
+    b.tilt_x_deg = v[2];
+    b.tilt_y_deg = v[3];
+    b.tilt_z_deg = v[4];
+    s.break_before = b;
+    s.break_line = l.number;
   }
 
   // CLAP/OBSC min max (circular aperture / obscuration, radii), SQAP/OBSQ x y (rectangular, half
@@ -564,6 +600,7 @@ class ZemaxParser {
       return;
     }
     ray_aiming_ = RayAiming::RealStop;
+    raim_line_ = l.number;
     if (type == 1) {
       note(l.number, "paraxial ray aiming (RAIM type 1) is read as real ray aiming: lensmith aims every ray onto the real "
                      "stop, which OpticStudio's paraxial aiming approximates");
@@ -779,12 +816,37 @@ class ZemaxParser {
                                 "); lensmith models a plane image surface");
     }
 
-    for (std::size_t k = 1; k + 1 < surfaces_.size(); ++k) p.surfaces.push_back(make_surface(surfaces_[k]));
+    for (std::size_t k = 1; k < surfaces_.size(); ++k) {
+      const ZmxSurface& z = surfaces_[k];
+      if (z.break_before) {
+        // A surface tilt/decentre before the surface: a coordinate break of zero thickness in front of it.
+        Surface b;
+        b.kind = SurfaceKind::CoordinateBreak;
+        b.coordinate_break = *z.break_before;
+        b.coordinate_break.decenter_x_mm = mm(b.coordinate_break.decenter_x_mm);
+        b.coordinate_break.decenter_y_mm = mm(b.coordinate_break.decenter_y_mm);
+        b.comment = "SCBD before SURF " + std::to_string(z.number);
+        if (p.surfaces.empty()) {
+          fail(z.break_line, 0, "SCBD: a tilt or decentre before the first lens surface is not supported");
+        }
+        // Thickness 0: the surface (or the image plane, before the image surface) sits at the break.
+        p.surfaces.push_back(b);
+        note(z.break_line, "SCBD: the tilt and decentre before SURF " + std::to_string(z.number) + " read as a coordinate break");
+      }
+      if (k + 1 < surfaces_.size()) p.surfaces.push_back(make_surface(z));
+    }
+    if (image.mirror) fail(image.line, 0, "the image surface (SURF " + std::to_string(image.number) + ") is a mirror");
 
     set_aperture(p);
     set_field(p);
     set_wavelengths(p);
     p.ray_aiming = ray_aiming_;
+    if (ray_aiming_ == RayAiming::RealStop && (p.has_mirrors() || !p.is_rotationally_symmetric())) {
+      note(raim_line_, "real ray aiming (RAIM) is implemented for rotationally symmetric refracting lenses; this system has " +
+                           std::string(p.has_mirrors() ? "mirrors" : "surfaces that are not rotationally symmetric") +
+                           ", so rays are aimed at the paraxial entrance pupil (OpticStudio's \"ray aiming off\")");
+      p.ray_aiming = RayAiming::ParaxialEntrancePupil;
+    }
     if (field_type_ && field_type_->telecentric) {
       p.object_space_telecentric = true;
       if (ray_aiming_ == RayAiming::RealStop) {
@@ -802,6 +864,8 @@ class ZemaxParser {
 
   Surface make_surface(const ZmxSurface& z) {
     Surface s;
+    if (z.type == "COORDBRK") return make_coordinate_break(z);
+    s.mirror = z.mirror;
     s.curvature_per_mm = z.curvature / mm_per_unit_;
     if (z.disz_infinite) {
       fail(z.disz_line, z.disz_column,
@@ -844,6 +908,11 @@ class ZemaxParser {
     }
     s.is_stop = z.stop;
     s.conic = z.conic;
+    if (z.type == "TOROIDAL" || z.type == "BICONICX") {
+      set_toroidal_or_biconic(z, s);
+      s.comment = z.comment;
+      return s;
+    }
     for (const ParmRecord& parm : z.parms) {
       if (parm.value == 0.0) continue;
       if (z.type != "EVENASPH") {
@@ -863,6 +932,63 @@ class ZemaxParser {
     }
     s.comment = z.comment;
     return s;
+  }
+
+  // COORDBRK: PARM 1, 2 decentre x, y (lens units); PARM 3, 4, 5 tilt about x, y, z (degrees); PARM 6 the
+  // order (0 decentre then tilt, else tilt then decentre). No shape, glass or stop.
+  Surface make_coordinate_break(const ZmxSurface& z) {
+    Surface s;
+    s.kind = SurfaceKind::CoordinateBreak;
+    if (z.glass || z.mirror) fail(z.line, 0, "SURF " + std::to_string(z.number) + ": a coordinate break (COORDBRK) has no glass or mirror");
+    if (z.stop) fail(z.stop_line, 0, "STOP on a coordinate break (SURF " + std::to_string(z.number) + ")");
+    if (z.disz_infinite) fail(z.disz_line, z.disz_column, "DISZ INFINITY on SURF " + std::to_string(z.number));
+    s.thickness_mm = mm(*z.disz);
+    for (const ParmRecord& parm : z.parms) {
+      CoordinateBreak& b = s.coordinate_break;
+      switch (parm.index) {
+        case 1: b.decenter_x_mm = mm(parm.value); break;
+        case 2: b.decenter_y_mm = mm(parm.value); break;
+        case 3: b.tilt_x_deg = parm.value; break;
+        case 4: b.tilt_y_deg = parm.value; break;
+        case 5: b.tilt_z_deg = parm.value; break;
+        case 6: b.tilt_first = parm.value != 0.0; break;
+        default:
+          if (parm.value != 0.0) {
+            fail(parm.line, parm.column, "PARM " + std::to_string(parm.index) + " of a coordinate break (SURF " + std::to_string(z.number) +
+                                             "): only PARM 1-6 (decentres, tilts, order) exist");
+          }
+      }
+    }
+    s.comment = z.comment;
+    return s;
+  }
+
+  // TOROIDAL: PARM 1 the radius of rotation (0: infinite, a cylinder), PARM 2..8 the y^2 ... y^14 terms;
+  // XDAT 1 the number of Zernike terms (must be 0). BICONICX: PARM 1 the x radius (0: flat), PARM 2 the x conic.
+  void set_toroidal_or_biconic(const ZmxSurface& z, Surface& s) {
+    const bool toroidal = z.type == "TOROIDAL";
+    s.kind = toroidal ? SurfaceKind::Toroidal : SurfaceKind::Biconic;
+    for (const ParmRecord& parm : z.parms) {
+      if (parm.index == 1) {
+        s.curvature_x_per_mm = parm.value == 0.0 ? 0.0 : 1.0 / mm(parm.value);
+      } else if (!toroidal && parm.index == 2) {
+        s.conic_x = parm.value;
+      } else if (toroidal && parm.index >= 2 && parm.index <= 8) {
+        // PARM j (j >= 2) is the y^(2 (j - 1)) coefficient, lens-unit^(1 - 2 (j - 1)).
+        const auto power = static_cast<int>(parm.index) - 1;
+        s.even_asphere[static_cast<std::size_t>(power - 1)] = parm.value * std::pow(mm_per_unit_, 1 - 2 * power);
+      } else if (parm.value != 0.0) {
+        fail(parm.line, parm.column,
+             "PARM " + std::to_string(parm.index) + " = " + format_number(parm.value) + " on " + z.type + " SURF " + std::to_string(z.number) +
+                 (toroidal ? ": a toroidal surface reads PARM 1 (radius of rotation) and PARM 2-8 (y^2 ... y^14 terms)"
+                           : ": a biconic surface reads PARM 1 (x radius) and PARM 2 (x conic)"));
+      }
+    }
+    for (const ParmRecord& x : z.xdat) {
+      if (x.index == 2 || x.value == 0.0) continue;  // the normalisation radius of no Zernike terms
+      fail(x.line, x.column, "XDAT " + std::to_string(x.index) + " on TOROIDAL SURF " + std::to_string(z.number) +
+                                 ": Zernike terms on a toroidal surface are not supported");
+    }
   }
 
   void set_aperture(Prescription& p) {
@@ -900,19 +1026,23 @@ class ZemaxParser {
                  : type == 2 ? FieldSpec::Kind::ImageHeightMm
                              : FieldSpec::Kind::RealImageHeightMm;
     bool folded = false;
+    const bool symmetric = p.is_rotationally_symmetric();
     for (std::size_t i = 0; i < count; ++i) {
       const double y = i < y_fields_.size() ? y_fields_[i].value : 0.0;
       const double x = i < x_fields_.size() ? x_fields_[i].value : 0.0;
       double radial = y;
       if (x != 0.0) {
         folded = true;
-        radial = radial_field_value(field.kind, x, y);  // what a rotationally symmetric lens sees
+        if (symmetric) radial = radial_field_value(field.kind, x, y);  // what a rotationally symmetric lens sees
       }
       field.values.push_back(type == 0 ? radial : mm(radial));
     }
-    if (folded) {
+    if (folded && symmetric) {
       note(field_line_,
            "fields with an x component were folded into radial fields (the lens is rotationally symmetric)");
+    } else if (folded) {
+      warn(field_line_, "the fields' x components are not used (lensmith's field points lie along y; fields off the y-z plane "
+                        "of a system that is not rotationally symmetric are not implemented): their y components are read");
     }
     // Vignetting factors of the fields in use, when any is not zero.
     auto factor = [&](const char* key, std::size_t i) {
@@ -1009,6 +1139,7 @@ class ZemaxParser {
   std::map<std::string, std::vector<Located>> vignetting_;  // VDXN, VDYN, VCXN, VCYN, VANN
   int vignetting_line_ = 0;
   RayAiming ray_aiming_ = RayAiming::ParaxialEntrancePupil;
+  int raim_line_ = 0;
   std::map<int, Located> wavm_;
   std::vector<Located> wavl_;
   std::optional<Located> primary_;

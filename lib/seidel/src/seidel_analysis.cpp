@@ -118,6 +118,11 @@ SeidelAnalysis::SeidelAnalysis(const Prescription& lens, const SeidelOptions& op
         options.validate();
         Prescription p = with_overrides(lens, options);
         p.validate();
+        if (const auto why = p.why_not_rotationally_symmetric()) {
+          // Third-order theory expands the aberrations of a rotationally symmetric system (mirrors included).
+          throw ComputationError("Seidel sums do not apply: the system is not rotationally symmetric (" + *why +
+                                 "); use real-ray analyses (spot, fan) instead");
+        }
         if (!p.field) {
           throw PrescriptionError("Seidel sums need a field (the chief ray): the lens gives none; pass a field angle or object height");
         }

@@ -19,7 +19,9 @@
 #include <stdexcept>
 
 #include "lensmith/core/errors.h"
+#include "lensmith/core/units.h"
 #include "lensmith/paraxial/paraxial_system.h"
+#include "lensmith/trace/surface_frames.h"
 
 namespace lensmith {
 
@@ -57,7 +59,8 @@ constexpr double kUnitTolerance = 1e-14;
 // as much as tracing a few hundred rays.
 constexpr std::ptrdiff_t kParallelBatchThreshold = 256;
 
-enum class Shape : std::uint8_t { Plane, Sphere, Conic, Asphere };
+// General: a toroid or biconic, intersected through Surface::sag_and_slope (the general path only).
+enum class Shape : std::uint8_t { Plane, Sphere, Conic, Asphere, General };
 
 // What the inner loop needs of a surface, precomputed once.
 struct SurfaceGeometry {
@@ -71,6 +74,8 @@ struct SurfaceGeometry {
   bool has_aperture = false;                 // an explicit (non-circular, annular, obscuring or decentred) aperture
   SurfaceAperture aperture;                  // used when has_aperture
   double aperture_tolerance_mm = 0.0;        // its rim tolerance
+  bool is_break = false;                     // a coordinate break: no interaction (general path)
+  bool mirror = false;                       // reflects (general path)
 };
 
 // A ray in the inner loop: position (global frame), unit direction, optical path so far.
@@ -377,8 +382,88 @@ inline RayStatus intersect(const SurfaceGeometry& g, const State& r, double sens
     }
     case Shape::Asphere:
       return intersect_asphere(g, r, sense, hit);
+    case Shape::General:
+      return RayStatus::Missed;  // intersect_general (needs the Surface)
   }
   return RayStatus::Missed;
+}
+
+// Newton's method on the ray's height above a shape given by Surface::sag_and_slope (a toroid or biconic),
+// vertex at the local origin: G(t) = z(t) - sag(x(t), y(t)), G'(t) = n - sag_x l - sag_y m, from the vertex
+// plane's crossing; where Newton fails, the sign change of G nearest that start (samples spaced geometrically
+// either side) refined by bisection. The crossing must go in the direction of travel (`sense` N.d > 0).
+RayStatus intersect_general(const Surface& shape, const State& r, double sense, Hit& hit) {
+  auto height = [&](double t, double& value, double& derivative, double& sx, double& sy) {
+    const double x = r.x + t * r.l, y = r.y + t * r.m;
+    double sag = 0.0;
+    if (!shape.sag_and_slope(x, y, sag, sx, sy)) return false;
+    value = r.z + t * r.n - sag;
+    derivative = r.n - sx * r.l - sy * r.m;
+    return std::isfinite(value);
+  };
+  double t = r.n != 0.0 ? -r.z / r.n : 0.0;
+  double value = 0.0, derivative = 0.0, sx = 0.0, sy = 0.0;
+  bool converged = false;
+  for (int iteration = 0; iteration < kMaxNewtonIterations; ++iteration) {
+    if (!height(t, value, derivative, sx, sy) || derivative == 0.0) break;
+    const double step = value / derivative;
+    if (!std::isfinite(step)) break;
+    t -= step;
+    if (std::abs(step) <= kAsphereStepTolerance_mm) {
+      converged = height(t, value, derivative, sx, sy);
+      break;
+    }
+  }
+  auto finish = [&](double at) {
+    double v = 0.0, d = 0.0, gx = 0.0, gy = 0.0;
+    if (!height(at, v, d, gx, gy)) return false;
+    const double inverse_length = 1.0 / std::sqrt(gx * gx + gy * gy + 1.0);
+    hit.t = at;
+    hit.nx = -gx * inverse_length;
+    hit.ny = -gy * inverse_length;
+    hit.nz = inverse_length;
+    hit.cos_i = hit.nx * r.l + hit.ny * r.m + hit.nz * r.n;
+    hit.cos_i_squared = hit.cos_i * hit.cos_i;
+    return sense * hit.cos_i > 0.0;
+  };
+  if (converged && finish(t)) return RayStatus::Ok;
+  // Fallback: samples either side of the start; the change of sense G from < 0 (before the surface) to >= 0
+  // (after it) along +t nearest the start, refined by bisection.
+  const double start = r.n != 0.0 ? -r.z / r.n : 0.0;
+  constexpr int kSamples = 2 * kBracketDoublings + 1;
+  std::array<double, kSamples> ts{};
+  std::array<double, kSamples> gs{};
+  std::array<bool, kSamples> valid{};
+  ts[0] = start;
+  for (int j = 0; j < kBracketDoublings; ++j) {
+    ts[static_cast<std::size_t>(2 * j + 1)] = start - std::ldexp(kBracketFirstStep_mm, j);
+    ts[static_cast<std::size_t>(2 * j + 2)] = start + std::ldexp(kBracketFirstStep_mm, j);
+  }
+  std::sort(ts.begin(), ts.end());
+  for (std::size_t i = 0; i < ts.size(); ++i) {
+    double d = 0.0;
+    valid[i] = height(ts[i], gs[i], d, sx, sy);
+    gs[i] *= sense;
+  }
+  double best_a = 0.0, best_b = 0.0, best_distance = kInfinity;
+  for (std::size_t i = 0; i + 1 < ts.size(); ++i) {
+    if (valid[i] && valid[i + 1] && gs[i] < 0.0 && gs[i + 1] >= 0.0) {
+      const double distance = std::min(std::abs(ts[i] - start), std::abs(ts[i + 1] - start));
+      if (distance < best_distance) {
+        best_distance = distance;
+        best_a = ts[i];
+        best_b = ts[i + 1];
+      }
+    }
+  }
+  if (!(best_distance < kInfinity)) return RayStatus::Missed;
+  for (int iteration = 0; iteration < kMaxFalsiIterations && best_b - best_a > kAsphereStepTolerance_mm; ++iteration) {
+    const double mid = 0.5 * (best_a + best_b);
+    double g = 0.0, d = 0.0;
+    if (!height(mid, g, d, sx, sy)) return RayStatus::NotConverged;
+    (sense * g < 0.0 ? best_a : best_b) = mid;
+  }
+  return finish(0.5 * (best_a + best_b)) ? RayStatus::Ok : RayStatus::NotConverged;
 }
 
 }  // namespace
@@ -397,6 +482,14 @@ struct TracerCore {
   std::vector<SurfaceGeometry> surfaces;
   std::vector<Glass> media;  // [0] object space, [k] after surface k
   double image_plane_z_mm = 0.0;
+  // The general path (docs/trace.md, "Mirrors, coordinate breaks, toroids"): surfaces in their own frames
+  // (vertex at the local origin, SurfaceGeometry::z_vertex_mm 0), the shapes Surface knows, the image plane's
+  // frame and the direction light reaches it (+1: toward its +z).
+  bool general = false;
+  std::vector<SurfaceFrame> frames;
+  std::vector<Surface> shapes;
+  SurfaceFrame image_frame;
+  double image_sense = 1.0;
 
   // Row layout for N surfaces: n_0..n_N, then mu_forward_k = n_(k-1) / n_k and mu_backward_k = n_k / n_(k-1)
   // for k = 1..N, so the loop does no division for the index ratio.
@@ -618,6 +711,143 @@ RayStatus propagate(const Core& impl, State& r, double wavelength_nm, const doub
   return status;
 }
 
+// ---- The general path: mirrors, coordinate breaks, toroids and biconics --------------------------------
+// Each surface is met in its own frame: the ray is carried into it, intersected there (the side it comes
+// from is the sign of its local z direction, so a ray that a mirror or a tilt sends back meets the next
+// surface from behind as it should), clipped in the local x-y plane, refracted (vector Snell, as above) or
+// reflected (d' = d - 2 (d.N) N), and carried back. Coordinate breaks do not touch the ray. Forward rays end
+// on the image plane in the image frame (x, y as there; z = image_plane_z_mm, travelling +z: after an odd
+// number of reflections the frame's z is reversed, so that every analysis sees light going +z).
+
+// Frames that are only moved along the axis (coaxial mirror systems, the surfaces between breaks that turn
+// nothing) are entered by a subtraction.
+inline bool unturned(const SurfaceFrame& f) { return f.axes.isIdentity(0.0); }
+
+inline void to_frame(const SurfaceFrame& f, State& r) {
+  if (f.origin_mm.x() == 0.0 && f.origin_mm.y() == 0.0 && unturned(f)) {
+    r.z -= f.origin_mm.z();
+    return;
+  }
+  const Eigen::Vector3d p = f.to_local(Eigen::Vector3d(r.x, r.y, r.z));
+  const Eigen::Vector3d d = f.axes.transpose() * Eigen::Vector3d(r.l, r.m, r.n);
+  r.x = p.x(); r.y = p.y(); r.z = p.z();
+  r.l = d.x(); r.m = d.y(); r.n = d.z();
+}
+
+inline void from_frame(const SurfaceFrame& f, State& r) {
+  if (f.origin_mm.x() == 0.0 && f.origin_mm.y() == 0.0 && unturned(f)) {
+    r.z += f.origin_mm.z();
+    return;
+  }
+  const Eigen::Vector3d p = f.to_global(Eigen::Vector3d(r.x, r.y, r.z));
+  const Eigen::Vector3d d = f.axes * Eigen::Vector3d(r.l, r.m, r.n);
+  r.x = p.x(); r.y = p.y(); r.z = p.z();
+  r.l = d.x(); r.m = d.y(); r.n = d.z();
+}
+
+template <bool kForward, bool kRecord>
+RayStatus propagate_general(const Core& impl, State& r, double wavelength_nm, const double* table, int& surface,
+                            std::vector<SurfaceHit>* path, bool clip = true) {
+  const int count = static_cast<int>(impl.count());
+  auto index_of = [&](std::size_t medium) { return table ? table[medium] : impl.media[medium].index(wavelength_nm); };
+  if constexpr (!kForward) {
+    // From the image plane's output frame (z reversed when light arrives toward -z) into global coordinates.
+    r.z = impl.image_sense * (r.z - impl.image_plane_z_mm);
+    r.n *= impl.image_sense;
+    from_frame(impl.image_frame, r);
+  }
+  double n_current = index_of(kForward ? 0 : impl.count());
+  for (int step = 0; step < count; ++step) {
+    const int k = kForward ? step : count - 1 - step;
+    const SurfaceGeometry& g = impl.surfaces[static_cast<std::size_t>(k)];
+    const SurfaceFrame& frame = impl.frames[static_cast<std::size_t>(k)];
+    if (g.is_break) {
+      if constexpr (kRecord) {
+        path->push_back(SurfaceHit{k + 1, Eigen::Vector3d(r.x, r.y, r.z), Eigen::Vector3d(r.l, r.m, r.n), frame.axes.col(2), r.opl});
+      }
+      continue;
+    }
+    State local = r;
+    to_frame(frame, local);
+    const double sense = local.n > 0.0 ? 1.0 : -1.0;
+    Hit hit{};
+    RayStatus status = RayStatus::Ok;
+    if (local.n == 0.0 && g.shape == Shape::Plane) {
+      status = RayStatus::Missed;
+    } else if (g.shape == Shape::General) {
+      status = intersect_general(impl.shapes[static_cast<std::size_t>(k)], local, sense, hit);
+    } else {
+      status = intersect(g, local, sense, hit);
+    }
+    if (status != RayStatus::Ok) {
+      surface = k + 1;
+      return status;
+    }
+    local.x += hit.t * local.l;
+    local.y += hit.t * local.m;
+    local.z += hit.t * local.n;
+    local.opl += n_current * hit.t;
+    auto record = [&]() {
+      if constexpr (kRecord) {
+        State global = local;
+        from_frame(frame, global);
+        path->push_back(SurfaceHit{k + 1, Eigen::Vector3d(global.x, global.y, global.z), Eigen::Vector3d(global.l, global.m, global.n),
+                                   frame.axes * Eigen::Vector3d(hit.nx, hit.ny, hit.nz), global.opl});
+      }
+    };
+    if (clip && (local.x * local.x + local.y * local.y > g.clip_radius2_mm2 ||
+                 (g.has_aperture && !g.aperture.passes(local.x, local.y, g.aperture_tolerance_mm)))) {
+      record();
+      r = local;
+      from_frame(frame, r);
+      surface = k + 1;
+      return RayStatus::Vignetted;
+    }
+    const double n_next = index_of(kForward ? static_cast<std::size_t>(k) + 1 : static_cast<std::size_t>(k));
+    if (g.mirror) {
+      const double twice = 2.0 * hit.cos_i;
+      local.l -= twice * hit.nx;
+      local.m -= twice * hit.ny;
+      local.n -= twice * hit.nz;
+    } else if (n_next != n_current) {
+      const double mu = n_current / n_next;
+      const double mu2 = mu * mu;
+      const double radicand = (1.0 - mu2) + mu2 * hit.cos_i_squared;
+      if (radicand < 0.0) {
+        record();
+        r = local;
+        from_frame(frame, r);
+        surface = k + 1;
+        return RayStatus::TotalInternalReflection;
+      }
+      const double cos_r = std::sqrt(radicand);
+      const double gamma = (hit.cos_i >= 0.0 ? cos_r : -cos_r) - mu * hit.cos_i;
+      local.l = mu * local.l + gamma * hit.nx;
+      local.m = mu * local.m + gamma * hit.ny;
+      local.n = mu * local.n + gamma * hit.nz;
+    }
+    n_current = n_next;
+    record();
+    r = local;
+    from_frame(frame, r);
+  }
+  if constexpr (kForward) {
+    State local = r;
+    to_frame(impl.image_frame, local);
+    if (!(local.n * impl.image_sense > 0.0)) {
+      surface = count + 1;
+      return RayStatus::Missed;
+    }
+    const double t = -local.z / local.n;
+    local.x += t * local.l;
+    local.y += t * local.m;
+    local.opl += n_current * t;
+    r = State{local.x, local.y, impl.image_plane_z_mm, local.l, local.m, impl.image_sense * local.n, local.opl};
+  }
+  surface = 0;
+  return RayStatus::Ok;
+}
+
 // Loads a ray into the loop state; false for NaN/infinite values, a zero direction or a wavelength
 // that is not > 0. A direction that is not unit length is normalised.
 inline bool load(double x, double y, double z, double l, double m, double n, double wavelength_nm, State& s) {
@@ -716,6 +946,25 @@ SequentialTracer::SequentialTracer(const Prescription& lens, const TracerOptions
   image_plane_z_mm_ = vertex_z_mm_.back() + image_distance_mm;
 
   auto impl = std::make_shared<Impl>();
+  impl->general = lens_.has_mirrors() || std::any_of(lens_.surfaces.begin(), lens_.surfaces.end(), [](const Surface& s) {
+                    return s.kind != SurfaceKind::Standard;
+                  });
+  if (impl->general) {
+    const LensFrames frames = surface_frames(lens_, image_distance_mm);
+    impl->frames = frames.surfaces;
+    impl->image_frame = frames.image;
+    impl->shapes = lens_.surfaces;
+    // The output z of the image plane: the path length along the unfolded axis (thicknesses after an odd
+    // number of mirrors count with their sign reversed), and light reaches it toward +z or -z of its frame
+    // as the number of reflections says (a probe below corrects that for tilted image planes).
+    double sense = 1.0, unfolded = 0.0;
+    for (std::size_t k = 0; k < count; ++k) {
+      if (lens_.surfaces[k].mirror) sense = -sense;
+      unfolded += sense * (k + 1 == count ? image_distance_mm : lens_.surfaces[k].thickness_mm);
+    }
+    image_plane_z_mm_ = unfolded;
+    impl->image_sense = sense;
+  }
   impl->image_plane_z_mm = image_plane_z_mm_;
   impl->media.reserve(count + 1);
   impl->media.push_back(lens_.object_medium);
@@ -732,7 +981,14 @@ SequentialTracer::SequentialTracer(const Prescription& lens, const TracerOptions
     for (std::size_t j = 0; j < s.even_asphere.size(); ++j) {
       if (s.even_asphere[j] != 0.0) g.asphere_terms = static_cast<int>(j) + 1;
     }
-    if (g.asphere_terms > 0) {
+    g.is_break = s.is_coordinate_break();
+    g.mirror = s.mirror;
+    if (impl->general) g.z_vertex_mm = 0.0;  // the frames place the surfaces
+    if (s.kind == SurfaceKind::Toroidal || s.kind == SurfaceKind::Biconic) {
+      g.shape = Shape::General;
+    } else if (g.is_break) {
+      g.shape = Shape::Plane;
+    } else if (g.asphere_terms > 0) {
       g.shape = Shape::Asphere;
     } else if (s.curvature_per_mm == 0.0) {
       g.shape = Shape::Plane;  // the conic constant of a plane changes nothing
@@ -754,6 +1010,22 @@ SequentialTracer::SequentialTracer(const Prescription& lens, const TracerOptions
   impl->rows.assign(Core::kMaxEntries * impl->stride, 0.0);
   // The prescription's wavelengths are the common case: put them in the table now.
   for (double w : lens_.wavelengths_nm) impl->indices(w);
+  if (impl->general) {
+    // Which way light reaches the image plane: that of a ray along the object-space axis (from the front of
+    // surface 1, apertures ignored), where it gets there; the count of reflections otherwise.
+    auto reaches_image = [&]() {
+      State probe{0.0, 0.0, -1.0, 0.0, 0.0, 1.0, 0.0};
+      int died = 0;
+      const double w = lens_.primary_wavelength_nm();
+      const RayStatus st = propagate_general<true, false>(*impl, probe, w, impl->indices(w), died, nullptr, false);
+      return st == RayStatus::Ok || died != static_cast<int>(count) + 1;
+    };
+    const double parity = impl->image_sense;
+    if (!reaches_image()) {
+      impl->image_sense = -parity;
+      if (!reaches_image()) impl->image_sense = parity;
+    }
+  }
   impl_ = std::move(impl);
 }
 
@@ -763,6 +1035,19 @@ double SequentialTracer::vertex_z_mm(int surface) const {
                             std::to_string(vertex_z_mm_.size()));
   }
   return vertex_z_mm_[static_cast<std::size_t>(surface) - 1];
+}
+
+SurfaceFrame SequentialTracer::surface_frame(int surface) const {
+  const double z = vertex_z_mm(surface);  // checks the range
+  if (impl_->general) return impl_->frames[static_cast<std::size_t>(surface) - 1];
+  SurfaceFrame f;
+  f.origin_mm = Eigen::Vector3d(0.0, 0.0, z);
+  return f;
+}
+
+Eigen::Vector3d SequentialTracer::image_point_in_global_frame(const Eigen::Vector3d& p) const {
+  if (!impl_->general) return p;
+  return impl_->image_frame.to_global(Eigen::Vector3d(p.x(), p.y(), impl_->image_sense * (p.z() - impl_->image_plane_z_mm)));
 }
 
 double SequentialTracer::index_after(int surface, double wavelength_nm) const {
@@ -788,8 +1073,13 @@ TraceResult trace_one(const Core& impl, const Ray& ray, std::vector<SurfaceHit>*
   }
   const double* table = impl.indices(ray.wavelength_nm);
   int surface = 0;
-  result.status = path ? propagate<kForward, true>(impl, s, ray.wavelength_nm, table, surface, path)
-                       : propagate<kForward, false>(impl, s, ray.wavelength_nm, table, surface, nullptr);
+  if (impl.general) {
+    result.status = path ? propagate_general<kForward, true>(impl, s, ray.wavelength_nm, table, surface, path)
+                         : propagate_general<kForward, false>(impl, s, ray.wavelength_nm, table, surface, nullptr);
+  } else {
+    result.status = path ? propagate<kForward, true>(impl, s, ray.wavelength_nm, table, surface, path)
+                         : propagate<kForward, false>(impl, s, ray.wavelength_nm, table, surface, nullptr);
+  }
   result.surface = surface;
   result.ray.position_mm = Eigen::Vector3d(s.x, s.y, s.z);
   result.ray.direction = Eigen::Vector3d(s.l, s.m, s.n);
@@ -815,6 +1105,33 @@ void trace_many(const Core& impl, const RayBatchView& batch) {
   const double* const wavelength = batch.wavelength_nm;
   RayStatus* const status = batch.status;
   int* const surface = batch.surface;
+  // Ray i's result into the caller's arrays.
+  auto store = [&](std::ptrdiff_t i, const State& s, RayStatus st, int died_at) {
+    status[i] = st;
+    surface[i] = st == RayStatus::Ok || st == RayStatus::InvalidInput ? 0 : died_at;
+    x_out[i * out] = s.x;
+    y_out[i * out] = s.y;
+    z_out[i * out] = s.z;
+    l_out[i * out] = s.l;
+    m_out[i * out] = s.m;
+    n_out[i * out] = s.n;
+  };
+  if (impl.general) {
+    // One ray at a time through the frames (no lanes: the frame changes dominate).
+#pragma omp parallel for schedule(static) if (count >= kParallelBatchThreshold)
+    for (std::ptrdiff_t i = 0; i < count; ++i) {
+      State s{};
+      int died_at = 0;
+      RayStatus st = RayStatus::InvalidInput;
+      if (load(x[i * in], y[i * in], z[i * in], l[i * in], m[i * in], n[i * in], wavelength[i * w], s)) {
+        st = propagate_general<kForward, false>(impl, s, wavelength[i * w], impl.indices(wavelength[i * w]), died_at, nullptr);
+      } else {
+        s = State{x[i * in], y[i * in], z[i * in], l[i * in], m[i * in], n[i * in], 0.0};
+      }
+      store(i, s, st, died_at);
+    }
+    return;
+  }
 #pragma omp parallel for schedule(static) if (count >= kParallelBatchThreshold)
   for (std::ptrdiff_t group = 0; group < groups; ++group) {
     const std::ptrdiff_t first = group * kLanes;
@@ -861,15 +1178,7 @@ void trace_many(const Core& impl, const RayBatchView& batch) {
           if (lane_status[lane] != RayStatus::Ok) died_at[lane] = surfaces + 1;
         }
       }
-      const State& s = walkers[lane].r;
-      status[i] = lane_status[lane];
-      surface[i] = lane_status[lane] == RayStatus::Ok ? 0 : died_at[lane];
-      x_out[i * out] = s.x;
-      y_out[i * out] = s.y;
-      z_out[i * out] = s.z;
-      l_out[i * out] = s.l;
-      m_out[i * out] = s.m;
-      n_out[i * out] = s.n;
+      store(i, walkers[lane].r, lane_status[lane], died_at[lane]);
     }
   }
 }

@@ -4,6 +4,7 @@
 // ch. 1 draws lenses this way; OpticStudio's "Cross-Section" layout). Plain data for lensmith/plot.
 #pragma once
 
+#include <array>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -34,6 +35,7 @@ struct LayoutSurface {
   bool semi_diameter_given = false;     // false: estimated from the rays as above
   bool is_stop = false;
   bool glass_after = false;             // the medium after this surface is not air
+  bool mirror = false;                  // reflects (drawn as a solid line)
   std::vector<LayoutPoint> profile;     // the sag curve from -semi_diameter to +semi_diameter
   double edge_z_mm() const;             // z of the profile's ends (vertex + sag at the semi-diameter)
 };
@@ -65,6 +67,9 @@ struct LensLayout {
   std::optional<int> stop_surface;   // 1-based, the paraxial stop
   double image_plane_z_mm = 0.0;
   double image_half_height_mm = 0.0;  // the image plane is drawn from -this to +this
+  // The drawn image plane's two ends in the global section (on the line z = image_plane_z_mm of a coaxial
+  // lens; where the plane lies in a folded or tilted system).
+  std::array<LayoutPoint, 2> image_plane_ends{};
   double total_track_mm = 0.0;        // first vertex to the image plane
   std::vector<LayoutRay> rays;        // per field, rays_per_field rays from py = -1 to +1
   std::string to_string() const;      // elements, stop, total track: a short text summary

@@ -47,9 +47,17 @@ struct Pupil {
   double magnification = 1.0;  // pupil diameter / stop diameter (paraxial, signed: < 0 = inverted image of the stop)
 };
 
+// Mirrors are unfolded as OpticStudio's paraxial trace does: after a reflection the index changes sign
+// (n' = -n; thicknesses after an odd number of mirrors are negative), so a mirror of curvature c has the
+// power -2 n c and every formula below holds as for a lens. Coordinate breaks are ignored (OpticStudio's
+// default, "Paraxial: ignore coordinate breaks"): the first-order data of a folded or tilted system are those
+// of the same surfaces on one axis. Toroidal and biconic surfaces are taken in one section.
 struct ParaxialOptions {
   double wavelength_nm = 0.0;                 // 0 = the prescription's primary wavelength
   std::optional<double> object_distance_mm;   // empty = the prescription's (mm, +inf = infinity)
+  // The section of toroidal and biconic surfaces: y (tangential, OpticStudio's paraxial section) or x. A
+  // rotationally symmetric lens is the same in both.
+  Section section = Section::Y;
   void validate() const;                      // throws OptionsError
 };
 
@@ -148,6 +156,8 @@ class ParaxialSystem {
   double z_rear_nodal_mm_ = 0.0;
   std::optional<double> stop_semi_diameter_mm_;  // the stop's clear semi-diameter, when given
   bool telecentric_ = false;                     // object-space telecentric: the entrance pupil at infinity
+  bool mirrors_ = false;                         // mirrors unfolded (the listing says so)
+  bool breaks_ignored_ = false;                  // tilting or decentring coordinate breaks ignored (the listing says so)
   std::string field_description_;    // the maximum field as the prescription states it, for to_string()
 };
 

@@ -116,8 +116,19 @@ struct Prescription {
   double primary_wavelength_nm() const { return wavelengths_nm.at(primary_wavelength_index); }
   // 0-based index of the surface flagged as stop, or empty when none is flagged.
   std::optional<std::size_t> flagged_stop_index() const;
-  // z of the vertex of surface k (0-based index), mm, z = 0 at surface 1.
+  // z of the vertex of surface k (0-based index), mm, z = 0 at surface 1: the sum of the thicknesses before
+  // it. In a coaxial system (no tilted or decentred coordinate break) that is where the vertex lies, mirrors
+  // included (after a mirror thicknesses are negative); otherwise it is a position along the folded path
+  // only, and surface_frames (lensmith/trace/surface_frames.h) places the surfaces.
   double vertex_z_mm(std::size_t surface_index) const;
+  bool has_mirrors() const;
+  // No coordinate break decentres or tilts anything: every surface is centred on one z axis.
+  bool is_coaxial() const;
+  // Coaxial, and every surface rotationally symmetric (no toroid or biconic with unequal sections): what
+  // third-order (Seidel) theory and the rotationally symmetric analyses and fits assume.
+  bool is_rotationally_symmetric() const;
+  // Why not, naming the first surface that breaks the symmetry ("surface 3 is toroidal"); empty when it is.
+  std::optional<std::string> why_not_rotationally_symmetric() const;
   // z of the last vertex, mm.
   double last_vertex_z_mm() const;
 
@@ -136,7 +147,8 @@ struct Prescription {
   // edge check; surfaces without one are checked at the vertex only.
   Diagnostics geometry_warnings() const;
 
-  // Resolves every MaterialSpec against `catalogue` (throws GlassError with the surface number).
+  // Resolves every MaterialSpec against `catalogue` (throws GlassError with the surface number). Mirrors
+  // and coordinate breaks take the medium before them.
   void resolve_materials(const GlassCatalog& catalogue);
 
   // Every length multiplied by `factor` > 0 (radii, thicknesses, semi-diameters, aspheric terms,

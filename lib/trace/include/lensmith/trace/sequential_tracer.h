@@ -13,6 +13,7 @@
 
 #include "lensmith/prescription/prescription.h"
 #include "lensmith/trace/ray.h"
+#include "lensmith/trace/surface_frames.h"
 
 namespace lensmith {
 
@@ -115,6 +116,11 @@ class SequentialTracer {
   double image_plane_z_mm() const { return image_plane_z_mm_; }
   // Index of the medium after surface k (k = 0: object space) at a wavelength.
   double index_after(int surface, double wavelength_nm) const;
+  // Where surface k (1-based) lies: its vertex and axes in the global frame (on the z axis, unturned, for a
+  // coaxial lens; docs/trace.md, "Mirrors, coordinate breaks, toroids").
+  SurfaceFrame surface_frame(int surface) const;
+  // A point of the image plane's output frame (TraceResult::ray of a forward trace) in the global frame.
+  Eigen::Vector3d image_point_in_global_frame(const Eigen::Vector3d& output_point_mm) const;
 
  private:
   Prescription lens_;
