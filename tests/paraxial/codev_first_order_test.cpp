@@ -96,3 +96,13 @@ TEST_CASE("CODE V Smith Cooke triplet: EFL, BFL and EPD match Smith's table", "[
   CHECK_THAT(p.marginal_ray().rows.back().y_mm, WithinAbs(11.169234, 1e-5));  // Smith's 6 decimals, his rounded glass data
   CHECK_THAT(p.chief_ray()->image_height_mm, WithinAbs(21.248022, 5e-5));
 }
+
+TEST_CASE("CODE V: a Cassegrain's first order is the two-mirror formula's, as from its Zemax file", "[paraxial][codev][mirror]") {
+  // Handbook of Optics vol. II ch. 18's Cassegrain (tests/data/zemax/real/HoO-V2C18Ex03.zmx) in CODE V's words.
+  const std::string text =
+      "RDM;LEN \"Cassegrain\"\nEPD 20.0234\nDIM M\nWL 550\nYAN 0 1\nSO 0 1e20\nS 0 16\n"
+      "S -45.72 -16 REFL\n  STO\n  K -1\nS -19.2 24.035 REFL\n  K -3.236\nSI 0 0\nGO\n";
+  const Prescription p = read_codev(text, "cassegrain.seq").prescription;
+  const double p1 = 2.0 / 45.72, p2 = -2.0 / 19.2, d = 16.0;
+  CHECK_THAT(ParaxialSystem(p).efl_mm(), Catch::Matchers::WithinRel(1.0 / (p1 + p2 - d * p1 * p2), 1e-12));
+}

@@ -267,16 +267,18 @@ TEST_CASE("CODE V: a curved image surface is a warning", "[prescription][codev]"
   CHECK(has_diagnostic(r.diagnostics, Diagnostic::Severity::Warning, line_of(text, "SI -100"), "curved"));
 }
 
-TEST_CASE("CODE V: REFL (a mirror) is refused on the S line, in GLA and in RMD", "[prescription][codev]") {
-  for (const std::string& mirror : {std::string("S -200 -90 REFL"), std::string("S -200 90\n  RMD REFL"),
-                                    std::string("S -200 90\n  GLA REFL")}) {
+TEST_CASE("CODE V: REFL makes a mirror, on the S line, in GLA and in RMD; not on SO or SI", "[prescription][codev]") {
+  for (const std::string& mirror : {std::string("S -200 -90 REFL"), std::string("S -200 -90\n  RMD REFL"),
+                                    std::string("S -200 -90\n  GLA REFL")}) {
     const std::string text = replaced(mini_seq(), "S -200 90", mirror);
     INFO(mirror);
-    const LensFileError e = codev_error(text);
-    CHECK(e.where().line == line_of(text, "REFL"));
-    CHECK_THAT(e.what(), Contains("mirrors are not supported"));
+    const Prescription p = read_codev(text, "t.seq").prescription;
+    CHECK(p.surfaces[2].mirror);
+    CHECK(p.surfaces[2].medium.index(587.5618) == p.surfaces[1].medium.index(587.5618));  // back into the glass
   }
-  CHECK_NOTHROW(read_codev(mini_seq("", "  RMD REFR\n"), "t.seq"));
+  CHECK_FALSE(read_codev(mini_seq("", "  RMD REFR\n"), "t.seq").prescription.surfaces[1].mirror);
+  const std::string image = replaced(mini_seq(), "SI 0 0", "SI 0 0 REFL");
+  CHECK(codev_error(image).where().line == line_of(image, "SI 0 0 REFL"));
 }
 
 TEST_CASE("CODE V: decentres and tilts are accepted when zero and refused otherwise", "[prescription][codev]") {

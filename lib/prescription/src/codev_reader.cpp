@@ -164,6 +164,8 @@ struct CvSurface {
   int thickness_line = 0;
   int thickness_column = 0;
   std::optional<GlassRef> glass;  // empty = air
+  bool mirror = false;            // REFL (as the glass or the refract mode): the surface reflects
+  int mirror_line = 0;
   double conic = 0.0;
   // A, B, ..., J (no I): the r^4, r^6, ..., r^20 coefficients, lens-unit^(1 - power).
   std::array<Located, 9> coefficients{};
@@ -482,9 +484,9 @@ class CodeVParser {
     }
     if (k == "RMD") {
       std::size_t i = 0;
-      surface_for(c, i);
+      const std::size_t index = surface_for(c, i);
       const Token& t = required_arg(c, i, "the refract mode");
-      check_refract_mode(c, t);
+      set_refract_mode(c, t, surfaces_[index]);
       return;
     }
     if (k == "STO") {
@@ -618,23 +620,28 @@ class CodeVParser {
     s.thickness_line = c.args[1].line;
     s.thickness_column = c.args[1].column;
     if (c.args.size() > 2) set_glass(c, s, c.args[2]);
-    if (c.args.size() > 3) check_refract_mode(c, c.args[3]);
+    if (c.args.size() > 3) set_refract_mode(c, c.args[3], s);
     no_more_args(c, 4);
   }
 
+  // REFL in the glass field makes a mirror (the medium before it continues), as RMD REFL does.
   void set_glass(const Command& c, CvSurface& s, const Token& t) {
     const std::string upper = to_upper(t.text);
     if (!t.quoted && upper == "REFL") {
-      fail_at(c, t, "mirrors are not supported (lensmith models refracting systems)");
+      s.mirror = true;
+      s.mirror_line = c.keyword.line;
+      s.glass.reset();
+      return;
     }
     s.glass = GlassRef{t.text, t.quoted, t.line, t.column};
   }
 
-  void check_refract_mode(const Command& c, const Token& t) const {
+  void set_refract_mode(const Command& c, const Token& t, CvSurface& s) const {
     const std::string mode = to_upper(t.text);
-    if (mode == "REFL") fail_at(c, t, "mirrors are not supported (lensmith models refracting systems)");
     if (mode == "TIR") fail_at(c, t, "total-internal-reflection surfaces are not supported");
-    if (mode != "REFR") fail_at(c, t, "unknown refract mode \"" + shown(t.text) + "\" (expected REFR)");
+    if (mode != "REFR" && mode != "REFL") fail_at(c, t, "unknown refract mode \"" + shown(t.text) + "\" (expected REFR or REFL)");
+    s.mirror = mode == "REFL";
+    s.mirror_line = c.keyword.line;
   }
 
   void handle_rdm(const Command& c) {
@@ -1035,6 +1042,8 @@ class CodeVParser {
       p.object_distance_mm = mm(object.thickness);
     }
     if (object.glass) p.object_material = material_for(*object.glass);
+    if (object.mirror) fail(object.mirror_line, 0, "REFL on the object surface (SO): the object cannot be a mirror");
+    if (surfaces_.back().mirror) fail(surfaces_.back().mirror_line, 0, "REFL on the image surface (SI): the image cannot be a mirror");
 
     const CvSurface& image = surfaces_.back();
     const std::size_t image_index = surfaces_.size() - 1;
@@ -1080,6 +1089,7 @@ class CodeVParser {
     }
     s.thickness_mm = mm(cv.thickness);
     if (cv.glass) s.material = material_for(*cv.glass);
+    s.mirror = cv.mirror;
     s.is_stop = stop_ && *stop_ == index;
     s.conic = cv.conic;
     for (std::size_t m = 0; m < cv.coefficients.size(); ++m) {
