@@ -6,7 +6,9 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "lensmith/core/errors.h"
 #include "lensmith/core/json_text.h"
+#include "lensmith/core/number_parsing.h"
 #include "lensmith/report/json_report.h"
 #include "json_output.h"
 #include "lensmith/core/units.h"
@@ -40,8 +42,36 @@ int run_info(const InfoOptions& options, const GlobalOptions& global) {
     table.emplace(lens, spectral);
   }
 
+  // A lens with toroidal or biconic surfaces has a second section: its x (sagittal) first-order data, and the
+  // anamorphic squeeze EFL_y / EFL_x; or none, where the x section has no power (a cylinder alone).
+  bool anamorphic = false;
+  for (const Surface& s : lens.surfaces) anamorphic = anamorphic || (!s.is_rotationally_symmetric() && !s.is_coordinate_break());
+  std::optional<ParaxialSystem> x_system;
+  std::string x_afocal;
+  if (anamorphic) {
+    ParaxialOptions x = paraxial;
+    x.section = Section::X;
+    try {
+      x_system.emplace(lens, x);
+    } catch (const ComputationError& e) {
+      x_afocal = e.what();
+    }
+  }
+
   if (options.json) {
     ojson o = info_json(lens, system);
+    if (anamorphic) {
+      ojson x = ojson::object();
+      if (x_system) {
+        x["efl_mm"] = x_system->efl_mm();
+        x["bfl_mm"] = x_system->bfl_mm();
+        x["squeeze"] = system.efl_mm() / x_system->efl_mm();
+      } else {
+        x["afocal"] = true;
+        x["why"] = x_afocal;
+      }
+      o["x_section"] = x;
+    }
     if (table) o["spectral"] = spectral_json(*table);
     std::cout << json_text(o, 2) << "\n";
     return kExitOk;
@@ -49,6 +79,16 @@ int run_info(const InfoOptions& options, const GlobalOptions& global) {
   std::cout << lens.to_string() << "\n";
   if (!lens.source.empty()) std::cout << "Source: " << lens.source << "\n\n";
   std::cout << system.to_string();
+  if (anamorphic) {
+    std::cout << "\nThe x section (sagittal; the listing above is the y section, OpticStudio's paraxial one):\n";
+    if (x_system) {
+      std::cout << "  Effective focal length EFL        " << format_rounded(x_system->efl_mm(), 8) << " mm\n"
+                << "  Back focal length BFL             " << format_rounded(x_system->bfl_mm(), 8) << " mm\n"
+                << "  Anamorphic squeeze EFL_y / EFL_x  " << format_rounded(system.efl_mm() / x_system->efl_mm(), 6) << "\n";
+    } else {
+      std::cout << "  no first-order image: " << x_afocal << "\n";
+    }
+  }
   if (table) std::cout << "\n" << table->to_string();
   return kExitOk;
 }

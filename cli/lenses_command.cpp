@@ -30,7 +30,7 @@ int run_lenses(const LensesOptions& options, const GlobalOptions&) {
               << "readable\n";
     for (const auto& e : entries) {
       std::cout << std::setw(6) << e.id << std::setw(24) << e.company << std::setw(34) << e.product_name << std::setw(6) << e.year
-                << (e.supported ? "yes" : "no (cylindrical or zoom)") << "\n";
+                << (e.supported ? "yes" : "no (no single iris, or a zoom)") << "\n";
     }
     std::cout << "read one with: lensmith info " << options.lentil_database << "#ID\n";
     return kExitOk;

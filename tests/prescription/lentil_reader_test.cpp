@@ -140,15 +140,19 @@ TEST_CASE("lentil: a radius of 99999 or more is a plane", "[prescription][lentil
   CHECK(p.surfaces[20].is_plane());
 }
 
-TEST_CASE("lentil: an anamorphic entry is an error naming the cylindrical element", "[prescription][lentil]") {
-  try {
-    read_entry("2001");
-    FAIL("expected a LensFileError");
-  } catch (const LensFileError& e) {
-    CHECK_THAT(e.what(), Contains("optical-elements-patent[") && Contains("cyl-y"));
-    CHECK(e.where().file == database_path());
-    CHECK(e.where().line > 0);
-  }
+TEST_CASE("lentil: cylindrical elements read as biconics, cyl-y curved in x and cyl-x curved in y", "[prescription][lentil]") {
+  // lentil's tracer (Hanika's polynomial optics) gives a "cyl-y" surface its axis along y: its normal has an x
+  // component, so it bends rays in x, the horizontal squeeze of a cinema anamorphic.
+  const Prescription p = read_entry("2001").prescription;
+  const Surface& first = p.surfaces[0];
+  CHECK(first.kind == SurfaceKind::Biconic);
+  CHECK(first.curvature_per_mm == 0.0);
+  CHECK(first.curvature_x_per_mm == 1.0 / 4.4467);  // the patent's radius, as every entry's, in its own units
+  CHECK_FALSE(first.is_rotationally_symmetric());
+  CHECK_FALSE(p.is_rotationally_symmetric());
+  const Prescription rear = read_entry("2004").prescription;  // cyl-y and spherical elements
+  CHECK(rear.surfaces[0].kind == SurfaceKind::Biconic);
+  CHECK(rear.surfaces[3].kind == SurfaceKind::Standard);
 }
 
 TEST_CASE("lentil: an unknown id is an error listing the available ids", "[prescription][lentil]") {
@@ -172,7 +176,7 @@ TEST_CASE("lentil: every supported entry reads and validates", "[prescription][l
       CHECK_THROWS_AS(read_entry(e.id), LensFileError);  // "supported" means exactly "readable"
     }
   }
-  CHECK(supported == 18);  // all but the five anamorphic entries and the iris-less test entry 9994
+  CHECK(supported == 21);  // all but the three without an iris (2002, 9991, 9994)
 }
 
 TEST_CASE("lentil: the entry list gives ids, makers and what lensmith can read", "[prescription][lentil]") {
@@ -188,9 +192,9 @@ TEST_CASE("lentil: the entry list gives ids, makers and what lensmith can read",
   CHECK(first.supported);
   for (const LentilEntrySummary& e : entries) {
     INFO("entry " << e.id);
-    const bool anamorphic = e.id == "2001" || e.id == "2002" || e.id == "2003" || e.id == "2004" || e.id == "9991";
-    const bool without_iris = e.id == "9994";
-    CHECK(e.supported == !(anamorphic || without_iris));
+    // 2002 (a rear anamorphic attachment), 9991 (an anamorphic test) and 9994 (a test lens) have no iris.
+    const bool without_iris = e.id == "2002" || e.id == "9991" || e.id == "9994";
+    CHECK(e.supported == !without_iris);
   }
 }
 

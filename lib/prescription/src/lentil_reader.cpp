@@ -101,7 +101,7 @@ const json& entries_object(const LocatedJson& doc) {
   return doc.root();
 }
 
-// Whether lensmith can read an entry: one iris, no cylindrical surface, no zoom thickness list.
+// Whether lensmith can read an entry: one iris, no zoom thickness list.
 bool entry_supported(const json& entry) {
   if (!entry.is_object()) return false;
   auto elements = entry.find("optical-elements-patent");
@@ -112,7 +112,7 @@ bool entry_supported(const json& entry) {
     auto geometry = e.find("lens-geometry");
     if (geometry != e.end() && geometry->is_string()) {
       const std::string g = geometry->get<std::string>();
-      if (g != "spherical" && g != "aspherical") return false;
+      if (g != "spherical" && g != "aspherical" && g != "cyl-x" && g != "cyl-y") return false;
     }
     auto thickness = e.find("thickness");
     if (thickness == e.end() || !thickness->is_number()) return false;
@@ -187,10 +187,8 @@ class LentilEntryReader {
   Surface read_element(JsonObjectReader& e, const Prescription& p) {
     Surface s;
     const std::string geometry = e.get_string("lens-geometry");
-    if (geometry == "cyl-x" || geometry == "cyl-y") {
-      e.fail("lens-geometry", "cylindrical (anamorphic) surface \"" + geometry + "\" is not supported");
-    }
-    if (geometry != "spherical" && geometry != "aspherical") {
+    const bool cylinder = geometry == "cyl-x" || geometry == "cyl-y";
+    if (geometry != "spherical" && geometry != "aspherical" && !cylinder) {
       e.fail("lens-geometry", "unknown geometry \"" + geometry + "\"; expected spherical, aspherical, cyl-x or cyl-y");
     }
 
@@ -212,14 +210,25 @@ class LentilEntryReader {
     const bool iris = kind == "iris";
     // An iris is a plane whatever radius lentil gives it (entry 0015 writes 9999).
     s.curvature_per_mm = iris || std::abs(radius) >= kFlatRadiusMm ? 0.0 : 1.0 / radius;
+    if (cylinder && s.curvature_per_mm != 0.0) {
+      // lentil's cylinders (Hanika's polynomial-optics tracer): "cyl-y" has its axis along y and is curved in x
+      // (the horizontal power of a cinema anamorphic), "cyl-x" its axis along x, curved in y. A biconic with one
+      // flat section.
+      s.kind = SurfaceKind::Biconic;
+      if (geometry == "cyl-y") {
+        s.curvature_x_per_mm = s.curvature_per_mm;
+        s.curvature_per_mm = 0.0;
+      }
+    }
 
     const double housing = finite_number(e, "housing-radius");
     if (!(housing > 0.0)) e.fail("housing-radius", "housing-radius = " + format_number(housing) + ": must be > 0");
     s.semi_diameter_mm = housing;
     // Some entries give a housing wider than the sphere itself (0015: radius 0.8146, housing 0.82).
     // No ray can pass beyond |R|, so lentil's own tracer loses nothing when the aperture stops there.
-    if (s.curvature_per_mm != 0.0 && housing > 1.0 / std::abs(s.curvature_per_mm)) {
-      const double limit = 1.0 / std::abs(s.curvature_per_mm);
+    const double curved = std::max(std::abs(s.curvature_per_mm), std::abs(s.curvature_x_per_mm));
+    if (curved != 0.0 && housing > 1.0 / curved) {
+      const double limit = 1.0 / curved;
       warn(e, "housing-radius",
            "housing-radius " + format_number(housing) + " exceeds |radius| " + format_number(limit) +
                "; the clear semi-diameter is limited to |radius|");

@@ -18,7 +18,7 @@ struct LentilEntrySummary {
   int year = 0;
   double patent_focal_length_mm = 0.0;  // 0 when unknown
   bool production_ready = false;
-  bool supported = false;    // read_lentil() can read it: no cylindrical surface, no zoom, exactly one iris
+  bool supported = false;    // read_lentil() can read it: no zoom, exactly one iris
 };
 
 // Lists the entries of a lentil database.
