@@ -95,13 +95,30 @@ Camera Camera::thin_lens(double focal_length_mm, const CameraOptions& options, i
 
 Camera Camera::from_lens(const Prescription& lens, const CameraOptions& options, int width_px, int height_px) {
   options.validate();
-  if (lens.has_mirrors() || !lens.is_rotationally_symmetric()) {
-    // Not implemented yet: the ray models, pupil meshes and fits assume a rotationally symmetric refracting lens.
-    const auto why = lens.why_not_rotationally_symmetric();
-    throw ComputationError("the bokeh camera does not take this lens yet (" +
-                           (why ? *why : std::string("it has mirrors")) +
-                           "): mirror lenses, coordinate breaks and toroidal or biconic surfaces are read, traced and analysed, "
-                           "but not yet photographed through (not implemented)");
+  // What the camera takes (docs/bokeh.md, "Mirror and anamorphic lenses"): coaxial systems whose image faces
+  // the way light left the scene. Tilts, decentres and an odd number of mirrors are not implemented yet: the
+  // camera's first-order frame would have to follow the folded axis.
+  int mirrors = 0;
+  bool obscured = false;
+  for (const Surface& s : lens.surfaces) {
+    mirrors += s.mirror ? 1 : 0;
+    obscured = obscured || (s.aperture && s.aperture->obscuration);
+  }
+  if (!lens.is_coaxial()) {
+    throw ComputationError("the bokeh camera does not take tilted or decentred systems yet (" + *lens.why_not_rotationally_symmetric() +
+                           "): they are read, traced and analysed, but not yet photographed through (not implemented)");
+  }
+  if (mirrors % 2 == 1) {
+    throw ComputationError("the bokeh camera does not take a lens with an odd number of mirrors yet (" + std::to_string(mirrors) +
+                           "): its image faces back toward the scene (not implemented)");
+  }
+  std::optional<std::string> exact_only;
+  if (const auto why = lens.why_not_rotationally_symmetric()) {
+    exact_only = *why;
+  } else if (mirrors > 0) {
+    exact_only = "it has " + std::to_string(mirrors) + " mirrors";
+  } else if (obscured) {
+    exact_only = "it has a central obscuration";
   }
   // A camera's pupil is where its stop images, at its f-number: a lens file's object-space telecentric
   // flag (a measuring lens's) is dropped.
@@ -148,6 +165,7 @@ Camera Camera::from_lens(const Prescription& lens, const CameraOptions& options,
   table_options.object_distance_mm = kInfinity;
   c.samples_ = ParaxialSpectralTable(*at_f_number, table_options).samples();
   c.lens_ = std::move(at_f_number);
+  c.exact_model_only_ = exact_only;
   c.finish();
   // The marginal ray from the axial point of the focus plane at N = n: its heights scale as n / N,
   // so the first clear aperture (the stop aside) it fills sets the fastest unclipped N.

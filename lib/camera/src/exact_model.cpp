@@ -50,9 +50,14 @@ ExactModel::ExactModel(const Camera& camera) : RayModel(camera) {
   // The clear apertures that clip, as (0-based surface index, semi-diameter); the stop with the
   // margin of kStopEdgeTolerance.
   for (std::size_t k = 0; k < lens.surfaces.size(); ++k) {
-    const std::optional<double>& r = lens.surfaces[k].semi_diameter_mm;
+    const Surface& s = lens.surfaces[k];
+    if (s.aperture && static_cast<int>(k) + 1 != stop_surface_) {
+      apertures_.push_back({k, 0.0, *s.aperture});  // as the tracer clips: the explicit aperture instead of the circle
+      continue;
+    }
+    const std::optional<double>& r = s.semi_diameter_mm;
     if (!r || !(*r > 0.0)) continue;
-    apertures_.emplace_back(k, static_cast<int>(k) + 1 == stop_surface_ ? *r * (1.0 + kStopEdgeTolerance) : *r);
+    apertures_.push_back({k, static_cast<int>(k) + 1 == stop_surface_ ? *r * (1.0 + kStopEdgeTolerance) : *r, std::nullopt});
   }
   z_stop_mm_ = free_->vertex_z_mm(stop_surface_);
   normalisation_ = weight_normalisation_for(camera, [this](auto&&... a) { map_raw(a...); });
@@ -157,9 +162,9 @@ void ExactModel::map_raw(const ScenePoint& point, double wavelength_nm, std::spa
       continue;
     }
     double clearance = 1.0;
-    for (const auto& [k, radius] : apertures_) {
-      const Eigen::Vector3d& p = path[k].point_mm;
-      clearance = std::min(clearance, 1.0 - std::hypot(p.x(), p.y()) / radius);
+    for (const Clip& c : apertures_) {
+      const Eigen::Vector3d& p = path[c.surface].point_mm;
+      clearance = std::min(clearance, c.aperture ? c.aperture->clearance(p.x(), p.y()) : 1.0 - std::hypot(p.x(), p.y()) / c.radius_mm);
     }
     hits[i] = SensorHit{f.ray.position_mm.x(), f.ray.position_mm.y(), clearance >= 0.0, true, weight, clearance};
   }

@@ -284,7 +284,13 @@ class ExactModel final : public RayModel {
   void map_raw(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil, std::span<SensorHit> hits) const;
 
   std::shared_ptr<const SequentialTracer> free_;     // no clipping: aiming and the final trace
-  std::vector<std::pair<std::size_t, double>> apertures_;  // clipping surfaces: 0-based index, semi-diameter (mm)
+  // Clipping surfaces: 0-based index and semi-diameter (mm), or an explicit aperture (a central obscuration).
+  struct Clip {
+    std::size_t surface = 0;
+    double radius_mm = 0.0;
+    std::optional<SurfaceAperture> aperture;
+  };
+  std::vector<Clip> apertures_;
   int stop_surface_ = 0;                             // 1-based
   double stop_radius_mm_ = 0.0;
   double z_stop_mm_ = 0.0;

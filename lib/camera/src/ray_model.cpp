@@ -122,6 +122,10 @@ std::unique_ptr<RayModel> make_ray_model(RayModelKind kind, const Camera& camera
     throw OptionsError("the " + std::string(to_string(kind)) + " model needs a lens prescription, not a thin lens");
   }
   if (kind == RayModelKind::Exact) return std::make_unique<camera_detail::ExactModel>(camera);
+  if (camera.exact_model_only()) {
+    throw OptionsError("the " + std::string(to_string(kind)) + " model assumes a rotationally symmetric refracting lens with a round "
+                       "aperture, and this one is not (" + *camera.exact_model_only() + "): use the exact model (--model exact)");
+  }
   if (kind == RayModelKind::Poly) {
     auto fit = options.fit ? options.fit : std::make_shared<const LensFit>(LensFit::fit(*camera.lens(), lens_fit_options_for(camera)));
     return std::make_unique<camera_detail::PolyModel>(camera, std::move(fit));

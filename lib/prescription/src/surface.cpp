@@ -172,6 +172,19 @@ bool SurfaceAperture::passes(double x_mm, double y_mm, double tolerance_mm) cons
   return obscuration ? !inside : inside;
 }
 
+double SurfaceAperture::clearance(double x_mm, double y_mm) const {
+  const double x = x_mm - decenter_x_mm, y = y_mm - decenter_y_mm;
+  double inside = 0.0;  // 1 - (relative distance from the centre), for the shape itself
+  switch (shape) {
+    case Shape::Circular: inside = 1.0 - std::hypot(x, y) / half_x_mm; break;
+    case Shape::Rectangular: inside = 1.0 - std::max(std::abs(x) / half_x_mm, std::abs(y) / half_y_mm); break;
+    case Shape::Elliptical: inside = 1.0 - std::hypot(x / half_x_mm, y / half_y_mm); break;
+  }
+  if (obscuration) return -inside;
+  if (shape == Shape::Circular && min_radius_mm > 0.0) inside = std::min(inside, std::hypot(x, y) / min_radius_mm - 1.0);
+  return inside;
+}
+
 double SurfaceAperture::outer_radius_mm() const {
   if (obscuration) return kInfinity;
   const double dx = std::abs(decenter_x_mm), dy = std::abs(decenter_y_mm);

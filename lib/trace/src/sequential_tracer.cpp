@@ -954,15 +954,13 @@ SequentialTracer::SequentialTracer(const Prescription& lens, const TracerOptions
     impl->frames = frames.surfaces;
     impl->image_frame = frames.image;
     impl->shapes = lens_.surfaces;
-    // The output z of the image plane: the path length along the unfolded axis (thicknesses after an odd
-    // number of mirrors count with their sign reversed), and light reaches it toward +z or -z of its frame
-    // as the number of reflections says (a probe below corrects that for tilted image planes).
-    double sense = 1.0, unfolded = 0.0;
-    for (std::size_t k = 0; k < count; ++k) {
-      if (lens_.surfaces[k].mirror) sense = -sense;
-      unfolded += sense * (k + 1 == count ? image_distance_mm : lens_.surfaces[k].thickness_mm);
+    // The output z of the image plane stays the sum of the thicknesses (where it lies in a coaxial system,
+    // so that with an even number of mirrors the output frame is the global frame); light reaches it toward
+    // +z or -z of its frame as the number of reflections says (a probe below corrects that for tilted planes).
+    double sense = 1.0;
+    for (const Surface& s : lens_.surfaces) {
+      if (s.mirror) sense = -sense;
     }
-    image_plane_z_mm_ = unfolded;
     impl->image_sense = sense;
   }
   impl->image_plane_z_mm = image_plane_z_mm_;

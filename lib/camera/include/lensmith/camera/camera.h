@@ -69,9 +69,15 @@ class Camera {
   // 380 to 780 nm. Throws ComputationError for afocal lenses or a focus plane the lens cannot image,
   // OptionsError for an f-number whose stop would be wider than its surface can be (naming the
   // fastest f-number the stop allows).
+  // Mirror lenses (an even number of mirrors: the image faces the scene's way) and anamorphic lenses
+  // (coaxial toroids and biconics) are taken, for the exact model only (exact_model_only); tilted or
+  // decentred systems and an odd number of mirrors are refused (not implemented yet).
   static Camera from_lens(const Prescription& lens, const CameraOptions& options, int width_px, int height_px);
 
   bool is_thin_lens() const { return !lens_; }
+  // Why only the exact model can photograph through this lens (its mirrors, central obscurations or
+  // surfaces that are not rotationally symmetric are beyond the other models); empty when every model can.
+  const std::optional<std::string>& exact_model_only() const { return exact_model_only_; }
   // The prescription at the chosen f-number (aperture spec and stop semi-diameter set to it); null
   // for a thin lens.
   const Prescription* lens() const { return lens_.get(); }
@@ -121,6 +127,7 @@ class Camera {
   double f_number_ = 0.0;
   double design_f_number_ = 0.0;
   double fastest_unclipped_f_number_ = 0.0;
+  std::optional<std::string> exact_model_only_;
   double focus_mm_ = 0.0;
   double reference_nm_ = kWavelengthD_nm;
   std::vector<ParaxialSample> samples_;  // evenly spaced in wavelength (one for a thin lens)

@@ -37,6 +37,11 @@ struct SurfaceAperture {
   // True when a ray meeting the surface at (x, y) (mm, local) passes, within `tolerance_mm` of the
   // edge in its favour (the rim tolerance of docs/trace.md).
   bool passes(double x_mm, double y_mm, double tolerance_mm) const;
+  // How far inside what passes (x, y) lies, relative to the shape's size: 1 - r / R for a circle, 1 -
+  // max(|x| / a, |y| / b) for a rectangle, 1 - sqrt((x / a)^2 + (y / b)^2) for an ellipse; for an
+  // obscuration the same measure outside it, negated; for an annulus the smaller of the outer and inner
+  // margins. 0 on the rim, < 0 where the ray is stopped (the edge of a beam lies between rays by it).
+  double clearance(double x_mm, double y_mm) const;
   // The radius of the circle about the axis that holds every point that can pass (mm; +infinity for
   // an obscuration): the surface's extent for drawing and for fits.
   double outer_radius_mm() const;
