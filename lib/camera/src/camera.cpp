@@ -1,4 +1,5 @@
 #include "lensmith/camera/camera.h"
+#include "lensmith/trace/surface_frames.h"
 
 #include <algorithm>
 #include <cmath>
@@ -105,8 +106,17 @@ Camera Camera::from_lens(const Prescription& lens, const CameraOptions& options,
     obscured = obscured || (s.aperture && s.aperture->obscuration);
   }
   if (!lens.is_coaxial()) {
-    throw ComputationError("the bokeh camera does not take tilted or decentred systems yet (" + *lens.why_not_rotationally_symmetric() +
-                           "): they are read, traced and analysed, but not yet photographed through (not implemented)");
+    // A tilt-shift lens: elements turned or moved between a break and its inverse, the sensor square to the
+    // camera's axis (moved across it, as a shifted image is). A folded or off-axis system whose image plane is
+    // turned is not (not implemented).
+    const SurfaceFrame image = surface_frames(lens, 0.0).image;
+    const bool square = image.axes.isIdentity(1e-12);
+    if (!square) {
+      throw ComputationError("the bokeh camera takes tilted or decentred elements only between a coordinate break and its inverse "
+                             "(a tilt-shift lens, its sensor square to the axis); this system's image plane is turned (" +
+                             *lens.why_not_rotationally_symmetric() + "): it is read, traced and analysed, but not photographed "
+                             "through (not implemented)");
+    }
   }
   if (mirrors % 2 == 1) {
     throw ComputationError("the bokeh camera does not take a lens with an odd number of mirrors yet (" + std::to_string(mirrors) +

@@ -60,6 +60,8 @@ ExactModel::ExactModel(const Camera& camera) : RayModel(camera) {
     apertures_.push_back({k, static_cast<int>(k) + 1 == stop_surface_ ? *r * (1.0 + kStopEdgeTolerance) : *r, std::nullopt});
   }
   z_stop_mm_ = free_->vertex_z_mm(stop_surface_);
+  for (int k = 1; k <= static_cast<int>(lens.surfaces.size()); ++k) frames_.push_back(free_->surface_frame(k));
+  stop_frame_ = frames_[static_cast<std::size_t>(stop_surface_ - 1)];
   normalisation_ = weight_normalisation_for(camera, [this](auto&&... a) { map_raw(a...); });
 }
 
@@ -84,8 +86,10 @@ void ExactModel::map_raw(const ScenePoint& point, double wavelength_nm, std::spa
     const Ray r = ray_towards(point, z_persp, tx, ty, z_target, wavelength_nm, start_z);
     free_->trace_forward(r, &path);
     if (path.size() <= stop_index) return false;
-    sx = path[stop_index].point_mm.x();
-    sy = path[stop_index].point_mm.y();
+    // In the stop's own frame (a tilted or shifted lens's stop turns and moves with it).
+    const Eigen::Vector3d on_stop = stop_frame_.to_local(path[stop_index].point_mm);
+    sx = on_stop.x();
+    sy = on_stop.y();
     return true;
   };
 
@@ -163,7 +167,7 @@ void ExactModel::map_raw(const ScenePoint& point, double wavelength_nm, std::spa
     }
     double clearance = 1.0;
     for (const Clip& c : apertures_) {
-      const Eigen::Vector3d& p = path[c.surface].point_mm;
+      const Eigen::Vector3d p = frames_[c.surface].to_local(path[c.surface].point_mm);
       clearance = std::min(clearance, c.aperture ? c.aperture->clearance(p.x(), p.y()) : 1.0 - std::hypot(p.x(), p.y()) / c.radius_mm);
     }
     hits[i] = SensorHit{f.ray.position_mm.x(), f.ray.position_mm.y(), clearance >= 0.0, true, weight, clearance};

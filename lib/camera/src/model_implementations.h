@@ -291,6 +291,8 @@ class ExactModel final : public RayModel {
     std::optional<SurfaceAperture> aperture;
   };
   std::vector<Clip> apertures_;
+  std::vector<SurfaceFrame> frames_;  // where each surface lies (apertures clip in their surface's frame)
+  SurfaceFrame stop_frame_;
   int stop_surface_ = 0;                             // 1-based
   double stop_radius_mm_ = 0.0;
   double z_stop_mm_ = 0.0;
