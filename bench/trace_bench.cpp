@@ -142,9 +142,9 @@ void BM_AimRay(benchmark::State& state, RayAiming aiming) {
 
 // The cost of one surface crossing per surface type (issue 18): a stack of 12 weak surfaces alternating
 // glass (n = 1.5) and air, 4 mm apart, as spheres on the coaxial path, the same spheres on the general path
-// (an identity coordinate break in front moves the lens there), toroids, biconics, spheres each between a
+// (an identity coordinate break in front moves the lens there), toroids, biconics, cylinders, spheres each between a
 // tilting break and its inverse, and a stack of 12 flat-and-curved mirrors (a beam folded back and forth).
-enum class StackKind { CoaxialSpheres, GeneralSpheres, Toroids, Biconics, TiltedSpheres, Mirrors };
+enum class StackKind { CoaxialSpheres, GeneralSpheres, Toroids, Biconics, Cylinders, TiltedSpheres, Mirrors };
 
 Prescription surface_stack(StackKind kind) {
   Prescription p;
@@ -173,6 +173,11 @@ Prescription surface_stack(StackKind kind) {
     if (kind == StackKind::Toroids || kind == StackKind::Biconics) {
       s.kind = kind == StackKind::Toroids ? SurfaceKind::Toroidal : SurfaceKind::Biconic;
       s.curvature_x_per_mm = 1.3 * s.curvature_per_mm;
+    }
+    if (kind == StackKind::Cylinders) {  // curved in x (lentil's "cyl-y"), flat in y: the closed-form cylinder
+      s.kind = SurfaceKind::Biconic;
+      s.curvature_x_per_mm = s.curvature_per_mm;
+      s.curvature_per_mm = 0.0;
     }
     if (kind == StackKind::TiltedSpheres) {
       Surface tilt;
@@ -247,6 +252,7 @@ const int kRegistered = [] {
       ->ReportAggregatesOnly(true);
   for (const auto& [name, kind] : {std::pair{"coaxial_spheres", StackKind::CoaxialSpheres}, std::pair{"general_spheres", StackKind::GeneralSpheres},
                                    std::pair{"toroids", StackKind::Toroids}, std::pair{"biconics", StackKind::Biconics},
+                                   std::pair{"cylinders", StackKind::Cylinders},
                                    std::pair{"tilted_spheres", StackKind::TiltedSpheres}, std::pair{"mirrors", StackKind::Mirrors}}) {
     benchmark::RegisterBenchmark((std::string("BM_TraceSurfaceKind/") + name).c_str(), BM_TraceSurfaceKind, kind)
         ->Unit(benchmark::kNanosecond)

@@ -60,7 +60,9 @@ constexpr double kUnitTolerance = 1e-14;
 constexpr std::ptrdiff_t kParallelBatchThreshold = 256;
 
 // General: a toroid or biconic, intersected through Surface::sag_and_slope (the general path only).
-enum class Shape : std::uint8_t { Plane, Sphere, Conic, Asphere, General };
+// Cylinder: a conic section in x-z or y-z extruded along the other axis (a biconic or toroid with one flat
+// section: lentil's and most anamorphics' cylinders), a quadric intersected in closed form.
+enum class Shape : std::uint8_t { Plane, Sphere, Conic, Asphere, General, Cylinder };
 
 // What the inner loop needs of a surface, precomputed once.
 struct SurfaceGeometry {
@@ -74,6 +76,7 @@ struct SurfaceGeometry {
   bool has_aperture = false;                 // an explicit (non-circular, annular, obscuring or decentred) aperture
   SurfaceAperture aperture;                  // used when has_aperture
   double aperture_tolerance_mm = 0.0;        // its rim tolerance
+  bool cylinder_in_x = false;                // Cylinder: curved in x (else in y), curvature_per_mm and one_plus_conic of that section
   bool is_break = false;                     // a coordinate break: no interaction (general path)
   bool mirror = false;                       // reflects (general path)
 };
@@ -384,6 +387,54 @@ inline RayStatus intersect(const SurfaceGeometry& g, const State& r, double sens
       return intersect_asphere(g, r, sense, hit);
     case Shape::General:
       return RayStatus::Missed;  // intersect_general (needs the Surface)
+    case Shape::Cylinder:
+      return RayStatus::Missed;  // intersect_cylinder (general path)
+  }
+  return RayStatus::Missed;
+}
+
+// A cylinder c u^2 + (1 + k) c z^2 - 2 z = 0 (u = x or y, the other coordinate free), vertex at the origin: with
+// p = p0 + t d, A t^2 + 2 B t + C = 0, A = c (du^2 + (1 + k) n^2), B = c (u0 du + (1 + k) z0 n) - n,
+// C = c (u0^2 + (1 + k) z0^2) - 2 z0. Of the two roots the one on the vertex sheet (N_z = 1 - (1 + k) c z >= 0)
+// that the ray crosses in its direction of travel (sense N.d > 0), as for the conics above.
+RayStatus intersect_cylinder(const SurfaceGeometry& g, const State& r, double sense, Hit& hit) {
+  const double c = g.curvature_per_mm, q = g.one_plus_conic;
+  const double u0 = g.cylinder_in_x ? r.x : r.y, du = g.cylinder_in_x ? r.l : r.m;
+  const double a = c * (du * du + q * r.n * r.n);
+  const double b = c * (u0 * du + q * r.z * r.n) - r.n;
+  const double cc = c * (u0 * u0 + q * r.z * r.z) - 2.0 * r.z;
+  std::array<double, 2> roots{};
+  int count = 0;
+  if (a == 0.0) {
+    if (b == 0.0) return RayStatus::Missed;
+    roots[count++] = -cc / (2.0 * b);
+  } else {
+    const double discriminant = b * b - a * cc;
+    if (!(discriminant >= 0.0)) return RayStatus::Missed;
+    const double root = std::sqrt(discriminant);
+    // Cancellation-free: q = -(b + sign(b) root), roots q / a and cc / q.
+    const double qq = -(b + (b >= 0.0 ? root : -root));
+    roots[count++] = qq / a;
+    if (qq != 0.0) roots[count++] = cc / qq;
+  }
+  for (int i = 0; i < count; ++i) {
+    const double t = roots[static_cast<std::size_t>(i)];
+    if (!std::isfinite(t)) continue;
+    const double u = u0 + t * du, z = r.z + t * r.n;
+    const double nz = 1.0 - q * c * z;
+    if (nz < -kSheetTolerance) continue;
+    const double nu = -c * u;
+    const double inverse_length = 1.0 / std::sqrt(nu * nu + nz * nz);
+    const double nx = g.cylinder_in_x ? nu * inverse_length : 0.0, ny = g.cylinder_in_x ? 0.0 : nu * inverse_length;
+    const double cos_i = nx * r.l + ny * r.m + nz * inverse_length * r.n;
+    if (!(sense * cos_i > 0.0)) continue;
+    hit.t = t;
+    hit.nx = nx;
+    hit.ny = ny;
+    hit.nz = nz * inverse_length;
+    hit.cos_i = cos_i;
+    hit.cos_i_squared = cos_i * cos_i;
+    return RayStatus::Ok;
   }
   return RayStatus::Missed;
 }
@@ -776,6 +827,8 @@ RayStatus propagate_general(const Core& impl, State& r, double wavelength_nm, co
       status = RayStatus::Missed;
     } else if (g.shape == Shape::General) {
       status = intersect_general(impl.shapes[static_cast<std::size_t>(k)], local, sense, hit);
+    } else if (g.shape == Shape::Cylinder) {
+      status = intersect_cylinder(g, local, sense, hit);
     } else {
       status = intersect(g, local, sense, hit);
     }
@@ -982,7 +1035,16 @@ SequentialTracer::SequentialTracer(const Prescription& lens, const TracerOptions
     g.is_break = s.is_coordinate_break();
     g.mirror = s.mirror;
     if (impl->general) g.z_vertex_mm = 0.0;  // the frames place the surfaces
-    if (s.kind == SurfaceKind::Toroidal || s.kind == SurfaceKind::Biconic) {
+    // A cylinder: a biconic with one flat section, or a toroid without y terms swept along x (infinite radius of
+    // rotation); otherwise the general Newton intersection.
+    const bool biconic_cylinder = s.kind == SurfaceKind::Biconic && ((s.curvature_per_mm == 0.0) != (s.curvature_x_per_mm == 0.0));
+    const bool toroid_cylinder = s.kind == SurfaceKind::Toroidal && s.curvature_x_per_mm == 0.0 && !s.has_asphere() && s.curvature_per_mm != 0.0;
+    if (biconic_cylinder || toroid_cylinder) {
+      g.shape = Shape::Cylinder;
+      g.cylinder_in_x = s.curvature_per_mm == 0.0;
+      g.curvature_per_mm = g.cylinder_in_x ? s.curvature_x_per_mm : s.curvature_per_mm;
+      g.one_plus_conic = 1.0 + (g.cylinder_in_x ? s.conic_x : s.conic);
+    } else if (s.kind == SurfaceKind::Toroidal || s.kind == SurfaceKind::Biconic) {
       g.shape = Shape::General;
     } else if (g.is_break) {
       g.shape = Shape::Plane;
