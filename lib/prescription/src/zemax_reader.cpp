@@ -797,6 +797,8 @@ class ZemaxParser {
 
     const ZmxSurface& object = surfaces_.front();
     if (object.stop) fail(object.stop_line, 0, "STOP on the object surface (SURF 0)");
+    if (object.break_before) fail(object.break_line, 0, "SCBD: a tilted or decentred object surface (SURF 0) is not supported");
+    if (object.type == "COORDBRK" || object.mirror) fail(object.line, 0, "the object surface (SURF 0) must be a plain surface");
     if (object.disz_infinite) {
       p.object_distance_mm = kInfinity;
     } else {
