@@ -52,6 +52,11 @@ ojson listing_json(const RayTraceListing& r, const std::string& aim) {
   ojson points = ojson::array();
   for (const SurfaceHit& h : r.hits) points.push_back(point_json(h.surface, h.point_mm, h.direction_after));
   o["points"] = points;
+  if (r.folded) {
+    ojson local = ojson::array();
+    for (const SurfaceHit& h : r.local_hits) local.push_back(point_json(h.surface, h.point_mm, h.direction_after));
+    o["points_local"] = local;
+  }
   if (r.image) {
     o["image"] = {{"x_mm", r.image->x_mm}, {"y_mm", r.image->y_mm}, {"z_mm", r.image->z_mm},
                   {"l", r.image_direction.x()}, {"m", r.image_direction.y()}, {"n", r.image_direction.z()}};

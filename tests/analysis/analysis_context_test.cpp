@@ -4,9 +4,11 @@
 
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <string>
 
 #include "lensmith/analysis/ray_trace_listing.h"
 #include "lensmith/core/errors.h"
+#include "lensmith/prescription/lens_file.h"
 #include "reference_lenses.h"
 
 using Catch::Matchers::WithinAbs;
@@ -75,4 +77,24 @@ TEST_CASE("one real ray that is vignetted reports the surface, and no image poin
   CHECK(!r.image.has_value());
   o.pupil = {2.0, 0.0};
   CHECK_THROWS_WITH(o.validate(), Catch::Contains("unit disc"));
+}
+
+TEST_CASE("A traced ray through a folded system is also listed in each surface's own frame, as OpticStudio lists it",
+          "[analysis][coordinate-break]") {
+  // Edmund's 90-degree off-axis paraboloid (tests/data/zemax/real): a decentring break, the mirror, the image
+  // plane turned 90 degrees. In the mirror's frame the ray meets the paraboloid 190.6 mm + 12.7 mm off its
+  // axis (the beam's offset plus the pupil point) at its sag; at the turned image plane, in its own frame, it
+  // is at the focus, the origin.
+  const std::string path = std::string(LENSMITH_TEST_DATA_DIR) + "/zemax/real/zmax_37992.zmx";
+  const Prescription lens = read_lens_file(path).prescription;
+  RayTraceOptions o;
+  o.pupil = {0.0, 0.5};
+  const RayTraceListing r = trace_ray_listing(lens, o);
+  REQUIRE(r.status == RayStatus::Ok);
+  REQUIRE(r.folded);
+  REQUIRE(r.local_hits.size() == 4);
+  const Eigen::Vector3d& on_mirror = r.local_hits[2].point_mm;
+  CHECK_THAT(on_mirror.y(), Catch::Matchers::WithinAbs(190.6 + 12.7, 1e-9));
+  CHECK_THAT(on_mirror.z(), Catch::Matchers::WithinAbs(lens.surfaces[2].sag_mm(190.6 + 12.7), 1e-9));
+  CHECK(r.local_hits[3].point_mm.norm() < 1e-9);
 }

@@ -48,6 +48,17 @@ RayTraceListing trace_ray_listing(const Prescription& lens, const RayTraceOption
     return out;
   }
   const TraceResult result = tracer.trace_forward(aimed.ray, &out.hits);
+  out.folded = !lens.is_coaxial();
+  if (out.folded) {
+    for (const SurfaceHit& h : out.hits) {
+      const SurfaceFrame frame = tracer.surface_frame(h.surface);
+      SurfaceHit local = h;
+      local.point_mm = frame.to_local(h.point_mm);
+      local.direction_after = frame.axes.transpose() * h.direction_after;
+      local.normal = frame.axes.transpose() * h.normal;
+      out.local_hits.push_back(local);
+    }
+  }
   out.status = result.status;
   out.surface = result.surface;
   if (result.ok()) {
@@ -80,6 +91,19 @@ std::string RayTraceListing::to_string() const {
     std::snprintf(line, sizeof line, "%8s %14.6f %14.6f %14.6f %12.8f %12.8f %12.8f\n", "image", image->x_mm, image->y_mm, image->z_mm,
                   image_direction.x(), image_direction.y(), image_direction.z());
     os << line;
+  }
+  if (folded) {
+    os << "\nIn each surface's own frame (as OpticStudio's Single Ray Trace lists it: z is the sag; the image in its own\n"
+          "plane's frame, z reversed where light arrives toward its -z):\n";
+    std::snprintf(line, sizeof line, "%8s %14s %14s %14s %12s %12s %12s\n", "surface", "x", "y", "z", "l", "m", "n");
+    os << line;
+    for (const SurfaceHit& h : local_hits) {
+      std::snprintf(line, sizeof line, "%8d %14.6f %14.6f %14.6f %12.8f %12.8f %12.8f\n", h.surface, h.point_mm.x(), h.point_mm.y(),
+                    h.point_mm.z(), h.direction_after.x(), h.direction_after.y(), h.direction_after.z());
+      os << line;
+    }
+  }
+  if (image) {
     os << "\nStatus: ok (reached the image plane at z = " << fixed(image_plane_z_mm, 6) << " mm)\n";
   } else {
     os << "\nStatus: " << lensmith::to_string(status);

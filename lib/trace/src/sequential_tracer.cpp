@@ -813,6 +813,19 @@ RayStatus propagate_general(const Core& impl, State& r, double wavelength_nm, co
     const SurfaceGeometry& g = impl.surfaces[static_cast<std::size_t>(k)];
     const SurfaceFrame& frame = impl.frames[static_cast<std::size_t>(k)];
     if (g.is_break) {
+      // The ray moves (virtually where need be) to the break's x-y plane, as OpticStudio traces it: the next
+      // surface's intersection starts from any point of the line, and the listing shows it there.
+      State local = r;
+      to_frame(frame, local);
+      if (local.n != 0.0) {
+        const double t = -local.z / local.n;
+        local.x += t * local.l;
+        local.y += t * local.m;
+        local.z = 0.0;
+        local.opl += n_current * t;
+        r = local;
+        from_frame(frame, r);
+      }
       if constexpr (kRecord) {
         path->push_back(SurfaceHit{k + 1, Eigen::Vector3d(r.x, r.y, r.z), Eigen::Vector3d(r.l, r.m, r.n), frame.axes.col(2), r.opl});
       }

@@ -31,6 +31,10 @@ struct RayTraceListing {
   int surface = 0;                       // where the ray died; 0 when it reached the image
   Ray object_ray;                        // the aimed ray in object space
   std::vector<SurfaceHit> hits;          // one per surface reached
+  // The same hits in each surface's own frame (its vertex at the origin, z the sag, directions in its axes):
+  // what OpticStudio's Single Ray Trace lists. Filled for systems with tilts or decentres (folded = true).
+  std::vector<SurfaceHit> local_hits;
+  bool folded = false;
   std::optional<ImagePoint> image;       // on the image plane; empty when the ray died
   Eigen::Vector3d image_direction{0.0, 0.0, 1.0};
   double image_plane_z_mm = 0.0;
