@@ -423,6 +423,13 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     if (o.lens.empty()) throw UsageError("give --lens LENS (a file or shipped lens name) or --thin-lens --focal-length MM");
     lens = load_lens(o.lens, global);
     lens_name = lens->name.empty() ? o.lens : lens->name;
+    if (o.model.empty()) {
+      if (const auto why = Camera::exact_model_only_for(*lens)) {
+        // The default model is for round refracting lenses: the exact one photographs the others.
+        kind = RayModelKind::Exact;
+        if (!global.quiet) std::cerr << "note: " << lens_name << ": the exact model photographs this lens (" << *why << "; --model exact)\n";
+      }
+    }
     default_focal_mm = ParaxialSystem(*lens).efl_mm();
   }
   if (!o.focus_m && o.focus_pixel.empty() && !metadata.focus_from_pupil_m && !metadata.focus_from_image_plane_m) {

@@ -460,3 +460,23 @@ TEST_CASE("lensmith bokeh --method gather gathers at half resolution, traces hol
   CHECK(layered.err.find("not implemented") != std::string::npos);
   CHECK_FALSE(fs::exists(scratch("gather-deep.exr")));
 }
+
+TEST_CASE("lensmith bokeh without --model photographs a mirror lens with the exact model, and says so", "[cli][bokeh][mirror]") {
+  const fs::path image = scratch("mirror-in.exr"), depth = scratch("mirror-depth.exr"), out = scratch("mirror-out.exr");
+  const std::string source = std::string(LENSMITH_SOURCE_DIR);
+  const auto rendered = run_lensmith("scene render " + source + "/examples/scenes/mirror-lens-highlights.json --pinhole --width 96 "
+                                     "--height 54 --sensor-width 36 --pinhole-focal-length 500 --depth " + depth.string() + " -o " +
+                                     image.string() + " --quiet");
+  REQUIRE(rendered.exit_code == 0);
+  const auto r = run_lensmith("bokeh --image " + image.string() + " --depth " + depth.string() + " --lens " + source +
+                              "/examples/lenses/cassegrain-500mm.json --focus 30 -o " + out.string());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK_THAT(r.err, Catch::Contains("the exact model photographs this lens") && Catch::Contains("2 mirrors"));
+  CHECK(value_of(lensmith::read_image_metadata(out), "lensmith:model") == "exact");
+  // Asked for another model, it is refused with the reason and the way out.
+  const auto seidel = run_lensmith("bokeh --image " + image.string() + " --depth " + depth.string() + " --lens " + source +
+                                   "/examples/lenses/cassegrain-500mm.json --focus 30 --model seidel -o " + out.string());
+  CHECK(seidel.exit_code != 0);
+  CHECK_THAT(seidel.err, Catch::Contains("--model exact"));
+}

@@ -94,17 +94,26 @@ Camera Camera::thin_lens(double focal_length_mm, const CameraOptions& options, i
   return c;
 }
 
-Camera Camera::from_lens(const Prescription& lens, const CameraOptions& options, int width_px, int height_px) {
-  options.validate();
-  // What the camera takes (docs/bokeh.md, "Mirror and anamorphic lenses"): coaxial systems whose image faces
-  // the way light left the scene. Tilts, decentres and an odd number of mirrors are not implemented yet: the
-  // camera's first-order frame would have to follow the folded axis.
+std::optional<std::string> Camera::exact_model_only_for(const Prescription& lens) {
   int mirrors = 0;
   bool obscured = false;
   for (const Surface& s : lens.surfaces) {
     mirrors += s.mirror ? 1 : 0;
     obscured = obscured || (s.aperture && s.aperture->obscuration);
   }
+  if (const auto why = lens.why_not_rotationally_symmetric()) return *why;
+  if (mirrors > 0) return "it has " + std::to_string(mirrors) + " mirrors";
+  if (obscured) return std::string("it has a central obscuration");
+  return std::nullopt;
+}
+
+Camera Camera::from_lens(const Prescription& lens, const CameraOptions& options, int width_px, int height_px) {
+  options.validate();
+  // What the camera takes (docs/bokeh.md, "Mirror and anamorphic lenses"): coaxial systems whose image faces
+  // the way light left the scene. Tilts, decentres and an odd number of mirrors are not implemented yet: the
+  // camera's first-order frame would have to follow the folded axis.
+  int mirrors = 0;
+  for (const Surface& s : lens.surfaces) mirrors += s.mirror ? 1 : 0;
   if (!lens.is_coaxial()) {
     // A tilt-shift lens: elements turned or moved between a break and its inverse, the sensor square to the
     // camera's axis (moved across it, as a shifted image is). A folded or off-axis system whose image plane is
@@ -122,14 +131,7 @@ Camera Camera::from_lens(const Prescription& lens, const CameraOptions& options,
     throw ComputationError("the bokeh camera does not take a lens with an odd number of mirrors yet (" + std::to_string(mirrors) +
                            "): its image faces back toward the scene (not implemented)");
   }
-  std::optional<std::string> exact_only;
-  if (const auto why = lens.why_not_rotationally_symmetric()) {
-    exact_only = *why;
-  } else if (mirrors > 0) {
-    exact_only = "it has " + std::to_string(mirrors) + " mirrors";
-  } else if (obscured) {
-    exact_only = "it has a central obscuration";
-  }
+  const std::optional<std::string> exact_only = exact_model_only_for(lens);
   // A camera's pupil is where its stop images, at its f-number: a lens file's object-space telecentric
   // flag (a measuring lens's) is dropped.
   Prescription as_camera = lens;

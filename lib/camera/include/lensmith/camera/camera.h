@@ -78,6 +78,8 @@ class Camera {
   // Why only the exact model can photograph through this lens (its mirrors, central obscurations or
   // surfaces that are not rotationally symmetric are beyond the other models); empty when every model can.
   const std::optional<std::string>& exact_model_only() const { return exact_model_only_; }
+  // The same for a lens before a camera is made of it (the CLI's default model follows it).
+  static std::optional<std::string> exact_model_only_for(const Prescription& lens);
   // The prescription at the chosen f-number (aperture spec and stop semi-diameter set to it); null
   // for a thin lens.
   const Prescription* lens() const { return lens_.get(); }
