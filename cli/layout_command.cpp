@@ -13,7 +13,7 @@ int run_layout(const LayoutCommandOptions& options, const GlobalOptions& global)
   AnalysisOptions analysis = make_analysis_options(options.common);
   // Drawn bundles fill the real stop where real aiming exists (rotationally symmetric refracting lenses).
   if (options.common.aim.empty()) {
-    analysis.aiming = lens.has_mirrors() || !lens.is_rotationally_symmetric() ? RayAiming::ParaxialEntrancePupil : RayAiming::RealStop;
+    analysis.aiming = lens.why_no_real_ray_aiming() ? RayAiming::ParaxialEntrancePupil : RayAiming::RealStop;
   }
   // Without a field the bundles are drawn on axis only (a lens file need not give one).
   if (!lens.field && !options.common.field_angle_deg) analysis.relative_fields = {0.0};

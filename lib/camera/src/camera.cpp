@@ -95,14 +95,10 @@ Camera Camera::thin_lens(double focal_length_mm, const CameraOptions& options, i
 }
 
 std::optional<std::string> Camera::exact_model_only_for(const Prescription& lens) {
-  int mirrors = 0;
-  bool obscured = false;
-  for (const Surface& s : lens.surfaces) {
-    mirrors += s.mirror ? 1 : 0;
-    obscured = obscured || (s.aperture && s.aperture->obscuration);
-  }
   if (const auto why = lens.why_not_rotationally_symmetric()) return *why;
-  if (mirrors > 0) return "it has " + std::to_string(mirrors) + " mirrors";
+  if (const int mirrors = lens.mirror_count(); mirrors > 0) return "it has " + std::to_string(mirrors) + " mirrors";
+  const bool obscured =
+      std::any_of(lens.surfaces.begin(), lens.surfaces.end(), [](const Surface& s) { return s.aperture && s.aperture->obscuration; });
   if (obscured) return std::string("it has a central obscuration");
   return std::nullopt;
 }
@@ -112,8 +108,7 @@ Camera Camera::from_lens(const Prescription& lens, const CameraOptions& options,
   // What the camera takes (docs/bokeh.md, "Mirror and anamorphic lenses"): coaxial systems whose image faces
   // the way light left the scene. Tilts, decentres and an odd number of mirrors are not implemented yet: the
   // camera's first-order frame would have to follow the folded axis.
-  int mirrors = 0;
-  for (const Surface& s : lens.surfaces) mirrors += s.mirror ? 1 : 0;
+  const int mirrors = lens.mirror_count();
   if (!lens.is_coaxial()) {
     // A tilt-shift lens: elements turned or moved between a break and its inverse, the sensor square to the
     // camera's axis (moved across it, as a shifted image is). A folded or off-axis system whose image plane is

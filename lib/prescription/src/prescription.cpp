@@ -94,8 +94,8 @@ double Prescription::vertex_z_mm(std::size_t surface_index) const {
   return z;
 }
 
-bool Prescription::has_mirrors() const {
-  return std::any_of(surfaces.begin(), surfaces.end(), [](const Surface& s) { return s.mirror; });
+int Prescription::mirror_count() const {
+  return static_cast<int>(std::count_if(surfaces.begin(), surfaces.end(), [](const Surface& s) { return s.mirror; }));
 }
 
 bool Prescription::is_coaxial() const {
@@ -115,6 +115,12 @@ std::optional<std::string> Prescription::why_not_rotationally_symmetric() const 
     }
     if (!s.is_rotationally_symmetric()) return "surface " + std::to_string(i + 1) + " is " + std::string(lensmith::to_string(s.kind));
   }
+  return std::nullopt;
+}
+
+std::optional<std::string> Prescription::why_no_real_ray_aiming() const {
+  if (auto why = why_not_rotationally_symmetric()) return why;
+  if (has_mirrors()) return std::string("it has mirrors");
   return std::nullopt;
 }
 

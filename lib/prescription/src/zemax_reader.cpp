@@ -843,11 +843,12 @@ class ZemaxParser {
     set_field(p);
     set_wavelengths(p);
     p.ray_aiming = ray_aiming_;
-    if (ray_aiming_ == RayAiming::RealStop && (p.has_mirrors() || !p.is_rotationally_symmetric())) {
-      note(raim_line_, "real ray aiming (RAIM) is implemented for rotationally symmetric refracting lenses; this system has " +
-                           std::string(p.has_mirrors() ? "mirrors" : "surfaces that are not rotationally symmetric") +
-                           ", so rays are aimed at the paraxial entrance pupil (OpticStudio's \"ray aiming off\")");
-      p.ray_aiming = RayAiming::ParaxialEntrancePupil;
+    if (ray_aiming_ == RayAiming::RealStop) {
+      if (const auto why = p.why_no_real_ray_aiming()) {
+        note(raim_line_, "real ray aiming (RAIM) is implemented for rotationally symmetric refracting lenses, not for this one (" +
+                             *why + "), so rays are aimed at the paraxial entrance pupil (OpticStudio's \"ray aiming off\")");
+        p.ray_aiming = RayAiming::ParaxialEntrancePupil;
+      }
     }
     if (field_type_ && field_type_->telecentric) {
       p.object_space_telecentric = true;

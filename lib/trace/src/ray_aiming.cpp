@@ -707,11 +707,11 @@ RayAimer::RayAimer(const SequentialTracer& tracer, const AimOptions& options)
     : tracer_(tracer), options_(options), paraxial_(tracer.lens()) {
   options_.validate();
   const Prescription& lens = tracer_.lens();
-  if (options_.aiming == RayAiming::RealStop && (lens.has_mirrors() || !lens.is_rotationally_symmetric())) {
-    // The real-stop solver follows rays backward from the stop along one axis (docs/trace.md).
-    const auto why = lens.why_not_rotationally_symmetric();
-    throw OptionsError("real ray aiming is implemented for rotationally symmetric refracting lenses, not for this one (" +
-                       (why ? *why : std::string("it has mirrors")) + "): aim at the paraxial entrance pupil (--aim paraxial)");
+  if (options_.aiming == RayAiming::RealStop) {
+    if (const auto why = lens.why_no_real_ray_aiming()) {
+      throw OptionsError("real ray aiming is implemented for rotationally symmetric refracting lenses, not for this one (" +
+                         *why + "): aim at the paraxial entrance pupil (--aim paraxial)");
+    }
   }
   const int stop = paraxial_.stop_surface();
   // Pupil coordinate 1 is the edge of the beam the aperture specification defines (as in Zemax): the

@@ -121,7 +121,9 @@ struct Prescription {
   // included (after a mirror thicknesses are negative); otherwise it is a position along the folded path
   // only, and surface_frames (lensmith/trace/surface_frames.h) places the surfaces.
   double vertex_z_mm(std::size_t surface_index) const;
-  bool has_mirrors() const;
+  // Reflecting surfaces: an odd count turns the image to face back toward the object.
+  int mirror_count() const;
+  bool has_mirrors() const { return mirror_count() > 0; }
   // No coordinate break decentres or tilts anything: every surface is centred on one z axis.
   bool is_coaxial() const;
   // Coaxial, and every surface rotationally symmetric (no toroid or biconic with unequal sections): what
@@ -129,6 +131,10 @@ struct Prescription {
   bool is_rotationally_symmetric() const;
   // Why not, naming the first surface that breaks the symmetry ("surface 3 is toroidal"); empty when it is.
   std::optional<std::string> why_not_rotationally_symmetric() const;
+  // Why real-stop ray aiming does not apply ("it has mirrors", or why_not_rotationally_symmetric): the
+  // real-stop solver follows rays backward from the stop along one axis, so it is implemented for
+  // rotationally symmetric refracting lenses only (docs/trace.md, "Ray aiming"). Empty when it applies.
+  std::optional<std::string> why_no_real_ray_aiming() const;
   // z of the last vertex, mm.
   double last_vertex_z_mm() const;
 
