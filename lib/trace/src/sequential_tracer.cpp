@@ -522,6 +522,18 @@ RayStatus intersect_general(const Surface& shape, const State& r, double sense, 
 // ---------------------------------------------------------------------------------------------
 namespace trace_detail {
 
+// A surface's frame, and whether it is only moved along the global z axis (coaxial mirror systems, the
+// surfaces between breaks that turn nothing): such a frame is entered by a subtraction, decided once here
+// rather than per ray.
+struct PlacedFrame {
+  SurfaceFrame frame;
+  bool along_z_only = true;
+
+  PlacedFrame() = default;
+  explicit PlacedFrame(const SurfaceFrame& f)
+      : frame(f), along_z_only(f.origin_mm.x() == 0.0 && f.origin_mm.y() == 0.0 && f.axes.isIdentity(0.0)) {}
+};
+
 // Shared, immutable after construction except for the wavelength cache, which is thread-safe.
 struct TracerCore {
   // Open-addressing table of wavelengths (keyed by their bit pattern) published with release stores,
@@ -537,9 +549,9 @@ struct TracerCore {
   // (vertex at the local origin, SurfaceGeometry::z_vertex_mm 0), the shapes Surface knows, the image plane's
   // frame and the direction light reaches it (+1: toward its +z).
   bool general = false;
-  std::vector<SurfaceFrame> frames;
+  std::vector<PlacedFrame> frames;
   std::vector<Surface> shapes;
-  SurfaceFrame image_frame;
+  PlacedFrame image_frame;
   double image_sense = 1.0;
 
   // Row layout for N surfaces: n_0..n_N, then mu_forward_k = n_(k-1) / n_k and mu_backward_k = n_k / n_(k-1)
@@ -611,6 +623,7 @@ struct SequentialTracer::Impl : trace_detail::TracerCore {};
 namespace {
 
 using Core = trace_detail::TracerCore;
+using trace_detail::PlacedFrame;
 
 // A ray on its way through the lens: its state, the index row of its wavelength (nullptr: evaluate the
 // glasses), the index of the medium it is in, and the next conic's B carried over the last refraction.
@@ -770,12 +783,9 @@ RayStatus propagate(const Core& impl, State& r, double wavelength_nm, const doub
 // on the image plane in the image frame (x, y as there; z = image_plane_z_mm, travelling +z: after an odd
 // number of reflections the frame's z is reversed, so that every analysis sees light going +z).
 
-// Frames that are only moved along the axis (coaxial mirror systems, the surfaces between breaks that turn
-// nothing) are entered by a subtraction.
-inline bool unturned(const SurfaceFrame& f) { return f.axes.isIdentity(0.0); }
-
-inline void to_frame(const SurfaceFrame& f, State& r) {
-  if (f.origin_mm.x() == 0.0 && f.origin_mm.y() == 0.0 && unturned(f)) {
+inline void to_frame(const PlacedFrame& placed, State& r) {
+  const SurfaceFrame& f = placed.frame;
+  if (placed.along_z_only) {
     r.z -= f.origin_mm.z();
     return;
   }
@@ -785,8 +795,9 @@ inline void to_frame(const SurfaceFrame& f, State& r) {
   r.l = d.x(); r.m = d.y(); r.n = d.z();
 }
 
-inline void from_frame(const SurfaceFrame& f, State& r) {
-  if (f.origin_mm.x() == 0.0 && f.origin_mm.y() == 0.0 && unturned(f)) {
+inline void from_frame(const PlacedFrame& placed, State& r) {
+  const SurfaceFrame& f = placed.frame;
+  if (placed.along_z_only) {
     r.z += f.origin_mm.z();
     return;
   }
@@ -811,7 +822,7 @@ RayStatus propagate_general(const Core& impl, State& r, double wavelength_nm, co
   for (int step = 0; step < count; ++step) {
     const int k = kForward ? step : count - 1 - step;
     const SurfaceGeometry& g = impl.surfaces[static_cast<std::size_t>(k)];
-    const SurfaceFrame& frame = impl.frames[static_cast<std::size_t>(k)];
+    const PlacedFrame& frame = impl.frames[static_cast<std::size_t>(k)];
     if (g.is_break) {
       // The ray moves (virtually where need be) to the break's x-y plane, as OpticStudio traces it: the next
       // surface's intersection starts from any point of the line, and the listing shows it there.
@@ -827,7 +838,7 @@ RayStatus propagate_general(const Core& impl, State& r, double wavelength_nm, co
         from_frame(frame, r);
       }
       if constexpr (kRecord) {
-        path->push_back(SurfaceHit{k + 1, Eigen::Vector3d(r.x, r.y, r.z), Eigen::Vector3d(r.l, r.m, r.n), frame.axes.col(2), r.opl});
+        path->push_back(SurfaceHit{k + 1, Eigen::Vector3d(r.x, r.y, r.z), Eigen::Vector3d(r.l, r.m, r.n), frame.frame.axes.col(2), r.opl});
       }
       continue;
     }
@@ -858,7 +869,7 @@ RayStatus propagate_general(const Core& impl, State& r, double wavelength_nm, co
         State global = local;
         from_frame(frame, global);
         path->push_back(SurfaceHit{k + 1, Eigen::Vector3d(global.x, global.y, global.z), Eigen::Vector3d(global.l, global.m, global.n),
-                                   frame.axes * Eigen::Vector3d(hit.nx, hit.ny, hit.nz), global.opl});
+                                   frame.frame.axes * Eigen::Vector3d(hit.nx, hit.ny, hit.nz), global.opl});
       }
     };
     if (clip && (local.x * local.x + local.y * local.y > g.clip_radius2_mm2 ||
@@ -1017,17 +1028,13 @@ SequentialTracer::SequentialTracer(const Prescription& lens, const TracerOptions
                   });
   if (impl->general) {
     const LensFrames frames = surface_frames(lens_, image_distance_mm);
-    impl->frames = frames.surfaces;
-    impl->image_frame = frames.image;
+    for (const SurfaceFrame& f : frames.surfaces) impl->frames.emplace_back(f);
+    impl->image_frame = trace_detail::PlacedFrame(frames.image);
     impl->shapes = lens_.surfaces;
     // The output z of the image plane stays the sum of the thicknesses (where it lies in a coaxial system,
     // so that with an even number of mirrors the output frame is the global frame); light reaches it toward
     // +z or -z of its frame as the number of reflections says (a probe below corrects that for tilted planes).
-    double sense = 1.0;
-    for (const Surface& s : lens_.surfaces) {
-      if (s.mirror) sense = -sense;
-    }
-    impl->image_sense = sense;
+    impl->image_sense = lens_.mirror_count() % 2 == 0 ? 1.0 : -1.0;
   }
   impl->image_plane_z_mm = image_plane_z_mm_;
   impl->media.reserve(count + 1);
@@ -1112,7 +1119,7 @@ double SequentialTracer::vertex_z_mm(int surface) const {
 
 SurfaceFrame SequentialTracer::surface_frame(int surface) const {
   const double z = vertex_z_mm(surface);  // checks the range
-  if (impl_->general) return impl_->frames[static_cast<std::size_t>(surface) - 1];
+  if (impl_->general) return impl_->frames[static_cast<std::size_t>(surface) - 1].frame;
   SurfaceFrame f;
   f.origin_mm = Eigen::Vector3d(0.0, 0.0, z);
   return f;
@@ -1120,7 +1127,7 @@ SurfaceFrame SequentialTracer::surface_frame(int surface) const {
 
 Eigen::Vector3d SequentialTracer::image_point_in_global_frame(const Eigen::Vector3d& p) const {
   if (!impl_->general) return p;
-  return impl_->image_frame.to_global(Eigen::Vector3d(p.x(), p.y(), impl_->image_sense * (p.z() - impl_->image_plane_z_mm)));
+  return impl_->image_frame.frame.to_global(Eigen::Vector3d(p.x(), p.y(), impl_->image_sense * (p.z() - impl_->image_plane_z_mm)));
 }
 
 double SequentialTracer::index_after(int surface, double wavelength_nm) const {
