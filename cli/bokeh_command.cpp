@@ -187,11 +187,13 @@ struct OutputExtras {
   std::string chromaticities;
   EdgeGrowth growth;
   int data_width = 0, data_height = 0;
+  int squeezed_width = 0;  // an anamorphic's picture narrowed to this width (anamorphic_output_width); 0: as rendered
 };
 
 // Writes the picture (RGB, or RGBA) in the output colour space, with the input's depth (--keep-depth)
-// and its passes after it.
-void write_bokeh_output(Image out, OutputMetadata& meta, const BokehCommandOptions& o, DepthMap depth, OtherChannels other,
+// and its passes after it, squeezed for an anamorphic lens (OutputExtras::squeezed_width); returns the
+// written size, "W x H".
+std::string write_bokeh_output(Image out, OutputMetadata& meta, const BokehCommandOptions& o, DepthMap depth, OtherChannels other,
                         const std::optional<ColorManagement>& color, const OutputExtras& extras) {
   meta.chromaticities = extras.chromaticities;
   if (const EdgeGrowth& g = extras.growth; g.any()) {
@@ -201,6 +203,16 @@ void write_bokeh_output(Image out, OutputMetadata& meta, const BokehCommandOptio
     depth.width = out.width = w;
     depth.height = out.height = h;
     if (!other.names.empty()) other.samples = crop_pixels(other.samples, w + g.left + g.right, static_cast<int>(other.names.size()), g.left, g.top, w, h);
+  }
+  if (const int narrow = extras.squeezed_width; narrow > 0) {
+    // As the sensor records it: each sensor pixel integrates its share of a row; the depth is the
+    // surface's under the pixel's centre (averaging depths would invent surfaces).
+    const int w = out.width, h = out.height;
+    out.data = squeeze_columns(out.data, w, h, out.channels, narrow);
+    depth.z_m = squeeze_columns_nearest(depth.z_m, w, h, 1, narrow);
+    if (!other.names.empty()) other.samples = squeeze_columns(other.samples, w, h, static_cast<int>(other.names.size()), narrow);
+    out.width = depth.width = narrow;
+    meta.camera.emplace_back("PixelAspectRatio", static_cast<double>(w) / narrow);
   }
   if (color && !color->options().output_colorspace.empty()) {
     color->working_to_output(out.data, out.channels);
@@ -222,6 +234,7 @@ void write_bokeh_output(Image out, OutputMetadata& meta, const BokehCommandOptio
     meta.extra.emplace_back("other_channels", o.other_channels);
   }
   write_output_image(o.output, out, meta, channels);
+  return std::to_string(out.width) + " x " + std::to_string(out.height);
 }
 
 }  // namespace
@@ -366,6 +379,13 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   for (const auto& [key, value] : attributes) {
     const std::optional<double> number = parse_finite_number(value);
     if (!number || !(*number > 0.0)) continue;
+    // A squeezed plate (an anamorphic's, or lensmith's own squeezed output) has wide pixels: its pixels
+    // do not look where a square pinhole frame says. Tolerance: OpenEXR stores the ratio as a float.
+    constexpr double kSquareTolerance = 1e-6;
+    if (key == "PixelAspectRatio" && std::abs(*number - 1.0) > kSquareTolerance) {
+      throw UsageError(o.image + ": its pixels are not square (pixel aspect ratio " + value + "): lensmith bokeh reads pictures with "
+                       "square pixels; desqueeze it first (e.g. oiiotool --resize), or render the input desqueezed (not implemented)");
+    }
     if (key == "lensmith:focal_length_mm" && !o.pinhole_focal_length_mm && !o.hfov_deg) {
       camera.framing.focal_length_mm = *number;
       from_file.push_back("pinhole focal length " + value + " mm");
@@ -540,6 +560,11 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   std::optional<Camera> cam = camera_for_model(kind, lens ? &*lens : nullptr, o.thin_lens ? thin_focal_mm : std::nullopt, camera,
                                                width, height);
   if (!cam->is_thin_lens()) warn_about_aperture(*cam, global);
+  extras.squeezed_width = anamorphic_output_width(*cam, extras.data_width, o.desqueeze, global);
+  if (extras.squeezed_width > 0 && windows.has_overscan()) {
+    throw UsageError(o.image + " has overscan (a data window beyond its display window): an anamorphic lens's picture with overscan "
+                     "is written desqueezed only (give --desqueeze; squeezing the windows is not implemented)");
+  }
   float nearest_m = std::numeric_limits<float>::infinity();
   for (float z : depth.z_m) nearest_m = std::min(nearest_m, z);
   RayModelOptions model_options;
@@ -574,11 +599,11 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture, windows);
     meta.extra.insert(meta.extra.end(), {{"views", std::to_string(options.views)}, {"mip_filter", options.mip_filter ? "on" : "off"},
                                          {"lightfield_colour", options.spectral ? "three wavelengths" : "reference wavelength"}});
-    write_bokeh_output(out, meta, o, depth, other, color, extras);
+    const std::string written = write_bokeh_output(out, meta, o, depth, other, color, extras);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     const double pixel_views = static_cast<double>(out.width) * out.height * options.views;
     std::ostringstream what;
-    what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds
+    what << output.string() << " (" << written << ") in " << std::fixed << std::setprecision(2) << seconds
          << " s (rendering " << render_seconds << " s)\n  " << lens_name << ", model " << to_string(kind) << ", method lightfield, f/"
          << format_rounded(cam->f_number(), 3) << ", focus " << format_rounded(camera.focus_distance_m, 4) << " m, " << aperture.to_string()
          << " aperture\n  " << options.views << " views, "
@@ -608,10 +633,10 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture, windows);
     meta.extra.insert(meta.extra.end(), {{"splat_kernel", options.lens_psf ? "lens psf" : "circular coc"},
                                          {"level_of_detail", options.level_of_detail ? "on" : "off"}});
-    write_bokeh_output(out, meta, o, depth, other, color, extras);
+    const std::string written = write_bokeh_output(out, meta, o, depth, other, color, extras);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     std::ostringstream what;
-    what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds
+    what << output.string() << " (" << written << ") in " << std::fixed << std::setprecision(2) << seconds
          << " s (rendering " << render_seconds << " s)\n  " << lens_name << ", model " << to_string(kind) << ", method ewa, f/"
          << format_rounded(cam->f_number(), 3) << ", focus " << format_rounded(camera.focus_distance_m, 4) << " m, " << aperture.to_string()
          << " aperture\n  " << stats.splats << " splats ("
@@ -652,10 +677,10 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture, windows);
     meta.extra.insert(meta.extra.end(), {{"rings", std::to_string(options.rings)}, {"median", options.median ? "on" : "off"},
                                          {"hidden_surfaces", traced ? "trace " + o.scene : std::string("none")}});
-    write_bokeh_output(out, meta, o, depth, other, color, extras);
+    const std::string written = write_bokeh_output(out, meta, o, depth, other, color, extras);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     std::ostringstream what;
-    what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds
+    what << output.string() << " (" << written << ") in " << std::fixed << std::setprecision(2) << seconds
          << " s (rendering " << render_seconds << " s)\n  " << lens_name << ", model " << to_string(kind) << ", method gather, f/"
          << format_rounded(cam->f_number(), 3) << ", focus " << format_rounded(camera.focus_distance_m, 4) << " m, " << aperture.to_string()
          << " aperture\n  " << stats.half_width << " x " << stats.half_height << " half resolution, " << stats.taps << " taps ("
@@ -698,10 +723,10 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture, windows);
     meta.extra.insert(meta.extra.end(), {{"samples", std::to_string(options.samples)}, {"layers", std::to_string(options.layers)},
                                          {"cone_tracing", options.cone_tracing ? "on" : "off"}});
-    write_bokeh_output(out, meta, o, depth, other, color, extras);
+    const std::string written = write_bokeh_output(out, meta, o, depth, other, color, extras);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     std::ostringstream what;
-    what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds
+    what << output.string() << " (" << written << ") in " << std::fixed << std::setprecision(2) << seconds
          << " s (rendering " << render_seconds << " s)\n  " << lens_name << ", model " << to_string(kind) << ", method multiview, f/"
          << format_rounded(cam->f_number(), 3) << ", focus " << format_rounded(camera.focus_distance_m, 4) << " m, " << aperture.to_string()
          << " aperture\n  " << stats.layers << " of " << options.layers << " depth layers hold samples, "
@@ -762,10 +787,10 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
 
   OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture, windows);
   meta.extra.insert(meta.extra.end(), {{"hidden_surfaces", std::string(to_string(options.hidden))}, {"edge_pixels", o.edge_pixels}});
-  write_bokeh_output(out, meta, o, depth, other, color, extras);
+  const std::string written = write_bokeh_output(out, meta, o, depth, other, color, extras);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   std::ostringstream what;
-  what << output.string() << " (" << out.width << " x " << out.height << ") in " << std::fixed << std::setprecision(2) << seconds
+  what << output.string() << " (" << written << ") in " << std::fixed << std::setprecision(2) << seconds
        << " s (rendering " << render_seconds << " s)\n  " << lens_name << ", model " << to_string(kind) << (kind == RayModelKind::Seidel ? " (" + o.seidel_coefficients + " terms)" : std::string()) << ", f/"
        << format_rounded(cam->f_number(), 3) << ", focus " << format_rounded(camera.focus_distance_m, 4) << " m, " << aperture.to_string()
        << " aperture\n  " << stats.layers << " depth layers " << format_rounded(stats.layer_spacing_px, 3) << " px apart, largest blur "

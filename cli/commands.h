@@ -153,6 +153,7 @@ struct BokehCommandOptions {
   std::string output_colorspace;             // --output-colorspace NAME (default: the input's for .exr, else linear Rec.709)
   std::string working_colorspace;            // --working-colorspace NAME: the config's linear Rec.709 (configs without aces_interchange)
   bool keep_depth = false;                   // --keep-depth: the input's planar depth as Z in an EXR output
+  bool desqueeze = false;                    // --desqueeze: an anamorphic's picture at the input's width, not squeezed
   std::string other_channels = "keep";       // --other-channels keep|defocus|drop: an EXR input's other passes
   std::optional<double> sensor_width_mm;     // --sensor-width of the pinhole image; default the EXR's or 36
   std::optional<double> pinhole_focal_length_mm;  // --pinhole-focal-length; default: the lens EFL
@@ -275,6 +276,7 @@ struct SceneRenderOptions {
   bool no_spectral = false;                       // --no-spectral
   int spectral_samples = 16;                      // --spectral-samples
   std::uint64_t seed = 1;                         // --seed
+  bool desqueeze = false;                         // --desqueeze: an anamorphic's picture at --width, not squeezed
   int threads = 0;                                // --threads (0 = all)
 };
 int run_scene_render(const SceneRenderOptions& options, const GlobalOptions& global);
@@ -286,6 +288,12 @@ void print_diagnostics(const Diagnostics& diagnostics, const GlobalOptions& glob
 // aperture: how much of the axial beam the clear apertures then pass, and the fastest f-number they
 // pass whole.
 void warn_about_aperture(const Camera& camera, const GlobalOptions& global);
+
+// The width (px) an anamorphic lens's picture of `width_px` columns is written at: narrowed by the
+// camera's squeeze, as the sensor records it, unless `desqueeze` (then 0: as rendered, the input's
+// framing); 0 for a lens that does not squeeze. Notes on stderr (unless quiet) what is written, and where
+// the x section focuses when that is not where the sensor focuses y (docs/bokeh.md, "Anamorphic lenses").
+int anamorphic_output_width(const Camera& camera, int width_px, bool desqueeze, const GlobalOptions& global);
 
 // "wrote WHAT" on stderr unless quiet: every command reports the files it wrote there, the same
 // way (stdout carries the command's results, and its JSON).

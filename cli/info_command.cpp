@@ -44,8 +44,7 @@ int run_info(const InfoOptions& options, const GlobalOptions& global) {
 
   // A lens with toroidal or biconic surfaces has a second section: its x (sagittal) first-order data, and the
   // anamorphic squeeze EFL_y / EFL_x; or none, where the x section has no power (a cylinder alone).
-  bool anamorphic = false;
-  for (const Surface& s : lens.surfaces) anamorphic = anamorphic || (!s.is_rotationally_symmetric() && !s.is_coordinate_break());
+  const bool anamorphic = lens.is_anamorphic();
   std::optional<ParaxialSystem> x_system;
   std::string x_afocal;
   if (anamorphic) {

@@ -70,6 +70,37 @@ void warn_about_aperture(const Camera& camera, const GlobalOptions& global) {
   }
 }
 
+int anamorphic_output_width(const Camera& camera, int width_px, bool desqueeze, const GlobalOptions& global) {
+  const double squeeze = camera.squeeze();
+  // Below this the lens does not squeeze: a round lens's 1, to rounding.
+  constexpr double kRoundTolerance = 1e-9;
+  if (std::abs(squeeze - 1.0) <= kRoundTolerance) {
+    if (desqueeze && !global.quiet) std::cerr << "note: --desqueeze has no effect: the lens is not anamorphic\n";
+    return 0;
+  }
+  const int narrowed = std::clamp(static_cast<int>(std::lround(width_px / squeeze)), 1, width_px);
+  if (!global.quiet) {
+    std::cerr << "note: anamorphic squeeze " << format_rounded(squeeze, 4) << ": ";
+    if (desqueeze) {
+      std::cerr << "written desqueezed, " << width_px << " px wide as the input (--desqueeze)\n";
+    } else {
+      std::cerr << "written squeezed as on the sensor, " << narrowed << " px wide (pixel aspect ratio "
+                << format_rounded(static_cast<double>(width_px) / narrowed, 4) << "; --desqueeze for the input's " << width_px << ")\n";
+    }
+    // Where x focuses: noted when its depth of field would not reach the y section's focus plane,
+    // taken as 2 % in inverse distance.
+    constexpr double kSameFocus = 0.02;
+    const double y_mm = camera.focus_distance_mm(), x_mm = camera.x_section_focus_distance_mm().value_or(y_mm);
+    const double wy = std::isinf(y_mm) ? 0.0 : 1.0 / y_mm, wx = std::isinf(x_mm) ? 0.0 : 1.0 / x_mm;
+    if (std::abs(wx - wy) > kSameFocus * std::max(wy, 1e-3)) {
+      std::cerr << "note: the sensor focuses the y section at " << format_rounded(m_from_mm(y_mm), 4) << " m; the x section, whose focal "
+                << "length is shorter, is then focused at " << (std::isinf(x_mm) ? std::string("infinity") : format_rounded(m_from_mm(x_mm), 4) + " m")
+                << " (lensmith moves the sensor to focus; a real anamorphic focuses its cylinders too: not modelled)\n";
+    }
+  }
+  return desqueeze ? 0 : narrowed;
+}
+
 // Numeric checks whose messages read as prose: "must be > 0, got -1", "must be between 0.5 and 512,
 // got 600" (CLI11's own print the limits with six decimals, or 309 digits for "no limit").
 CLI::Validator positive() {
@@ -315,6 +346,9 @@ int main(int argc, char** argv) {
                         "The config's linear Rec.709 colour space, for configs without an aces_interchange role (OCIO 1 configs)");
   bokeh_cmd->add_flag("--keep-depth", bokeh.keep_depth,
                       "Write the input's depth (planar metres from the entrance pupil, inf for the sky) as the Z channel of an .exr output");
+  bokeh_cmd->add_flag("--desqueeze", bokeh.desqueeze,
+                      "An anamorphic lens's picture desqueezed, at the input's width and framing, instead of squeezed as on the sensor "
+                      "(width / squeeze, the EXR's pixelAspectRatio the squeeze)");
   bokeh_cmd->add_option("--focus-pixel", bokeh.focus_pixel, "Focus on the depth at this pixel of the input, X,Y (0,0 = top left), instead of --focus")
       ->excludes(bokeh_focus);
   bokeh_cmd->add_option("--sensor-width", bokeh.sensor_width_mm, "Sensor width of the input image's pinhole camera, mm (default: the EXR's lensmith:sensor_width_mm, else 36)")
@@ -521,7 +555,10 @@ int main(int argc, char** argv) {
       scene_render_cmd->add_option("--seed", scene_render.seed, "Random seed (default 1; the same seed gives the same image)"),
       scene_render_cmd->add_flag("--no-spectral", scene_render.no_spectral, "Trace every ray at 587.6 nm and keep RGB as it is"),
       scene_render_cmd->add_option("--spectral-samples", scene_render.spectral_samples, "Wavelengths of the spectral quadrature (3-64, default 16)")
-          ->check(range(3, 64))};
+          ->check(range(3, 64)),
+      scene_render_cmd->add_flag("--desqueeze", scene_render.desqueeze,
+                                 "An anamorphic lens's picture desqueezed, --width px wide as framed, instead of squeezed as on the sensor "
+                                 "(width / squeeze, the EXR's pixelAspectRatio the squeeze)")};
   for (CLI::Option* option : lens_only) option->excludes(scene_pinhole);
   scene_render_cmd->add_option("--width", scene_render.width_px, "Image width, px (default 640)")->check(range(1, 65536));
   scene_render_cmd->add_option("--height", scene_render.height_px, "Image height, px (default 360)")->check(range(1, 65536));

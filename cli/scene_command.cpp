@@ -113,6 +113,7 @@ int run_scene_render(const SceneRenderOptions& o, const GlobalOptions& global) {
     options.progress = [&bar](double f) { bar.update(f); };
     std::optional<Camera> camera;
     LensRender out;
+    int squeezed_width = 0;
     if (o.thin_lens) {
       if (!o.focal_length_mm) throw UsageError("--thin-lens needs --focal-length MM");
       camera = Camera::thin_lens(*o.focal_length_mm, camera_options, o.width_px, o.height_px);
@@ -125,6 +126,7 @@ int run_scene_render(const SceneRenderOptions& o, const GlobalOptions& global) {
       meta.model = "exact trace ground truth";
       camera = Camera::from_lens(lens, camera_options, o.width_px, o.height_px);
       warn_about_aperture(*camera, global);
+      squeezed_width = anamorphic_output_width(*camera, o.width_px, o.desqueeze, global);
       out = render_through_lens(scene, *camera, options);
     }
     bar.finish();
@@ -154,6 +156,13 @@ int run_scene_render(const SceneRenderOptions& o, const GlobalOptions& global) {
     if (clamped > 0) s << "\n  " << clamped << " negative channel values (spectral noise) clamped to 0: raise --spp";
     summary = s.str();
     rgb = std::move(out.rgb);
+    if (squeezed_width > 0) {
+      // As the sensor records it (the picture rendered at the input's framing, each sensor pixel
+      // integrating its share of a row); viewers desqueeze by the pixel aspect ratio.
+      rgb.data = squeeze_columns(rgb.data, rgb.width, rgb.height, rgb.channels, squeezed_width);
+      meta.camera.emplace_back("PixelAspectRatio", static_cast<double>(rgb.width) / squeezed_width);
+      rgb.width = squeezed_width;
+    }
   }
   write_output_image(output, rgb, meta);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

@@ -480,3 +480,38 @@ TEST_CASE("lensmith bokeh without --model photographs a mirror lens with the exa
   CHECK(seidel.exit_code != 0);
   CHECK_THAT(seidel.err, Catch::Contains("--model exact"));
 }
+
+TEST_CASE("lensmith bokeh writes an anamorphic lens's picture squeezed as on the sensor, desqueezed on request, and refuses a "
+          "squeezed input", "[cli][bokeh][anamorphic]") {
+  // lentil's Schneider anamorphic (entry 2004, US 6,310,731): EFL_y 60.55 mm, EFL_x 31.49 mm, squeeze 1.92 at infinity.
+  const std::string lens = std::string(LENSMITH_TEST_DATA_DIR) + "/lentil/lenses.json#2004";
+  const fs::path image = scratch("ana-in.exr"), depth = scratch("ana-depth.exr");
+  const fs::path squeezed = scratch("ana-squeezed.exr"), desqueezed = scratch("ana-desqueezed.exr");
+  const std::string source = std::string(LENSMITH_SOURCE_DIR);
+  REQUIRE(run_lensmith("scene render " + source + "/examples/scenes/highlight-field.json --pinhole --width 32 --height 18 "
+                       "--pinhole-focal-length 60.5546 --depth " + depth.string() + " -o " + image.string() + " --quiet")
+              .exit_code == 0);
+  const std::string common = "bokeh --image " + image.string() + " --depth " + depth.string() + " --lens \"" + lens + "\" --focus 30 --fstop 4 ";
+  const auto r = run_lensmith(common + "--keep-depth -o " + squeezed.string());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK_THAT(r.err, Catch::Contains("squeezed as on the sensor, 17 px wide") && Catch::Contains("(17 x 18)"));
+  // The squeeze at 30 m from the sections' magnifications: 1.918 (32 / 17 = 1.882 once rounded to whole pixels).
+  const lensmith::Image narrow = lensmith::read_radiance_image(squeezed);
+  CHECK(narrow.width == 17);
+  CHECK(narrow.height == 18);
+  CHECK_THAT(std::stod(value_of(lensmith::read_image_metadata(squeezed), "PixelAspectRatio")), Catch::WithinRel(32.0 / 17.0, 1e-6));
+  const auto d = run_lensmith(common + "--desqueeze -o " + desqueezed.string() + " --quiet");
+  REQUIRE(d.exit_code == 0);
+  const lensmith::Image wide = lensmith::read_radiance_image(desqueezed);
+  CHECK(wide.width == 32);
+  // Squeezing keeps each row's light: the means agree (the squeezed file is the desqueezed picture
+  // integrated over wider sensor pixels).
+  CHECK_THAT(narrow.mean(1), Catch::WithinRel(wide.mean(1), 1e-4));
+  // A squeezed plate has wide pixels: refused, with the way out.
+  const auto again = run_lensmith("bokeh --image " + squeezed.string() + " --thin-lens --focal-length 50 --fstop 2 --focus 3 -o " +
+                                  scratch("ana-again.exr").string());
+  CHECK(again.exit_code != 0);
+  CHECK_THAT(again.err, Catch::Contains("not square") && Catch::Contains("desqueeze it first"));
+  CHECK_FALSE(fs::exists(scratch("ana-again.exr")));
+}

@@ -173,6 +173,34 @@ Camera Camera::from_lens(const Prescription& lens, const CameraOptions& options,
   c.samples_ = ParaxialSpectralTable(*at_f_number, table_options).samples();
   c.lens_ = std::move(at_f_number);
   c.exact_model_only_ = exact_only;
+  if (lens.is_anamorphic()) {
+    // The x section frames x (finish()): its own focal length and principal planes, the y section's
+    // perspective centre (the picture's pinhole).
+    ParaxialOptions x;
+    x.wavelength_nm = c.reference_nm_;
+    x.object_distance_mm = kInfinity;
+    x.section = Section::X;
+    std::optional<ParaxialSystem> xs;
+    try {
+      xs.emplace(*c.lens_, x);
+    } catch (const ComputationError& e) {
+      throw ComputationError(std::string("the bokeh camera needs an anamorphic lens whose x section forms an image too: ") + e.what());
+    }
+    if (!(xs->efl_mm() > 0.0)) {
+      throw ComputationError("the bokeh camera needs an anamorphic lens whose x section forms a real image (EFL_x > 0); this one has EFL_x " +
+                             format_number(xs->efl_mm()) + " mm");
+    }
+    FirstOrderSample s;
+    s.wavelength_nm = c.reference_nm_;
+    s.efl_mm = xs->efl_mm();
+    s.z_front_principal_mm = xs->z_front_principal_mm();
+    s.z_rear_principal_mm = xs->z_rear_principal_mm();
+    s.z_entrance_pupil_mm = xs->entrance_pupil().z_mm;
+    s.z_exit_pupil_mm = xs->exit_pupil().z_mm;
+    s.entrance_pupil_radius_mm = 0.5 * xs->entrance_pupil().diameter_mm;
+    s.exit_pupil_radius_mm = 0.5 * xs->exit_pupil().diameter_mm;
+    c.x_section_ = s;
+  }
   c.finish();
   // The marginal ray from the axial point of the focus plane at N = n: its heights scale as n / N,
   // so the first clear aperture (the stop aside) it fills sets the fastest unclipped N.
@@ -229,6 +257,29 @@ void Camera::finish() {
   z_sensor_mm_ = focus_image.z_mm;
   // focus_image.x_mm is the sensor height of tangent 1 on the focus plane.
   px_per_sensor_mm_ = frame_.focal_length_px() / focus_image.x_mm;
+  px_per_sensor_mm_x_ = px_per_sensor_mm_;
+  if (x_section_) {
+    // The x section images the focus plane with its own magnification, and perhaps a little before or
+    // behind the sensor: its chief ray (through its exit pupil's centre) meets the sensor at the height
+    // the blurred image of the point is centred on.
+    const GaussianImage gx = gaussian_image({1.0, 0.0, w_focus}, *x_section_);
+    const double to_pupil = gx.z_mm - x_section_->z_exit_pupil_mm;
+    const double x_on_sensor = to_pupil == 0.0 ? gx.x_mm : gx.x_mm * (z_sensor_mm_ - x_section_->z_exit_pupil_mm) / to_pupil;
+    if (!(std::abs(x_on_sensor) > 0.0) || !std::isfinite(x_on_sensor)) {
+      throw ComputationError("the anamorphic lens's x section images the focus plane at infinity: no x framing (focus elsewhere)");
+    }
+    px_per_sensor_mm_x_ = frame_.focal_length_px() / x_on_sensor;
+  }
+}
+
+std::optional<double> Camera::x_section_focus_distance_mm() const {
+  if (!x_section_) return std::nullopt;
+  // Gauss between the x principal planes: 1 / s_o = 1 / f - 1 / s_i, s_o from the front principal plane,
+  // which lies Delta = z_front_principal - z_perspective behind the perspective centre (gaussian_image).
+  const FirstOrderSample& x = *x_section_;
+  const double inverse_object = 1.0 / x.efl_mm - 1.0 / (z_sensor_mm_ - x.z_rear_principal_mm);
+  if (!(inverse_object > 0.0)) return kInfinity;
+  return 1.0 / inverse_object - (x.z_front_principal_mm - z_perspective_mm_);
 }
 
 double Camera::signed_coc_px(double inverse_depth_per_mm) const {

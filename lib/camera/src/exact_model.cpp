@@ -93,14 +93,31 @@ void ExactModel::map_raw(const ScenePoint& point, double wavelength_nm, std::spa
     return true;
   };
 
-  // Affine map target -> stop point from the centre and two offsets at half the pupil radius.
+  // Affine map target -> stop point from the centre and two offsets at half the pupil radius. The
+  // centre: the paraxial chief ray's crossing of the target plane. An anamorphic lens's x section has
+  // its own entrance pupil (a front anamorphic group's lies far from the y section's): the chief ray
+  // heads for it in x, and a ray towards the y pupil's centre would miss the rear group off axis
+  // (lentil's Schneider anamorphic, entry 2004: beyond tan x = 0.2 at 30 m).
+  double cx = 0.0;
+  double hx = 0.5 * r_target;
+  if (const std::optional<FirstOrderSample>& xs = camera_.x_section()) {
+    const double z_x = xs->z_entrance_pupil_mm;
+    if (point.inverse_depth_per_mm > 0.0) {
+      const double depth = distance_mm_from_inverse(point.inverse_depth_per_mm);
+      const double x0 = point.tan_x * depth, z0 = z_persp - depth;
+      if (z_x != z0) cx = x0 * (1.0 - (z_target - z0) / (z_x - z0));
+    } else {
+      cx = -point.tan_x * (z_target - z_x);
+    }
+    hx = 0.5 * xs->entrance_pupil_radius_mm;
+  }
   const double h = 0.5 * r_target;
   double s0x, s0y, s1x, s1y, s2x, s2y;
-  if (!stop_point(0.0, 0.0, s0x, s0y) || !stop_point(h, 0.0, s1x, s1y) || !stop_point(0.0, h, s2x, s2y)) {
+  if (!stop_point(cx, 0.0, s0x, s0y) || !stop_point(cx + hx, 0.0, s1x, s1y) || !stop_point(cx, h, s2x, s2y)) {
     for (auto& hit : hits) hit = {};
     return;
   }
-  const double j11 = (s1x - s0x) / h, j21 = (s1y - s0y) / h, j12 = (s2x - s0x) / h, j22 = (s2y - s0y) / h;
+  const double j11 = (s1x - s0x) / hx, j21 = (s1y - s0y) / hx, j12 = (s2x - s0x) / h, j22 = (s2y - s0y) / h;
   const double det = j11 * j22 - j12 * j21;
   if (!(std::abs(det) > 0.0) || !std::isfinite(det)) {
     for (auto& hit : hits) hit = {};
@@ -115,7 +132,7 @@ void ExactModel::map_raw(const ScenePoint& point, double wavelength_nm, std::spa
 
   for (std::size_t i = 0; i < pupil.size(); ++i) {
     const double want_x = pupil[i].x * stop_radius_mm_, want_y = pupil[i].y * stop_radius_mm_;
-    double tx = i11 * (want_x - s0x) + i12 * (want_y - s0y);
+    double tx = cx + i11 * (want_x - s0x) + i12 * (want_y - s0y);
     double ty = i21 * (want_x - s0x) + i22 * (want_y - s0y);
     // Quasi-Newton from the beam's Jacobian, updated by Broyden's rank-one rule from each step's
     // change on the stop: at the rim of a strongly aberrated pupil (the Sasian triplet's frame at

@@ -196,8 +196,7 @@ std::optional<CameraRay> LensCamera::generate_ray(double film_x_mm, double film_
 }
 
 std::array<double, 2> LensCamera::film_point_mm(double x_px, double y_px) const {
-  const double p = camera_.px_per_sensor_mm();
-  return {(x_px - 0.5 * camera_.frame().width_px()) / p, (0.5 * camera_.frame().height_px() - y_px) / p};
+  return camera_.sensor_point_mm({x_px, y_px});
 }
 
 std::string LensCamera::to_string() const {

@@ -118,6 +118,10 @@ std::optional<std::string> Prescription::why_not_rotationally_symmetric() const 
   return std::nullopt;
 }
 
+bool Prescription::is_anamorphic() const {
+  return std::any_of(surfaces.begin(), surfaces.end(), [](const Surface& s) { return !s.is_coordinate_break() && !s.is_rotationally_symmetric(); });
+}
+
 std::optional<std::string> Prescription::why_no_real_ray_aiming() const {
   if (auto why = why_not_rotationally_symmetric()) return why;
   if (has_mirrors()) return std::string("it has mirrors");

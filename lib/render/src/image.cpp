@@ -99,4 +99,57 @@ std::vector<float> crop_pixels(std::span<const float> samples, int full_width, i
   return out;
 }
 
+namespace {
+
+void check_squeeze(std::span<const float> samples, int width, int height, int channels, int new_width) {
+  if (width < 1 || height < 1 || channels < 1 ||
+      samples.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * static_cast<std::size_t>(channels)) {
+    throw OptionsError("squeeze_columns: " + std::to_string(samples.size()) + " samples do not fill " + std::to_string(width) + " x " +
+                       std::to_string(height) + " pixels of " + std::to_string(channels) + " channels");
+  }
+  if (new_width < 1 || new_width > width) {
+    throw OptionsError("squeeze_columns: " + std::to_string(new_width) + " columns: expected 1 to " + std::to_string(width));
+  }
+}
+
+}  // namespace
+
+std::vector<float> squeeze_columns(std::span<const float> samples, int width, int height, int channels, int new_width) {
+  check_squeeze(samples, width, height, channels, new_width);
+  const double share = static_cast<double>(width) / new_width;  // old pixels per new one
+  const auto c = static_cast<std::size_t>(channels);
+  std::vector<float> out(static_cast<std::size_t>(new_width) * static_cast<std::size_t>(height) * c);
+  std::vector<double> sum(c);
+  for (int y = 0; y < height; ++y) {
+    const float* row = samples.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(width) * c;
+    float* to = out.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(new_width) * c;
+    for (int i = 0; i < new_width; ++i) {
+      const double from = i * share, until = std::min(static_cast<double>(width), (i + 1) * share);
+      std::fill(sum.begin(), sum.end(), 0.0);
+      for (int x = static_cast<int>(from); x < width && x < until; ++x) {
+        const double overlap = std::min(until, x + 1.0) - std::max(from, static_cast<double>(x));
+        for (std::size_t k = 0; k < c; ++k) sum[k] += overlap * row[static_cast<std::size_t>(x) * c + k];
+      }
+      for (std::size_t k = 0; k < c; ++k) to[static_cast<std::size_t>(i) * c + k] = static_cast<float>(sum[k] / (until - from));
+    }
+  }
+  return out;
+}
+
+std::vector<float> squeeze_columns_nearest(std::span<const float> samples, int width, int height, int channels, int new_width) {
+  check_squeeze(samples, width, height, channels, new_width);
+  const double share = static_cast<double>(width) / new_width;
+  const auto c = static_cast<std::size_t>(channels);
+  std::vector<float> out(static_cast<std::size_t>(new_width) * static_cast<std::size_t>(height) * c);
+  for (int y = 0; y < height; ++y) {
+    for (int i = 0; i < new_width; ++i) {
+      const int x = std::min(width - 1, static_cast<int>((i + 0.5) * share));
+      const std::size_t from = (static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)) * c;
+      const std::size_t to = (static_cast<std::size_t>(y) * static_cast<std::size_t>(new_width) + static_cast<std::size_t>(i)) * c;
+      std::copy_n(samples.begin() + static_cast<std::ptrdiff_t>(from), c, out.begin() + static_cast<std::ptrdiff_t>(to));
+    }
+  }
+  return out;
+}
+
 }  // namespace lensmith

@@ -183,7 +183,7 @@ LensRayTable::LensRayTable(const RayModel& model, const Aperture& aperture, std:
   else source_ = std::make_unique<InverseSource>(model, aperture, wavelengths_nm_, options.vignetting);
 
   const PinholeFrame& frame = model.camera().frame();
-  px_per_sensor_mm_ = model.camera().px_per_sensor_mm();
+  camera_ = &model.camera();
   width_ = frame.width_px();
   height_ = frame.height_px();
   grid_ = options.grid_px;
@@ -209,8 +209,7 @@ std::size_t LensRayTable::direct_rays() const { return direct_rays_.load(std::me
 
 PixelRay LensRayTable::direct_ray(double x_px, double y_px, std::size_t j) const {
   const LensSample& s = samples_[j];
-  // The film point of the output position (LensCamera::film_point_mm, Camera::output_pixel).
-  const double fx = (x_px - 0.5 * width_) / px_per_sensor_mm_, fy = (0.5 * height_ - y_px) / px_per_sensor_mm_;
+  const auto [fx, fy] = camera_->sensor_point_mm({x_px, y_px});
   return source_->ray(fx, fy, s, wavelengths_nm_[static_cast<std::size_t>(s.node)]);
 }
 

@@ -80,7 +80,7 @@ class LensRayTable {
 
   std::vector<LensSample> samples_;
   std::vector<double> wavelengths_nm_;
-  double px_per_sensor_mm_ = 1.0;
+  const Camera* camera_ = nullptr;  // the model's (outlives the table, as the model does)
   int width_ = 0, height_ = 0, grid_ = 8, nodes_x_ = 0, nodes_y_ = 0;
   std::vector<PixelRay> grid_rays_;  // [sample][node_y][node_x]
   std::unique_ptr<Source> source_;

@@ -260,14 +260,11 @@ auto with_thin_lens_sampler(const Scene& scene, const Camera& camera, Use&& use)
   const double focus_mm = camera.focus_distance_mm();
   const CameraBasis basis = scene.camera.basis();
   const Eigen::Vector3d position_m = scene.camera.position_m;
-  const double half_width = 0.5 * camera.frame().width_px();
-  const double half_height = 0.5 * camera.frame().height_px();
-  const double px_per_mm = camera.px_per_sensor_mm();
 
   auto sample = [&](double x_px, double y_px, double /*node_u*/, Pcg32& rng) -> SampleResult {
     // The sensor point and the tangents of its chief ray through the lens centre: the point it
     // images to on the focus plane.
-    const double x_mm = (x_px - half_width) / px_per_mm, y_mm = (half_height - y_px) / px_per_mm;
+    const auto [x_mm, y_mm] = camera.sensor_point_mm({x_px, y_px});
     const double tan_x = -x_mm / image_distance_mm, tan_y = -y_mm / image_distance_mm;
     const double r = lens_radius_mm * std::sqrt(rng.uniform());
     const double phi = 2.0 * kPi * rng.uniform();

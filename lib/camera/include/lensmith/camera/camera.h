@@ -9,8 +9,13 @@
 // - The sensor sits at the paraxial image of the focus plane at the reference wavelength.
 // - Output framing keeps points on the focus plane at their input pixels: an output pixel is the
 //   sensor point divided by the focus plane's magnification and seen through the pinhole frame.
+//   An anamorphic lens magnifies x and y differently (its x section's focal length is shorter by
+//   the squeeze): x is divided by the x section's magnification, so the output grid is the input's,
+//   desqueezed, and a sensor pixel is squeeze() times narrower than it is tall (docs/bokeh.md,
+//   "Anamorphic lenses").
 #pragma once
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <ostream>
@@ -108,10 +113,27 @@ class Camera {
   GaussianImage gaussian_image(const ScenePoint& p, const FirstOrderSample& s) const;
   // Output pixel of a sensor point (mm, lens frame x/y).
   PixelPoint output_pixel(double x_mm, double y_mm) const {
-    return {0.5 * frame_.width_px() + x_mm * px_per_sensor_mm_, 0.5 * frame_.height_px() - y_mm * px_per_sensor_mm_};
+    return {0.5 * frame_.width_px() + x_mm * px_per_sensor_mm_x_, 0.5 * frame_.height_px() - y_mm * px_per_sensor_mm_};
   }
-  // Output pixels per sensor millimetre, signed (< 0: the real image is inverted and the output is not).
+  // The sensor point (mm, lens frame x/y) of an output pixel position: output_pixel's inverse.
+  std::array<double, 2> sensor_point_mm(const PixelPoint& p) const {
+    return {(p.x - 0.5 * frame_.width_px()) / px_per_sensor_mm_x_, (0.5 * frame_.height_px() - p.y) / px_per_sensor_mm_};
+  }
+  // Output pixels per sensor millimetre in y, signed (< 0: the real image is inverted and the output is
+  // not); in x it is squeeze() times this.
   double px_per_sensor_mm() const { return px_per_sensor_mm_; }
+  // The anamorphic squeeze: output pixels per sensor millimetre in x over those in y, the ratio of the
+  // focus plane's magnifications in y and x (EFL_y / EFL_x for a lens focused at infinity). 1 for a
+  // lens without toroidal or biconic surfaces.
+  double squeeze() const { return px_per_sensor_mm_x_ / px_per_sensor_mm_; }
+  // An anamorphic lens's x section at the reference wavelength (its focal length, principal planes and
+  // pupils: an anamorphic front group puts its x entrance pupil elsewhere); empty for other lenses.
+  const std::optional<FirstOrderSample>& x_section() const { return x_section_; }
+  // The distance (mm from the perspective centre; +inf at or beyond infinity) of the plane an anamorphic
+  // lens's x section images onto the sensor: the sensor focuses the y section, and moving it focuses the x
+  // section, whose focal length is shorter, elsewhere (a real anamorphic focuses its cylinders with the
+  // rest: not modelled). Empty for other lenses.
+  std::optional<double> x_section_focus_distance_mm() const;
   // Signed diameter (output pixels) of the paraxial blur disc of an on-axis point at this inverse
   // depth, reference wavelength: > 0 nearer than the focus plane, < 0 beyond it.
   double signed_coc_px(double inverse_depth_per_mm) const;
@@ -137,6 +159,9 @@ class Camera {
   double z_perspective_mm_ = 0.0;
   double pupil_orientation_ = 1.0;
   double px_per_sensor_mm_ = 0.0;
+  double px_per_sensor_mm_x_ = 0.0;
+  // The x section's first-order data at the reference wavelength, for an anamorphic lens only.
+  std::optional<FirstOrderSample> x_section_;
   FirstOrderSample reference_first_order_{};  // first_order(reference_nm_), for signed_coc_px per pixel
 };
 

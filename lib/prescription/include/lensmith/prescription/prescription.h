@@ -129,6 +129,9 @@ struct Prescription {
   // Coaxial, and every surface rotationally symmetric (no toroid or biconic with unequal sections): what
   // third-order (Seidel) theory and the rotationally symmetric analyses and fits assume.
   bool is_rotationally_symmetric() const;
+  // Some surface has unequal x and y sections (a toroid, biconic or cylinder): first-order data differ per
+  // section (ParaxialOptions::section), the x section's focal length giving an anamorphic's squeeze.
+  bool is_anamorphic() const;
   // Why not, naming the first surface that breaks the symmetry ("surface 3 is toroidal"); empty when it is.
   std::optional<std::string> why_not_rotationally_symmetric() const;
   // Why real-stop ray aiming does not apply ("it has mirrors", or why_not_rotationally_symmetric): the
