@@ -185,6 +185,7 @@ TracedRay aim_and_trace(const RayAimer& aimer, const SequentialTracer& tracer, c
   out.status = result.status;
   out.surface = result.surface;
   out.image_ray = result.ray;
+  out.optical_path_mm = result.optical_path_mm;
   return out;
 }
 

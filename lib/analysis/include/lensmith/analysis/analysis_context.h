@@ -68,6 +68,9 @@ struct TracedRay {
   int surface = 0;                   // 1-based surface where it died; 0 when ok
   Ray object_ray;                    // the ray as aimed in object space
   Ray image_ray;                     // at the image plane when ok
+  // Optical path from the aimed ray's start to the image plane, mm (n x length): the rays of one field
+  // start on one wavefront (docs/trace.md, "Optical path"), so differences are OPDs.
+  double optical_path_mm = 0.0;
   bool ok() const { return status == RayStatus::Ok; }
 };
 
