@@ -125,6 +125,15 @@ struct FanCommandOptions {
 };
 int run_fan(const FanCommandOptions& options, const GlobalOptions& global);
 
+struct WavefrontCommandOptions {
+  RealRayCommandOptions common;
+  int grid = 64;                        // --grid: pupil samples across
+  std::string zernike = "fringe";       // --zernike fringe|standard
+  std::optional<int> terms;             // --terms: Zernike terms fitted (default 37)
+  bool map_in_json = false;             // --json-map: the OPD grid in the JSON too
+};
+int run_wavefront(const WavefrontCommandOptions& options, const GlobalOptions& global);
+
 struct AnalyzeCommandOptions {
   RealRayCommandOptions common;
   std::string what;              // --what distortion|field-curves|focal-shift|illumination|pupil

@@ -258,6 +258,16 @@ int main(int argc, char** argv) {
   spot_cmd->add_option("--seed", spot.seed, "Seed of --random (default 1; the same seed gives the same rays everywhere)")->needs(spot_random);
   spot_rings->excludes(spot_random);
 
+  WavefrontCommandOptions wavefront;
+  CLI::App* wavefront_cmd =
+      app.add_subcommand("wavefront", "Wavefront (OPD against the reference sphere) per field and wavelength: RMS, P-V, Zernike fit, map");
+  add_real_ray_options(wavefront_cmd, wavefront.common);
+  wavefront_cmd->add_option("--grid", wavefront.grid, "Pupil samples across the map (default 64; 8-1024)")->check(range(8, 1024));
+  wavefront_cmd->add_option("--zernike", wavefront.zernike, "Zernike ordering: fringe (default; Z1-Z37, not normalised) or standard (Noll, normalised)")
+      ->check(CLI::IsMember({"fringe", "standard"}));
+  wavefront_cmd->add_option("--terms", wavefront.terms, "Zernike terms fitted (default 37; fringe 1-37, standard 1-231)")->check(range(1, 231));
+  wavefront_cmd->add_flag("--json-map", wavefront.map_in_json, "With --json: the OPD map's grid too (waves, row-major from py = -1)");
+
   SeidelCommandOptions seidel;
   CLI::App* seidel_cmd = app.add_subcommand("seidel", "Third-order (Seidel) aberrations per surface and summed, and Born & Wolf's B..F");
   seidel_cmd->add_option("lens", seidel.lens, "Lens file or shipped lens name")->required();
@@ -630,6 +640,7 @@ int main(int argc, char** argv) {
     if (*trace_cmd) return run_trace(trace, global);
     if (*spot_cmd) return run_spot(spot, global);
     if (*fan_cmd) return run_fan(fan, global);
+    if (*wavefront_cmd) return run_wavefront(wavefront, global);
     if (*layout_cmd) return run_layout(layout, global);
     if (*analyze_cmd) return run_analyze(analyze, global);
     if (*bokeh_cmd) {

@@ -212,3 +212,30 @@ TEST_CASE("lensmith analyze: a lens without a field needs --field-angle, unknown
   CHECK(run_lensmith("analyze sasian-triplet --what sharpness").exit_code == 2);
   CHECK(run_lensmith("analyze sasian-triplet").exit_code == 2);  // --what is required
 }
+
+TEST_CASE("lensmith wavefront: a map, RMS and Zernike coefficients per field and wavelength, as JSON and a picture", "[cli][wavefront]") {
+  const ScratchFolder folder;
+  const std::string png = (folder.dir / "wavefront.png").string();
+  const auto r = run_lensmith("wavefront sasian-triplet --grid 16 --terms 16 --json --json-map --png " + png);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  CHECK(j["analysis"] == "wavefront");
+  CHECK(j["zernike_ordering"] == "fringe");
+  REQUIRE(j["maps"].size() == 9);  // 3 fields x 3 wavelengths
+  for (const auto& m : j["maps"]) {
+    CHECK(m["zernike"].size() == 16);
+    CHECK(m["map_waves"].size() == 256);
+    CHECK(m["rms_waves"].get<double>() >= 0.0);
+    CHECK(m["pv_waves"].get<double>() >= m["rms_waves"].get<double>());
+    // The fans pass through the chief ray, where the OPD is 0 by definition of the reference.
+    CHECK_THAT(m["tangential_fan"][20]["opd_waves"].get<double>(), WithinAbs(0.0, 1e-9));
+  }
+  CHECK(read_png_header(png).valid);
+  // Bad options: the Fringe set has 37 terms; --json-map needs --json.
+  const auto many = run_lensmith("wavefront sasian-triplet --terms 40");
+  CHECK(many.exit_code == 2);
+  CHECK(many.err.find("1 to 37") != std::string::npos);
+  CHECK(run_lensmith("wavefront sasian-triplet --json-map").exit_code == 2);
+  CHECK(run_lensmith("wavefront sasian-triplet --zernike zebra").exit_code == 2);
+}

@@ -8,6 +8,7 @@
 #include "lensmith/analysis/chromatic_focal_shift.h"
 #include "lensmith/analysis/distortion_curve.h"
 #include "lensmith/analysis/field_curves.h"
+#include "lensmith/analysis/wavefront.h"
 #include "lensmith/analysis/pupil_shape.h"
 #include "lensmith/analysis/ray_fan.h"
 #include "lensmith/analysis/relative_illumination.h"
@@ -228,6 +229,49 @@ ojson fan_json(const RayFan& fan) {
   }
   o["fields"] = fields;
   return o;
+}
+
+ojson wavefront_json(const Wavefront& w, bool include_map) {
+  auto fan = [](const std::vector<OpdSample>& samples, bool tangential) {
+    ojson out = ojson::array();
+    for (const OpdSample& s : samples) {
+      out.push_back({{tangential ? "py" : "px", tangential ? s.py : s.px},
+                     {"opd_waves", number_or_null(s.opd_waves)},
+                     {"status", std::string(to_string(s.status))}});
+    }
+    return out;
+  };
+  ojson maps = ojson::array();
+  for (const WavefrontMap& m : w.maps) {
+    ojson o{{"relative_field", m.relative_field},
+            {"field_value", m.field_value},
+            {"wavelength_nm", m.wavelength_nm},
+            {"reference", {{"x_mm", m.reference.x_mm}, {"y_mm", m.reference.y_mm}, {"z_mm", m.reference.z_mm}}},
+            {"reference_radius_mm", m.reference_radius_mm},
+            {"rms_waves", m.rms_waves},
+            {"rms_tilt_removed_waves", m.rms_tilt_removed_waves},
+            {"pv_waves", m.pv_waves},
+            {"rays", m.samples},
+            {"lost", m.lost.total()},
+            {"zernike", m.zernike},
+            {"tangential_fan", fan(m.tangential, true)},
+            {"sagittal_fan", fan(m.sagittal, false)}};
+    if (include_map) {
+      ojson grid = ojson::array();
+      for (const OpdSample& s : m.map) grid.push_back(number_or_null(s.opd_waves));
+      o["grid"] = m.grid;
+      o["map_waves"] = grid;
+    }
+    maps.push_back(o);
+  }
+  return {{"analysis", "wavefront"},
+          {"lens", w.lens_name},
+          {"wavelengths_nm", w.wavelengths_nm},
+          {"reference_wavelength_nm", w.reference_wavelength_nm},
+          {"image_plane_z_mm", w.image_plane_z_mm},
+          {"exit_pupil_z_mm", w.exit_pupil_z_mm},
+          {"zernike_ordering", std::string(to_string(w.ordering))},
+          {"maps", maps}};
 }
 
 ojson distortion_json(const DistortionCurve& d) {

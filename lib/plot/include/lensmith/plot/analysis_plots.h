@@ -15,6 +15,7 @@
 #include "lensmith/analysis/ray_fan.h"
 #include "lensmith/analysis/relative_illumination.h"
 #include "lensmith/analysis/spot_diagram.h"
+#include "lensmith/analysis/wavefront.h"
 #include "lensmith/plot/canvas.h"
 #include "lensmith/seidel/seidel_analysis.h"
 
@@ -37,6 +38,9 @@ Canvas plot_spot_diagram(const SpotDiagram& spots, const PlotOptions& options = 
 // Per field a tangential (ey against py) and a sagittal (ex against px) panel, one curve per
 // wavelength, a common error scale in micrometres; a ray that died leaves a gap.
 Canvas plot_ray_fan(const RayFan& fan, const PlotOptions& options = {});
+// The wavefront map per field (rows) and wavelength (columns), piston removed, on one diverging colour
+// scale in waves with its bar, RMS and P-V under each map (wavefront_plot.cpp).
+Canvas plot_wavefront_map(const Wavefront& wavefront, const PlotOptions& options = {});
 // Distortion (%) across, field up.
 Canvas plot_distortion(const DistortionCurve& distortion, const PlotOptions& options = {});
 // Tangential (solid) and sagittal (dashed) focus shift (mm) across, field up, per wavelength.

@@ -17,6 +17,7 @@ class ParaxialSpectralTable;
 class SeidelAnalysis;
 struct SpotDiagram;
 struct RayFan;
+struct Wavefront;
 struct DistortionCurve;
 struct FieldCurves;
 struct ChromaticFocalShift;
@@ -37,6 +38,10 @@ ojson spectral_json(const ParaxialSpectralTable& table);
 ojson seidel_json(const Prescription& lens, const SeidelAnalysis& seidel);
 ojson spot_json(const SpotDiagram& diagram);
 ojson fan_json(const RayFan& fan);
+// lensmith wavefront --json: per field and wavelength the OPD statistics in waves, the reference
+// sphere, the Zernike coefficients and the OPD fans; with `include_map`, the grid too (row-major from
+// py = -1, null outside the pupil or where the ray died).
+ojson wavefront_json(const Wavefront& wavefront, bool include_map);
 // `lensmith analyze --what ... --json`.
 ojson distortion_json(const DistortionCurve& curve);
 ojson field_curves_json(const FieldCurves& curves);

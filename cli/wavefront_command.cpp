@@ -1,0 +1,40 @@
+// `lensmith wavefront`: OPD against the reference sphere per field and wavelength, its RMS and P-V and
+// Zernike fit; a table, one JSON object (docs/cli.md) and optionally the wavefront map as a PNG.
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "lensmith/analysis/wavefront.h"
+#include "lensmith/core/json_text.h"
+#include "lensmith/plot/analysis_plots.h"
+#include "lensmith/report/json_report.h"
+
+namespace lensmith::cli {
+
+int run_wavefront(const WavefrontCommandOptions& options, const GlobalOptions& global) {
+  if (options.map_in_json && !options.common.json) throw UsageError("--json-map adds the map to --json: give --json too");
+  WavefrontOptions wavefront_options;
+  wavefront_options.grid = options.grid;
+  wavefront_options.ordering = parse_zernike_ordering(options.zernike);
+  wavefront_options.zernike_terms = options.terms.value_or(37);
+  if (const int most = max_zernike_terms(wavefront_options.ordering); wavefront_options.zernike_terms > most) {
+    throw UsageError("--terms " + std::to_string(wavefront_options.zernike_terms) + ": the " + options.zernike + " ordering has terms 1 to " +
+                     std::to_string(most));
+  }
+  wavefront_options.validate();
+  const Prescription lens = load_lens(options.common.lens, global);
+  const AnalysisContext context(lens, make_analysis_options(options.common));
+  const Wavefront wavefront = compute_wavefront(context, wavefront_options);
+  if (!options.common.png.empty()) {
+    write_picture(plot::plot_wavefront_map(wavefront, make_plot_options(global)), options.common.png, options.common.lens, global);
+  }
+  if (options.common.json) {
+    std::cout << json_text(wavefront_json(wavefront, options.map_in_json), 2) << "\n";
+  } else {
+    std::cout << wavefront.to_string();
+  }
+  return kExitOk;
+}
+
+}  // namespace lensmith::cli
