@@ -134,6 +134,14 @@ struct WavefrontCommandOptions {
 };
 int run_wavefront(const WavefrontCommandOptions& options, const GlobalOptions& global);
 
+struct MtfCommandOptions {
+  RealRayCommandOptions common;
+  int pupil_samples = 64;                     // --pupil-samples
+  std::optional<double> max_frequency_per_mm;  // --max-frequency (default: the cutoff)
+  int frequency_samples = 51;                 // --frequencies
+};
+int run_mtf(const MtfCommandOptions& options, const GlobalOptions& global);
+
 struct AnalyzeCommandOptions {
   RealRayCommandOptions common;
   std::string what;              // --what distortion|field-curves|focal-shift|illumination|pupil

@@ -268,6 +268,14 @@ int main(int argc, char** argv) {
   wavefront_cmd->add_option("--terms", wavefront.terms, "Zernike terms fitted (default 37; fringe 1-37, standard 1-231)")->check(range(1, 231));
   wavefront_cmd->add_flag("--json-map", wavefront.map_in_json, "With --json: the OPD map's grid too (waves, row-major from py = -1)");
 
+  MtfCommandOptions mtf;
+  CLI::App* mtf_cmd = app.add_subcommand("mtf", "Diffraction MTF (FFT of the pupil function), tangential and sagittal per field, and the Strehl ratio");
+  add_real_ray_options(mtf_cmd, mtf.common);
+  mtf_cmd->add_option("--pupil-samples", mtf.pupil_samples, "Pupil grid across the pupil (default 64; 16-512)")->check(range(16, 512));
+  mtf_cmd->add_option("--max-frequency", mtf.max_frequency_per_mm, "Highest frequency, cycles/mm (default: the diffraction cutoff; > 0)")
+      ->check(positive());
+  mtf_cmd->add_option("--frequencies", mtf.frequency_samples, "Points per curve (default 51; 2-1001)")->check(range(2, 1001));
+
   SeidelCommandOptions seidel;
   CLI::App* seidel_cmd = app.add_subcommand("seidel", "Third-order (Seidel) aberrations per surface and summed, and Born & Wolf's B..F");
   seidel_cmd->add_option("lens", seidel.lens, "Lens file or shipped lens name")->required();
@@ -641,6 +649,7 @@ int main(int argc, char** argv) {
     if (*spot_cmd) return run_spot(spot, global);
     if (*fan_cmd) return run_fan(fan, global);
     if (*wavefront_cmd) return run_wavefront(wavefront, global);
+    if (*mtf_cmd) return run_mtf(mtf, global);
     if (*layout_cmd) return run_layout(layout, global);
     if (*analyze_cmd) return run_analyze(analyze, global);
     if (*bokeh_cmd) {

@@ -1,10 +1,12 @@
 // `lensmith wavefront`: OPD against the reference sphere per field and wavelength, its RMS and P-V and
-// Zernike fit; a table, one JSON object (docs/cli.md) and optionally the wavefront map as a PNG.
+// Zernike fit; `lensmith mtf`: the diffraction MTF from the same wavefront. Each a table, one JSON object
+// (docs/cli.md) and optionally a PNG.
 #include <iostream>
 
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "lensmith/analysis/mtf.h"
 #include "lensmith/analysis/wavefront.h"
 #include "lensmith/core/json_text.h"
 #include "lensmith/plot/analysis_plots.h"
@@ -33,6 +35,26 @@ int run_wavefront(const WavefrontCommandOptions& options, const GlobalOptions& g
     std::cout << json_text(wavefront_json(wavefront, options.map_in_json), 2) << "\n";
   } else {
     std::cout << wavefront.to_string();
+  }
+  return kExitOk;
+}
+
+int run_mtf(const MtfCommandOptions& options, const GlobalOptions& global) {
+  MtfOptions mtf_options;
+  mtf_options.pupil_samples = options.pupil_samples;
+  mtf_options.max_frequency_per_mm = options.max_frequency_per_mm.value_or(0.0);
+  mtf_options.frequency_samples = options.frequency_samples;
+  mtf_options.validate();
+  const Prescription lens = load_lens(options.common.lens, global);
+  const AnalysisContext context(lens, make_analysis_options(options.common));
+  const Mtf mtf = compute_mtf(context, mtf_options);
+  if (!options.common.png.empty()) {
+    write_picture(plot::plot_mtf(mtf, make_plot_options(global)), options.common.png, options.common.lens, global);
+  }
+  if (options.common.json) {
+    std::cout << json_text(mtf_json(mtf), 2) << "\n";
+  } else {
+    std::cout << mtf.to_string();
   }
   return kExitOk;
 }

@@ -20,29 +20,10 @@ using Catch::Matchers::WithinRel;
 
 namespace {
 
-constexpr double kIndex = 1.5;
-constexpr double kRadiusMm = 50.0;
-// The focus of the ellipsoid k = -1 / n^2: n R / (n - 1) behind its vertex, in the glass.
-constexpr double kFocusMm = kIndex * kRadiusMm / (kIndex - 1.0);
+constexpr double kIndex = testing::CartesianEllipsoid::kIndex;
+constexpr double kFocusMm = testing::CartesianEllipsoid::kFocusMm;
 
-// The ellipsoid, its stop on it, a 20-mm beam, the image plane `defocus_mm` behind the focus.
-Prescription perfect_imager(double defocus_mm) {
-  Prescription p;
-  p.name = "Cartesian ellipsoid";
-  Surface s;
-  s.curvature_per_mm = 1.0 / kRadiusMm;
-  s.conic = -1.0 / (kIndex * kIndex);
-  s.thickness_mm = kFocusMm + defocus_mm;
-  s.material = MaterialSpec::model(kIndex, std::nullopt);
-  s.is_stop = true;
-  s.semi_diameter_mm = 12.0;
-  p.surfaces = {s};
-  p.aperture = ApertureSpec{ApertureSpec::Kind::EntrancePupilDiameter, 20.0};
-  p.wavelengths_nm = {kWavelengthD_nm};
-  p.primary_wavelength_index = 0;
-  p.resolve_materials(GlassCatalog::builtin());
-  return p;
-}
+Prescription perfect_imager(double defocus_mm) { return testing::cartesian_ellipsoid(defocus_mm); }
 
 AnalysisOptions on_axis() {
   AnalysisOptions o;

@@ -239,3 +239,25 @@ TEST_CASE("lensmith wavefront: a map, RMS and Zernike coefficients per field and
   CHECK(run_lensmith("wavefront sasian-triplet --json-map").exit_code == 2);
   CHECK(run_lensmith("wavefront sasian-triplet --zernike zebra").exit_code == 2);
 }
+
+TEST_CASE("lensmith mtf: tangential, sagittal and diffraction-limit curves with Strehl ratios, as JSON and a picture", "[cli][mtf]") {
+  const ScratchFolder folder;
+  const std::string png = (folder.dir / "mtf.png").string();
+  const auto r = run_lensmith("mtf sasian-triplet --pupil-samples 32 --frequencies 11 --max-frequency 100 --json --png " + png);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  CHECK(j["analysis"] == "mtf");
+  REQUIRE(j["frequencies_per_mm"].size() == 11);
+  CHECK(j["frequencies_per_mm"].back() == 100.0);
+  REQUIRE(j["fields"].size() == 3);
+  for (const auto& f : j["fields"]) {
+    CHECK_THAT(f["tangential"][0].get<double>(), WithinAbs(1.0, 1e-9));  // the OTF is normalised at zero frequency
+    const double strehl = f["strehl"].get<double>();
+    CHECK(strehl > 0.0);
+    CHECK(strehl <= 1.0);
+    for (std::size_t i = 0; i < 11; ++i) CHECK(f["tangential"][i].get<double>() <= f["diffraction_limit"][i].get<double>() + 0.02);
+  }
+  CHECK(read_png_header(png).valid);
+  CHECK(run_lensmith("mtf sasian-triplet --pupil-samples 8").exit_code == 2);
+}

@@ -92,4 +92,23 @@ Prescription angenieux_double_gauss() {
   return p;
 }
 
+Prescription cartesian_ellipsoid(double defocus_mm) {
+  using C = CartesianEllipsoid;
+  Prescription p;
+  p.name = "Cartesian ellipsoid";
+  Surface s;
+  s.curvature_per_mm = 1.0 / C::kRadiusMm;
+  s.conic = -1.0 / (C::kIndex * C::kIndex);
+  s.thickness_mm = C::kFocusMm + defocus_mm;
+  s.material = MaterialSpec::model(C::kIndex, std::nullopt);
+  s.is_stop = true;
+  s.semi_diameter_mm = 12.0;
+  p.surfaces = {s};
+  p.aperture = ApertureSpec{ApertureSpec::Kind::EntrancePupilDiameter, 20.0};
+  p.wavelengths_nm = {kWavelengthD_nm};
+  p.primary_wavelength_index = 0;
+  p.resolve_materials(GlassCatalog::builtin());
+  return p;
+}
+
 }  // namespace lensmith::testing

@@ -25,4 +25,14 @@ Prescription sasian_triplet();
 // patent's glass types from the Schott catalogue; 15 surfaces, aperture floating by the iris.
 Prescription angenieux_double_gauss();
 
+// A perfect imager: a Cartesian ellipsoid of index n = 1.5 (conic -1/n^2, R = 50 mm) focusing a parallel
+// 20-mm beam without aberration at n R / (n - 1) = 150 mm inside the glass (Born & Wolf, Principles of
+// Optics, sec. 4.2.3), its stop on the surface; the image plane `defocus_mm` behind that focus; the d line.
+struct CartesianEllipsoid {
+  static constexpr double kIndex = 1.5;
+  static constexpr double kRadiusMm = 50.0;
+  static constexpr double kFocusMm = kIndex * kRadiusMm / (kIndex - 1.0);
+};
+Prescription cartesian_ellipsoid(double defocus_mm);
+
 }  // namespace lensmith::testing

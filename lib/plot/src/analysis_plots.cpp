@@ -1,5 +1,6 @@
 // Analysis pictures: layouts of PlotAxes panels with legends and the key numbers of each analysis.
 #include "lensmith/plot/analysis_plots.h"
+#include "lensmith/plot/layout_plot.h"
 
 #include <algorithm>
 #include <cmath>
@@ -392,6 +393,36 @@ Canvas plot_field_curves(const FieldCurves& fc, const PlotOptions& o) {
     }
     axes.curve(t, f, LineStyle{colours[w], 2.2});
     axes.curve(s, f, LineStyle{colours[w], 2.2, 8.0, 5.0});
+  }
+  return canvas;
+}
+
+Canvas plot_mtf(const Mtf& mtf, const PlotOptions& o) {
+  Canvas canvas = one_panel_canvas(o, true);
+  const double top = panel_top(o, true);
+  const double fmax = mtf.frequencies_per_mm.empty() ? 1.0 : std::max(1e-9, mtf.frequencies_per_mm.back());
+  PlotAxes axes(canvas, {kPanelLeft, top}, {kPanelLeft + kPanelWidth, top + kPanelHeight}, {0.0, fmax}, {0.0, 1.0});
+  std::string waves;
+  for (double w : mtf.wavelengths_nm) waves += (waves.empty() ? "" : ", ") + fixed(w, 1);
+  std::string strehl;
+  for (const MtfCurve& c : mtf.fields) strehl += (strehl.empty() ? "" : ", ") + fixed(c.strehl, 3);
+  header(canvas, "MTF (FFT)", mtf.lens_name,
+         "polychromatic over " + waves + " nm, equal weights; diffraction cutoff " + fixed(mtf.cutoff_per_mm, 1) +
+             " cycles/mm on axis; black: the diffraction limit" + (mtf.fields.empty() ? std::string() : " at " + mtf.fields.front().field_label) +
+             "; Strehl ratios by field: " + strehl,
+         o);
+  std::vector<LegendEntry> legend{{"tangential", LineStyle{kText, 2.0}}, {"sagittal", LineStyle{kText, 2.0, 7.0, 5.0}}};
+  for (std::size_t f = 0; f < mtf.fields.size(); ++f) legend.push_back({mtf.fields[f].field_label, LineStyle{field_colour(f), 2.0}});
+  legend_row(canvas, {20.0, header_height(o) + 0.4 * o.font_px}, legend, o);
+  AxesText text;
+  text.font_px = o.font_px;
+  text.x_label = "spatial frequency (cycles/mm)";
+  text.y_label = "modulation";
+  axes.draw_frame(text, true, true, 6, 5);
+  if (!mtf.fields.empty()) axes.curve(mtf.frequencies_per_mm, mtf.fields.front().diffraction_limit, LineStyle{kText, 1.6});
+  for (std::size_t f = 0; f < mtf.fields.size(); ++f) {
+    axes.curve(mtf.frequencies_per_mm, mtf.fields[f].tangential, LineStyle{field_colour(f), 2.2});
+    axes.curve(mtf.frequencies_per_mm, mtf.fields[f].sagittal, LineStyle{field_colour(f), 2.2, 8.0, 5.0});
   }
   return canvas;
 }

@@ -9,6 +9,7 @@
 #include "lensmith/analysis/distortion_curve.h"
 #include "lensmith/analysis/field_curves.h"
 #include "lensmith/analysis/wavefront.h"
+#include "lensmith/analysis/mtf.h"
 #include "lensmith/analysis/pupil_shape.h"
 #include "lensmith/analysis/ray_fan.h"
 #include "lensmith/analysis/relative_illumination.h"
@@ -272,6 +273,24 @@ ojson wavefront_json(const Wavefront& w, bool include_map) {
           {"exit_pupil_z_mm", w.exit_pupil_z_mm},
           {"zernike_ordering", std::string(to_string(w.ordering))},
           {"maps", maps}};
+}
+
+ojson mtf_json(const Mtf& mtf) {
+  ojson fields = ojson::array();
+  for (const MtfCurve& c : mtf.fields) {
+    fields.push_back({{"relative_field", c.relative_field},
+                      {"field_value", c.field_value},
+                      {"strehl", c.strehl},
+                      {"tangential", c.tangential},
+                      {"sagittal", c.sagittal},
+                      {"diffraction_limit", c.diffraction_limit}});
+  }
+  return {{"analysis", "mtf"},
+          {"lens", mtf.lens_name},
+          {"wavelengths_nm", mtf.wavelengths_nm},
+          {"cutoff_per_mm", mtf.cutoff_per_mm},
+          {"frequencies_per_mm", mtf.frequencies_per_mm},
+          {"fields", fields}};
 }
 
 ojson distortion_json(const DistortionCurve& d) {

@@ -11,6 +11,7 @@
 #include "lensmith/analysis/chromatic_focal_shift.h"
 #include "lensmith/analysis/distortion_curve.h"
 #include "lensmith/analysis/field_curves.h"
+#include "lensmith/analysis/mtf.h"
 #include "lensmith/analysis/pupil_shape.h"
 #include "lensmith/analysis/ray_fan.h"
 #include "lensmith/analysis/relative_illumination.h"
@@ -41,6 +42,9 @@ Canvas plot_ray_fan(const RayFan& fan, const PlotOptions& options = {});
 // The wavefront map per field (rows) and wavelength (columns), piston removed, on one diverging colour
 // scale in waves with its bar, RMS and P-V under each map (wavefront_plot.cpp).
 Canvas plot_wavefront_map(const Wavefront& wavefront, const PlotOptions& options = {});
+// MTF against spatial frequency (cycles/mm): per field tangential (solid) and sagittal (dashed) in the
+// field's colour, the first field's diffraction limit in black, the Strehl ratios in the header.
+Canvas plot_mtf(const Mtf& mtf, const PlotOptions& options = {});
 // Distortion (%) across, field up.
 Canvas plot_distortion(const DistortionCurve& distortion, const PlotOptions& options = {});
 // Tangential (solid) and sagittal (dashed) focus shift (mm) across, field up, per wavelength.

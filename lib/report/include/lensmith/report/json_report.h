@@ -18,6 +18,7 @@ class SeidelAnalysis;
 struct SpotDiagram;
 struct RayFan;
 struct Wavefront;
+struct Mtf;
 struct DistortionCurve;
 struct FieldCurves;
 struct ChromaticFocalShift;
@@ -42,6 +43,9 @@ ojson fan_json(const RayFan& fan);
 // sphere, the Zernike coefficients and the OPD fans; with `include_map`, the grid too (row-major from
 // py = -1, null outside the pupil or where the ray died).
 ojson wavefront_json(const Wavefront& wavefront, bool include_map);
+// lensmith mtf --json: frequencies (cycles/mm), per field the tangential, sagittal and diffraction-limit
+// curves and the Strehl ratio.
+ojson mtf_json(const Mtf& mtf);
 // `lensmith analyze --what ... --json`.
 ojson distortion_json(const DistortionCurve& curve);
 ojson field_curves_json(const FieldCurves& curves);

@@ -1,0 +1,174 @@
+// FFT MTF: the pupil function's autocorrelation by two 2-D FFTs (lensmith/analysis/mtf.h says what and
+// why; Goodman, Introduction to Fourier Optics, eq. 6-31).
+#include "lensmith/analysis/mtf.h"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <cstdio>
+#include <sstream>
+
+#include <unsupported/Eigen/FFT>
+
+#include "analysis_detail.h"
+#include "lensmith/analysis/wavefront.h"
+#include "lensmith/core/errors.h"
+#include "lensmith/core/units.h"
+#include "lensmith/glass/glass.h"
+#include "lensmith/paraxial/paraxial_system.h"
+
+namespace lensmith {
+
+namespace {
+
+using Complex = std::complex<double>;
+
+// In-place 2-D FFT of an m x m row-major array (rows, then columns).
+void fft2(std::vector<Complex>& a, int m, bool inverse, Eigen::FFT<double>& fft) {
+  std::vector<Complex> in(static_cast<std::size_t>(m)), out(static_cast<std::size_t>(m));
+  const auto mm = static_cast<std::size_t>(m);
+  for (int pass = 0; pass < 2; ++pass) {
+    for (std::size_t line = 0; line < mm; ++line) {
+      for (std::size_t k = 0; k < mm; ++k) in[k] = pass == 0 ? a[line * mm + k] : a[k * mm + line];
+      if (inverse) fft.inv(out, in);
+      else fft.fwd(out, in);
+      for (std::size_t k = 0; k < mm; ++k) (pass == 0 ? a[line * mm + k] : a[k * mm + line]) = out[k];
+    }
+  }
+}
+
+// The OTF (normalised to 1 at 0) and the PSF's peak of a pupil function placed in an m x m array.
+struct Transfer {
+  std::vector<Complex> otf;
+  double psf_peak = 0.0;
+};
+
+Transfer transfer(std::vector<Complex> pupil, int m, Eigen::FFT<double>& fft) {
+  fft2(pupil, m, false, fft);
+  Transfer t;
+  for (Complex& c : pupil) {
+    const double intensity = std::norm(c);
+    t.psf_peak = std::max(t.psf_peak, intensity);
+    c = intensity;
+  }
+  fft2(pupil, m, true, fft);
+  const Complex zero = pupil[0];
+  for (Complex& c : pupil) c /= zero;
+  t.otf = std::move(pupil);
+  return t;
+}
+
+// The OTF at a fractional shift s (samples, >= 0) along x (along_y false) or y, linear between samples;
+// shifts beyond the array's half are past the cutoff (0).
+Complex otf_at(const std::vector<Complex>& otf, int m, double s, bool along_y) {
+  if (!(s < 0.5 * m - 1.0)) return 0.0;
+  const int k = static_cast<int>(s);
+  const double t = s - k;
+  auto at = [&](int i) { return along_y ? otf[static_cast<std::size_t>(i) * static_cast<std::size_t>(m)] : otf[static_cast<std::size_t>(i)]; };
+  return (1.0 - t) * at(k) + t * at(k + 1);
+}
+
+}  // namespace
+
+void MtfOptions::validate() const {
+  analysis_detail::check_count("MtfOptions::pupil_samples", pupil_samples, 16, 512);
+  analysis_detail::check_count("MtfOptions::padding", padding, 2, 16);
+  analysis_detail::check_count("MtfOptions::frequency_samples", frequency_samples, 2, 1001);
+  if (!(max_frequency_per_mm >= 0.0) || !std::isfinite(max_frequency_per_mm)) {
+    throw OptionsError("MtfOptions::max_frequency_per_mm = " + std::to_string(max_frequency_per_mm) + ": must be finite and >= 0 (0: the cutoff)");
+  }
+}
+
+Mtf compute_mtf(const AnalysisContext& context, const MtfOptions& options) {
+  options.validate();
+  WavefrontOptions w;
+  w.grid = options.pupil_samples;
+  w.zernike_terms = 1;
+  w.fan_samples = 3;
+  const Wavefront wavefront = compute_wavefront(context, w);
+  const int n = options.pupil_samples;
+  int m = 1;
+  while (m < n * options.padding) m *= 2;
+  const double exit_pupil_radius_mm = 0.5 * context.paraxial().exit_pupil().diameter_mm;
+  const double step_mm = 2.0 * exit_pupil_radius_mm / (n - 1);  // pupil sample step on the exit pupil
+
+  Mtf out;
+  out.lens_name = wavefront.lens_name;
+  out.wavelengths_nm = wavefront.wavelengths_nm;
+  const std::size_t waves = out.wavelengths_nm.size();
+  // The cutoff at the reference wavelength on axis (the first field's radius); the curves run to the
+  // shortest wavelength's, the highest any wavelength passes.
+  // The wavelength in the image space's medium sets the scale (an image in glass: lambda / n').
+  const Glass& image_medium = context.lens().surfaces.back().medium;
+  auto medium_wavelength_mm = [&](double nm) { return mm_from_nm(nm) / std::abs(image_medium.index(nm)); };
+  const double radius_mm = std::abs(wavefront.maps.front().reference_radius_mm);
+  out.cutoff_per_mm = 2.0 * exit_pupil_radius_mm / (medium_wavelength_mm(wavefront.reference_wavelength_nm) * radius_mm);
+  double top = options.max_frequency_per_mm;
+  for (double nm : out.wavelengths_nm) {
+    if (options.max_frequency_per_mm == 0.0) top = std::max(top, 2.0 * exit_pupil_radius_mm / (medium_wavelength_mm(nm) * radius_mm));
+  }
+  for (int i = 0; i < options.frequency_samples; ++i) out.frequencies_per_mm.push_back(top * i / (options.frequency_samples - 1));
+
+  Eigen::FFT<double> fft;
+  const auto nf = out.frequencies_per_mm.size();
+  for (std::size_t f = 0; f < wavefront.maps.size(); f += waves) {
+    MtfCurve curve;
+    curve.relative_field = wavefront.maps[f].relative_field;
+    curve.field_value = wavefront.maps[f].field_value;
+    curve.field_label = wavefront.maps[f].field_label;
+    std::vector<Complex> t(nf), s(nf), limit(nf);
+    for (std::size_t k = 0; k < waves; ++k) {
+      const WavefrontMap& map = wavefront.maps[f + k];
+      std::vector<Complex> pupil(static_cast<std::size_t>(m) * static_cast<std::size_t>(m)), perfect(pupil.size());
+      for (int row = 0; row < n; ++row) {
+        for (int col = 0; col < n; ++col) {
+          const OpdSample& o = map.map[static_cast<std::size_t>(row) * static_cast<std::size_t>(n) + static_cast<std::size_t>(col)];
+          if (o.status != RayStatus::Ok || !std::isfinite(o.opd_waves)) continue;
+          const std::size_t at = static_cast<std::size_t>(row) * static_cast<std::size_t>(m) + static_cast<std::size_t>(col);
+          pupil[at] = std::polar(1.0, 2.0 * kPi * o.opd_waves);
+          perfect[at] = 1.0;
+        }
+      }
+      const Transfer real = transfer(std::move(pupil), m, fft), ideal = transfer(std::move(perfect), m, fft);
+      curve.strehl += real.psf_peak / ideal.psf_peak / static_cast<double>(waves);
+      // A shift of one sample is the frequency step / (lambda R).
+      const double per_sample = step_mm / (medium_wavelength_mm(map.wavelength_nm) * std::abs(map.reference_radius_mm));
+      for (std::size_t i = 0; i < nf; ++i) {
+        const double shift = out.frequencies_per_mm[i] / per_sample;
+        t[i] += otf_at(real.otf, m, shift, true) / static_cast<double>(waves);
+        s[i] += otf_at(real.otf, m, shift, false) / static_cast<double>(waves);
+        limit[i] += otf_at(ideal.otf, m, shift, true) / static_cast<double>(waves);
+      }
+    }
+    for (std::size_t i = 0; i < nf; ++i) {
+      curve.tangential.push_back(std::abs(t[i]));
+      curve.sagittal.push_back(std::abs(s[i]));
+      curve.diffraction_limit.push_back(std::abs(limit[i]));
+    }
+    out.fields.push_back(std::move(curve));
+  }
+  return out;
+}
+
+std::string Mtf::to_string() const {
+  std::ostringstream os;
+  char cell[128];
+  os << "MTF (FFT of the pupil function): " << lens_name << "\n";
+  std::snprintf(cell, sizeof cell, "%.1f", cutoff_per_mm);
+  os << "Diffraction cutoff " << cell << " cycles/mm at the reference wavelength on axis; polychromatic, equal weights over";
+  for (double w : wavelengths_nm) os << " " << w;
+  os << " nm.\n";
+  for (const MtfCurve& c : fields) {
+    std::snprintf(cell, sizeof cell, "%.4f", c.strehl);
+    os << "\nField " << c.field_label << " (relative " << c.relative_field << "), Strehl ratio " << cell << "\n";
+    os << "  cycles/mm  tangential  sagittal  diffraction limit\n";
+    for (std::size_t i = 0; i < frequencies_per_mm.size(); ++i) {
+      std::snprintf(cell, sizeof cell, "  %9.2f  %10.4f  %8.4f  %17.4f\n", frequencies_per_mm[i], c.tangential[i], c.sagittal[i],
+                    c.diffraction_limit[i]);
+      os << cell;
+    }
+  }
+  return os.str();
+}
+
+}  // namespace lensmith

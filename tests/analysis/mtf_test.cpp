@@ -1,0 +1,76 @@
+// The FFT MTF against closed forms: an aberration-free circular pupil has the diffraction-limited MTF
+// (2 / pi) (acos v - v sqrt(1 - v^2)), v = f / f_c, f_c = 2 NA / lambda (Goodman, Introduction to Fourier
+// Optics, eq. 6-32), and a Strehl ratio of 1; a pupil defocused by W020 waves (peak) has the Strehl ratio
+// [sin(pi W020) / (pi W020)]^2 (the on-axis amplitude is the mean of exp(2 pi i W020 rho^2) over the disc).
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "lensmith/analysis/mtf.h"
+#include "lensmith/core/units.h"
+#include "lensmith/glass/glass_catalog.h"
+#include "reference_lenses.h"
+
+using namespace lensmith;
+using Catch::Matchers::WithinAbs;
+using Catch::Matchers::WithinRel;
+
+namespace {
+
+constexpr double kIndex = testing::CartesianEllipsoid::kIndex;
+
+Prescription perfect_imager(double defocus_mm) { return testing::cartesian_ellipsoid(defocus_mm); }
+
+AnalysisOptions on_axis() {
+  AnalysisOptions o;
+  o.relative_fields = {0.0};
+  return o;
+}
+
+// sin of the marginal ray's angle in the image space.
+double marginal_sine(const AnalysisContext& context) {
+  const TracedRay r = context.trace(context.field_at(0.0), {0.0, 1.0}, kWavelengthD_nm);
+  REQUIRE(r.ok());
+  return std::sqrt(1.0 - r.image_ray.direction.z() * r.image_ray.direction.z());
+}
+
+}  // namespace
+
+TEST_CASE("An aberration-free lens has the diffraction-limited MTF of a circular pupil and a Strehl ratio of 1", "[analysis][mtf]") {
+  const AnalysisContext context(perfect_imager(0.0), on_axis());
+  const Mtf mtf = compute_mtf(context);
+  REQUIRE(mtf.fields.size() == 1);
+  const MtfCurve& c = mtf.fields.front();
+  CHECK_THAT(c.strehl, WithinAbs(1.0, 1e-9));
+  // The cutoff from the image-space NA (n' sin a of the real marginal ray) in vacuum wavelengths.
+  const double cutoff = 2.0 * kIndex * marginal_sine(context) / mm_from_nm(kWavelengthD_nm);
+  CHECK_THAT(mtf.cutoff_per_mm, WithinRel(cutoff, 5e-3));  // paraxial pupil against the real marginal ray: 0.4 %
+  // 0.01: the pupil's edge sampled by a 64-point grid, and the 0.4 % between paraxial and real cutoffs
+  // (measured 0.0055 at most).
+  constexpr double kSampling = 0.01;
+  for (std::size_t i = 0; i < mtf.frequencies_per_mm.size(); ++i) {
+    const double v = std::min(1.0, mtf.frequencies_per_mm[i] / cutoff);
+    const double analytic = 2.0 / kPi * (std::acos(v) - v * std::sqrt(1.0 - v * v));
+    INFO("f = " << mtf.frequencies_per_mm[i] << " cycles/mm");
+    CHECK_THAT(c.tangential[i], WithinAbs(analytic, kSampling));
+    CHECK_THAT(c.sagittal[i], WithinAbs(analytic, kSampling));
+    CHECK_THAT(c.diffraction_limit[i], WithinAbs(c.tangential[i], 1e-9));  // nothing to lose to aberration
+  }
+}
+
+TEST_CASE("A quarter wave of defocus has the Strehl ratio of a defocused circular pupil", "[analysis][mtf]") {
+  // dz for W020 = 0.25 waves at the rim: W = n' dz (1 - cos a) (wavefront_test.cpp checks it).
+  const AnalysisContext focused(perfect_imager(0.0), on_axis());
+  const double sin_a = marginal_sine(focused);
+  const double one_minus_cos = 1.0 - std::sqrt(1.0 - sin_a * sin_a);
+  const double dz = 0.25 * mm_from_nm(kWavelengthD_nm) / (kIndex * one_minus_cos);
+  const AnalysisContext context(perfect_imager(dz), on_axis());
+  const double w020 = kIndex * dz * one_minus_cos / mm_from_nm(kWavelengthD_nm);
+  const double expected = std::pow(std::sin(kPi * w020) / (kPi * w020), 2);  // 0.811
+  // 1 %: the wavefront is not exactly quadratic in the pupil coordinate (a 0.7 % rho^4 part, the
+  // surface's sag), and the disc's edge on a 64-point grid (measured 0.3 %).
+  CHECK_THAT(compute_mtf(context).fields.front().strehl, WithinRel(expected, 0.01));
+  // Defocus lowers the MTF below the diffraction limit at middle frequencies.
+  const Mtf mtf = compute_mtf(context);
+  const std::size_t middle = mtf.frequencies_per_mm.size() / 2;
+  CHECK(mtf.fields.front().tangential[middle] < 0.9 * mtf.fields.front().diffraction_limit[middle]);
+}
