@@ -142,6 +142,14 @@ struct MtfCommandOptions {
 };
 int run_mtf(const MtfCommandOptions& options, const GlobalOptions& global);
 
+struct PsfCommandOptions {
+  RealRayCommandOptions common;
+  int pupil_samples = 64;  // --pupil-samples
+  int size = 128;          // --size: samples across the picture
+  bool grid_in_json = false;  // --json-grid
+};
+int run_psf(const PsfCommandOptions& options, const GlobalOptions& global);
+
 struct AnalyzeCommandOptions {
   RealRayCommandOptions common;
   std::string what;              // --what distortion|field-curves|focal-shift|illumination|pupil

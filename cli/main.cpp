@@ -276,6 +276,14 @@ int main(int argc, char** argv) {
       ->check(positive());
   mtf_cmd->add_option("--frequencies", mtf.frequency_samples, "Points per curve (default 51; 2-1001)")->check(range(2, 1001));
 
+  PsfCommandOptions psf;
+  CLI::App* psf_cmd = app.add_subcommand("psf", "Diffraction PSF (FFT of the pupil function) per field, polychromatic, with the Strehl ratio");
+  add_real_ray_options(psf_cmd, psf.common);
+  psf_cmd->add_option("--pupil-samples", psf.pupil_samples, "Pupil grid across the pupil (default 64; 16-512)")->check(range(16, 512));
+  psf_cmd->add_option("--size", psf.size, "PSF samples across (default 128; 8 to 4 x --pupil-samples, rounded up to a power of two)")
+      ->check(range(8, 2048));
+  psf_cmd->add_flag("--json-grid", psf.grid_in_json, "With --json: the intensity grid too");
+
   SeidelCommandOptions seidel;
   CLI::App* seidel_cmd = app.add_subcommand("seidel", "Third-order (Seidel) aberrations per surface and summed, and Born & Wolf's B..F");
   seidel_cmd->add_option("lens", seidel.lens, "Lens file or shipped lens name")->required();
@@ -650,6 +658,7 @@ int main(int argc, char** argv) {
     if (*fan_cmd) return run_fan(fan, global);
     if (*wavefront_cmd) return run_wavefront(wavefront, global);
     if (*mtf_cmd) return run_mtf(mtf, global);
+    if (*psf_cmd) return run_psf(psf, global);
     if (*layout_cmd) return run_layout(layout, global);
     if (*analyze_cmd) return run_analyze(analyze, global);
     if (*bokeh_cmd) {

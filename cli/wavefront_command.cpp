@@ -59,4 +59,28 @@ int run_mtf(const MtfCommandOptions& options, const GlobalOptions& global) {
   return kExitOk;
 }
 
+int run_psf(const PsfCommandOptions& options, const GlobalOptions& global) {
+  if (options.grid_in_json && !options.common.json) throw UsageError("--json-grid adds the grid to --json: give --json too");
+  PsfOptions psf_options;
+  psf_options.pupil_samples = options.pupil_samples;
+  psf_options.size = options.size;
+  try {
+    psf_options.validate();
+  } catch (const OptionsError& e) {
+    throw UsageError(std::string("--size ") + std::to_string(options.size) + ": " + e.what());
+  }
+  const Prescription lens = load_lens(options.common.lens, global);
+  const AnalysisContext context(lens, make_analysis_options(options.common));
+  const Psf psf = compute_psf(context, psf_options);
+  if (!options.common.png.empty()) {
+    write_picture(plot::plot_psf(psf, make_plot_options(global)), options.common.png, options.common.lens, global);
+  }
+  if (options.common.json) {
+    std::cout << json_text(psf_json(psf, options.grid_in_json), 2) << "\n";
+  } else {
+    std::cout << psf.to_string();
+  }
+  return kExitOk;
+}
+
 }  // namespace lensmith::cli

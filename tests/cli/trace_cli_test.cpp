@@ -261,3 +261,25 @@ TEST_CASE("lensmith mtf: tangential, sagittal and diffraction-limit curves with 
   CHECK(read_png_header(png).valid);
   CHECK(run_lensmith("mtf sasian-triplet --pupil-samples 8").exit_code == 2);
 }
+
+TEST_CASE("lensmith psf: the PSF per field with its Strehl ratio and centroid, as JSON and a picture", "[cli][psf]") {
+  const ScratchFolder folder;
+  const std::string png = (folder.dir / "psf.png").string();
+  const auto r = run_lensmith("psf sasian-triplet --pupil-samples 32 --size 32 --json --json-grid --png " + png);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  CHECK(j["analysis"] == "psf");
+  CHECK(j["size"] == 32);
+  REQUIRE(j["fields"].size() == 3);
+  for (const auto& f : j["fields"]) {
+    CHECK(f["intensity"].size() == 32 * 32);
+    CHECK(f["peak"].get<double>() <= 1.0);  // no PSF peaks above the aberration-free one
+    CHECK(f["strehl"].get<double>() > 0.0);
+  }
+  CHECK(read_png_header(png).valid);
+  const auto big = run_lensmith("psf sasian-triplet --pupil-samples 16 --size 512");
+  CHECK(big.exit_code == 2);
+  CHECK(big.err.find("--size") != std::string::npos);
+  CHECK(run_lensmith("psf sasian-triplet --json-grid").exit_code == 2);
+}

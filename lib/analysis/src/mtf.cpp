@@ -68,6 +68,43 @@ Complex otf_at(const std::vector<Complex>& otf, int m, double s, bool along_y) {
   return (1.0 - t) * at(k) + t * at(k + 1);
 }
 
+// The pupil function of a wavefront map, and the same pupil without aberration, in the corner of m x m
+// arrays (rows from py = -1).
+void fill_pupil(const WavefrontMap& map, int m, std::vector<Complex>& pupil, std::vector<Complex>& perfect) {
+  const int n = map.grid;
+  pupil.assign(static_cast<std::size_t>(m) * static_cast<std::size_t>(m), 0.0);
+  perfect.assign(pupil.size(), 0.0);
+  for (int row = 0; row < n; ++row) {
+    for (int col = 0; col < n; ++col) {
+      const OpdSample& o = map.map[static_cast<std::size_t>(row) * static_cast<std::size_t>(n) + static_cast<std::size_t>(col)];
+      if (o.status != RayStatus::Ok || !std::isfinite(o.opd_waves)) continue;
+      const std::size_t at = static_cast<std::size_t>(row) * static_cast<std::size_t>(m) + static_cast<std::size_t>(col);
+      pupil[at] = std::polar(1.0, 2.0 * kPi * o.opd_waves);
+      perfect[at] = 1.0;
+    }
+  }
+}
+
+int transform_size(int pupil_samples, int padding) {
+  int m = 1;
+  while (m < pupil_samples * padding) m *= 2;
+  return m;
+}
+
+// The wavelength in the image space's medium, mm (an image in glass: lambda / n').
+double medium_wavelength_mm(const AnalysisContext& context, double nm) {
+  return mm_from_nm(nm) / std::abs(context.lens().surfaces.back().medium.index(nm));
+}
+
+// The OPD maps a pupil function is made of (no Zernike fit, short fans).
+Wavefront pupil_wavefront(const AnalysisContext& context, int pupil_samples) {
+  WavefrontOptions w;
+  w.grid = pupil_samples;
+  w.zernike_terms = 1;
+  w.fan_samples = 3;
+  return compute_wavefront(context, w);
+}
+
 }  // namespace
 
 void MtfOptions::validate() const {
@@ -81,14 +118,9 @@ void MtfOptions::validate() const {
 
 Mtf compute_mtf(const AnalysisContext& context, const MtfOptions& options) {
   options.validate();
-  WavefrontOptions w;
-  w.grid = options.pupil_samples;
-  w.zernike_terms = 1;
-  w.fan_samples = 3;
-  const Wavefront wavefront = compute_wavefront(context, w);
+  const Wavefront wavefront = pupil_wavefront(context, options.pupil_samples);
   const int n = options.pupil_samples;
-  int m = 1;
-  while (m < n * options.padding) m *= 2;
+  const int m = transform_size(n, options.padding);
   const double exit_pupil_radius_mm = 0.5 * context.paraxial().exit_pupil().diameter_mm;
   const double step_mm = 2.0 * exit_pupil_radius_mm / (n - 1);  // pupil sample step on the exit pupil
 
@@ -98,9 +130,8 @@ Mtf compute_mtf(const AnalysisContext& context, const MtfOptions& options) {
   const std::size_t waves = out.wavelengths_nm.size();
   // The cutoff at the reference wavelength on axis (the first field's radius); the curves run to the
   // shortest wavelength's, the highest any wavelength passes.
-  // The wavelength in the image space's medium sets the scale (an image in glass: lambda / n').
-  const Glass& image_medium = context.lens().surfaces.back().medium;
-  auto medium_wavelength_mm = [&](double nm) { return mm_from_nm(nm) / std::abs(image_medium.index(nm)); };
+  // The wavelength in the image space's medium sets the scale.
+  auto medium_wavelength_mm = [&](double nm) { return lensmith::medium_wavelength_mm(context, nm); };
   const double radius_mm = std::abs(wavefront.maps.front().reference_radius_mm);
   out.cutoff_per_mm = 2.0 * exit_pupil_radius_mm / (medium_wavelength_mm(wavefront.reference_wavelength_nm) * radius_mm);
   double top = options.max_frequency_per_mm;
@@ -119,16 +150,8 @@ Mtf compute_mtf(const AnalysisContext& context, const MtfOptions& options) {
     std::vector<Complex> t(nf), s(nf), limit(nf);
     for (std::size_t k = 0; k < waves; ++k) {
       const WavefrontMap& map = wavefront.maps[f + k];
-      std::vector<Complex> pupil(static_cast<std::size_t>(m) * static_cast<std::size_t>(m)), perfect(pupil.size());
-      for (int row = 0; row < n; ++row) {
-        for (int col = 0; col < n; ++col) {
-          const OpdSample& o = map.map[static_cast<std::size_t>(row) * static_cast<std::size_t>(n) + static_cast<std::size_t>(col)];
-          if (o.status != RayStatus::Ok || !std::isfinite(o.opd_waves)) continue;
-          const std::size_t at = static_cast<std::size_t>(row) * static_cast<std::size_t>(m) + static_cast<std::size_t>(col);
-          pupil[at] = std::polar(1.0, 2.0 * kPi * o.opd_waves);
-          perfect[at] = 1.0;
-        }
-      }
+      std::vector<Complex> pupil, perfect;
+      fill_pupil(map, m, pupil, perfect);
       const Transfer real = transfer(std::move(pupil), m, fft), ideal = transfer(std::move(perfect), m, fft);
       curve.strehl += real.psf_peak / ideal.psf_peak / static_cast<double>(waves);
       // A shift of one sample is the frequency step / (lambda R).
@@ -148,6 +171,104 @@ Mtf compute_mtf(const AnalysisContext& context, const MtfOptions& options) {
     out.fields.push_back(std::move(curve));
   }
   return out;
+}
+
+void PsfOptions::validate() const {
+  analysis_detail::check_count("PsfOptions::pupil_samples", pupil_samples, 16, 512);
+  analysis_detail::check_count("PsfOptions::padding", padding, 2, 16);
+  analysis_detail::check_count("PsfOptions::size", size, 8, transform_size(pupil_samples, padding));
+}
+
+Psf compute_psf(const AnalysisContext& context, const PsfOptions& options) {
+  options.validate();
+  const Wavefront wavefront = pupil_wavefront(context, options.pupil_samples);
+  const int n = options.pupil_samples, m = transform_size(n, options.padding);
+  const double step_mm = 2.0 * (0.5 * context.paraxial().exit_pupil().diameter_mm) / (n - 1);
+  // The image-plane sampling of a wavelength's transform: lambda' R / (m dp).
+  auto spacing_mm = [&](const WavefrontMap& map) {
+    return medium_wavelength_mm(context, map.wavelength_nm) * std::abs(map.reference_radius_mm) / (m * step_mm);
+  };
+  Psf out;
+  out.lens_name = wavefront.lens_name;
+  out.wavelengths_nm = wavefront.wavelengths_nm;
+  out.size = options.size;
+  const std::size_t waves = out.wavelengths_nm.size();
+  std::size_t reference = 0;
+  for (std::size_t k = 0; k < waves; ++k) {
+    if (out.wavelengths_nm[k] == wavefront.reference_wavelength_nm) reference = k;
+  }
+  out.spacing_mm = spacing_mm(wavefront.maps[reference]);
+  const int size = options.size;
+  Eigen::FFT<double> fft;
+  for (std::size_t f = 0; f < wavefront.maps.size(); f += waves) {
+    FieldPsf field;
+    field.relative_field = wavefront.maps[f].relative_field;
+    field.field_value = wavefront.maps[f].field_value;
+    field.field_label = wavefront.maps[f].field_label;
+    field.centre = wavefront.maps[f].reference;
+    field.intensity.assign(static_cast<std::size_t>(size) * static_cast<std::size_t>(size), 0.0);
+    for (std::size_t k = 0; k < waves; ++k) {
+      const WavefrontMap& map = wavefront.maps[f + k];
+      std::vector<Complex> pupil, perfect;
+      fill_pupil(map, m, pupil, perfect);
+      fft2(pupil, m, false, fft);
+      fft2(perfect, m, false, fft);
+      double ideal_peak = 0.0, peak = 0.0;
+      for (const Complex& c : perfect) ideal_peak = std::max(ideal_peak, std::norm(c));
+      for (const Complex& c : pupil) peak = std::max(peak, std::norm(c));
+      field.strehl += peak / ideal_peak / static_cast<double>(waves);
+      // Sample the periodic transform at each output point, bilinearly. The transform's index runs
+      // against the image coordinate: a wavefront leading at +x (W rising with px) sends its light to -x
+      // (e_x = -(R / n') dW/dx), while its transform peaks at a positive index.
+      const double d = spacing_mm(map);
+      auto at = [&](int i, int j) {
+        const int wi = ((i % m) + m) % m, wj = ((j % m) + m) % m;
+        return std::norm(pupil[static_cast<std::size_t>(wj) * static_cast<std::size_t>(m) + static_cast<std::size_t>(wi)]);
+      };
+      for (int r = 0; r < size; ++r) {
+        const double y = (0.5 * size - r) * out.spacing_mm;
+        for (int c = 0; c < size; ++c) {
+          const double x = (c - 0.5 * size) * out.spacing_mm;
+          const double u = -x / d, v = -y / d;
+          const int i = static_cast<int>(std::floor(u)), j = static_cast<int>(std::floor(v));
+          const double tu = u - i, tv = v - j;
+          const double value = (1 - tu) * (1 - tv) * at(i, j) + tu * (1 - tv) * at(i + 1, j) + (1 - tu) * tv * at(i, j + 1) + tu * tv * at(i + 1, j + 1);
+          field.intensity[static_cast<std::size_t>(r) * static_cast<std::size_t>(size) + static_cast<std::size_t>(c)] +=
+              value / ideal_peak / static_cast<double>(waves);
+        }
+      }
+    }
+    double total = 0.0, sx = 0.0, sy = 0.0;
+    for (int r = 0; r < size; ++r) {
+      for (int c = 0; c < size; ++c) {
+        const double v = field.intensity[static_cast<std::size_t>(r) * static_cast<std::size_t>(size) + static_cast<std::size_t>(c)];
+        total += v;
+        sx += v * (c - 0.5 * size) * out.spacing_mm;
+        sy += v * (0.5 * size - r) * out.spacing_mm;
+      }
+    }
+    field.centroid_x_mm = total > 0.0 ? sx / total : 0.0;
+    field.centroid_y_mm = total > 0.0 ? sy / total : 0.0;
+    out.fields.push_back(std::move(field));
+  }
+  return out;
+}
+
+std::string Psf::to_string() const {
+  std::ostringstream os;
+  char cell[160];
+  os << "PSF (FFT of the pupil function): " << lens_name << "\n";
+  std::snprintf(cell, sizeof cell, "%d x %d samples %.3f um apart (%.1f um across)", size, size, um_from_mm(spacing_mm),
+                um_from_mm(spacing_mm * size));
+  os << cell << ", about the reference chief ray; polychromatic, equal weights; 1 = the aberration-free peak.\n";
+  for (const FieldPsf& f : fields) {
+    double peak = 0.0;
+    for (double v : f.intensity) peak = std::max(peak, v);
+    std::snprintf(cell, sizeof cell, ": Strehl ratio %.4f, peak %.4f, centroid (%.3f, %.3f) um", f.strehl, peak, um_from_mm(f.centroid_x_mm),
+                  um_from_mm(f.centroid_y_mm));
+    os << "Field " << f.field_label << " (relative " << f.relative_field << ")" << cell << "\n";
+  }
+  return os.str();
 }
 
 std::string Mtf::to_string() const {

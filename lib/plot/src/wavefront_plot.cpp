@@ -6,6 +6,7 @@
 #include "figure_parts.h"
 #include "lensmith/plot/analysis_plots.h"
 #include "lensmith/plot/plot_axes.h"
+#include "lensmith/core/units.h"
 
 namespace lensmith::plot {
 
@@ -90,6 +91,50 @@ Canvas plot_wavefront_map(const Wavefront& wavefront, const PlotOptions& o) {
     canvas.text({x, by + 24.0}, tick_label(v, step), o.font_px * 0.85, kText, HAlign::Centre, VAlign::Top);
   }
   canvas.text({0.5 * width, by + 26.0 + 1.2 * o.font_px}, "OPD, waves", o.font_px * 0.9, kText, HAlign::Centre, VAlign::Top);
+  return canvas;
+}
+
+Canvas plot_psf(const Psf& psf, const PlotOptions& o) {
+  const int count = static_cast<int>(psf.fields.size());
+  const int columns = std::max(1, std::min(count, 3));
+  const int rows = (count + columns - 1) / columns;
+  const double panel = 240.0, gap_x = 80.0, gap_y = 64.0 + 3.0 * o.font_px;
+  const double left = 80.0, top = header_height(o) + 1.0 * o.font_px + 10.0;
+  const int width = std::max(640, static_cast<int>(left + columns * panel + (columns - 1) * gap_x + 40.0));
+  const int height = static_cast<int>(top + rows * panel + (rows - 1) * gap_y + 40.0 + 2.5 * o.font_px);
+  Canvas canvas = make_canvas(width, height, o);
+  std::string waves;
+  for (double w : psf.wavelengths_nm) waves += (waves.empty() ? "" : ", ") + fixed(w, 1);
+  header(canvas, "PSF (FFT)", psf.lens_name,
+         "polychromatic over " + waves + " nm, equal weights; grey, logarithmic over four decades of the aberration-free peak; "
+         "micrometres about the reference chief ray",
+         o);
+  const double half_um = 0.5 * psf.size * um_from_mm(psf.spacing_mm);
+  constexpr double kDecades = 4.0;
+  for (int k = 0; k < count; ++k) {
+    const FieldPsf& f = psf.fields[static_cast<std::size_t>(k)];
+    const double x0 = left + (k % columns) * (panel + gap_x), y0 = top + (k / columns) * (panel + gap_y);
+    PlotAxes axes(canvas, {x0, y0}, {x0 + panel, y0 + panel}, {-half_um, half_um}, {-half_um, half_um});
+    const double cell = 2.0 * half_um / psf.size;
+    for (int r = 0; r < psf.size; ++r) {
+      for (int c = 0; c < psf.size; ++c) {
+        const double v = f.intensity[static_cast<std::size_t>(r) * static_cast<std::size_t>(psf.size) + static_cast<std::size_t>(c)];
+        const double level = std::clamp(1.0 + std::log10(std::max(v, 1e-12)) / kDecades, 0.0, 1.0);
+        const double x = -half_um + c * cell, y = half_um - r * cell;
+        const Point2 a = axes.to_pixel(x, y), b = axes.to_pixel(x + cell, y - cell);
+        const float g = static_cast<float>(1.0 - level);
+        canvas.fill_rect({std::round(a.x), std::round(a.y)}, {std::round(b.x), std::round(b.y)}, Rgb{g, g, g});
+      }
+    }
+    AxesText text;
+    text.font_px = o.font_px;
+    text.title = "Field " + f.field_label;
+    text.x_label = "x (um)";
+    text.y_label = "y (um)";
+    axes.draw_frame(text, true, true, 4, 4);
+    canvas.text({x0 + 0.5 * panel, y0 + panel + 16.0 + 2.2 * o.font_px}, "Strehl ratio " + fixed(f.strehl, 4), o.font_px * 0.95, kText,
+                HAlign::Centre, VAlign::Top);
+  }
   return canvas;
 }
 

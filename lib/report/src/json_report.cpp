@@ -275,6 +275,29 @@ ojson wavefront_json(const Wavefront& w, bool include_map) {
           {"maps", maps}};
 }
 
+ojson psf_json(const Psf& psf, bool include_grid) {
+  ojson fields = ojson::array();
+  for (const FieldPsf& f : psf.fields) {
+    double peak = 0.0;
+    for (double v : f.intensity) peak = std::max(peak, v);
+    ojson o{{"relative_field", f.relative_field},
+            {"field_value", f.field_value},
+            {"centre", {{"x_mm", f.centre.x_mm}, {"y_mm", f.centre.y_mm}, {"z_mm", f.centre.z_mm}}},
+            {"strehl", f.strehl},
+            {"peak", peak},
+            {"centroid_x_um", um_from_mm(f.centroid_x_mm)},
+            {"centroid_y_um", um_from_mm(f.centroid_y_mm)}};
+    if (include_grid) o["intensity"] = f.intensity;
+    fields.push_back(o);
+  }
+  return {{"analysis", "psf"},
+          {"lens", psf.lens_name},
+          {"wavelengths_nm", psf.wavelengths_nm},
+          {"size", psf.size},
+          {"spacing_um", um_from_mm(psf.spacing_mm)},
+          {"fields", fields}};
+}
+
 ojson mtf_json(const Mtf& mtf) {
   ojson fields = ojson::array();
   for (const MtfCurve& c : mtf.fields) {

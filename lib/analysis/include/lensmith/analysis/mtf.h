@@ -53,4 +53,39 @@ struct Mtf {
 // Throws what compute_wavefront throws.
 Mtf compute_mtf(const AnalysisContext& context, const MtfOptions& options = {});
 
+// The diffraction PSF from the same pupil function: |FFT(P)|^2, per wavelength on its own sampling
+// (lambda' R / (M dp)), resampled bilinearly onto the reference wavelength's grid and averaged with equal
+// weights. Each wavelength's PSF is scaled so that its aberration-free pupil's peak is 1: the polychromatic
+// peak is then about the Strehl ratio. Coordinates are image-plane mm about the reference sphere's centre
+// (the reference wavelength's chief ray), x right and y up as the image plane's.
+struct PsfOptions {
+  int pupil_samples = 64;   // pupil grid across the unit pupil (16 to 512)
+  int padding = 4;          // transform size = pupil_samples x padding, rounded up to a power of two (2 to 16)
+  int size = 128;           // output samples across, centred (8 to the transform size)
+  void validate() const;    // throws OptionsError
+};
+
+struct FieldPsf {
+  double relative_field = 0.0;
+  double field_value = 0.0;
+  std::string field_label;
+  ImagePoint centre;              // the grid's centre: the reference chief ray on the image plane
+  double strehl = 0.0;            // as MtfCurve::strehl
+  double centroid_x_mm = 0.0;     // the PSF's centroid about `centre`
+  double centroid_y_mm = 0.0;
+  std::vector<double> intensity;  // size x size, row-major, the top row at +y
+};
+
+struct Psf {
+  std::string lens_name;
+  std::vector<double> wavelengths_nm;
+  int size = 0;
+  double spacing_mm = 0.0;        // between samples (the reference wavelength's FFT sampling)
+  std::vector<FieldPsf> fields;
+  std::string to_string() const;  // per field: Strehl, peak, centroid, the sampling
+  friend std::ostream& operator<<(std::ostream& os, const Psf& p) { return os << p.to_string(); }
+};
+
+Psf compute_psf(const AnalysisContext& context, const PsfOptions& options = {});
+
 }  // namespace lensmith

@@ -19,6 +19,7 @@ struct SpotDiagram;
 struct RayFan;
 struct Wavefront;
 struct Mtf;
+struct Psf;
 struct DistortionCurve;
 struct FieldCurves;
 struct ChromaticFocalShift;
@@ -46,6 +47,9 @@ ojson wavefront_json(const Wavefront& wavefront, bool include_map);
 // lensmith mtf --json: frequencies (cycles/mm), per field the tangential, sagittal and diffraction-limit
 // curves and the Strehl ratio.
 ojson mtf_json(const Mtf& mtf);
+// lensmith psf --json: the sampling, per field the Strehl ratio, the centroid and (with `include_grid`) the
+// intensity grid (size x size, row-major from the top row, +y).
+ojson psf_json(const Psf& psf, bool include_grid);
 // `lensmith analyze --what ... --json`.
 ojson distortion_json(const DistortionCurve& curve);
 ojson field_curves_json(const FieldCurves& curves);
