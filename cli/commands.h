@@ -139,6 +139,9 @@ struct MtfCommandOptions {
   int pupil_samples = 64;                     // --pupil-samples
   std::optional<double> max_frequency_per_mm;  // --max-frequency (default: the cutoff)
   int frequency_samples = 51;                 // --frequencies
+  std::optional<double> through_focus_per_mm;  // --through-focus F: the MTF at F cycles/mm against focus
+  double focus_range_mm = 0.1;                // --focus-range: shifts from -R to +R
+  int focus_steps = 21;                       // --focus-steps
 };
 int run_mtf(const MtfCommandOptions& options, const GlobalOptions& global);
 

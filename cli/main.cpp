@@ -275,6 +275,13 @@ int main(int argc, char** argv) {
   mtf_cmd->add_option("--max-frequency", mtf.max_frequency_per_mm, "Highest frequency, cycles/mm (default: the diffraction cutoff; > 0)")
       ->check(positive());
   mtf_cmd->add_option("--frequencies", mtf.frequency_samples, "Points per curve (default 51; 2-1001)")->check(range(2, 1001));
+  CLI::Option* through_focus = mtf_cmd->add_option("--through-focus", mtf.through_focus_per_mm,
+                                                   "Instead: the MTF at this frequency (cycles/mm, > 0) against the image plane's shift")
+                                   ->check(positive());
+  mtf_cmd->add_option("--focus-range", mtf.focus_range_mm, "With --through-focus: shifts from -MM to +MM (default 0.1; > 0)")
+      ->check(positive())
+      ->needs(through_focus);
+  mtf_cmd->add_option("--focus-steps", mtf.focus_steps, "With --through-focus: shifts (default 21; 2-1001)")->check(range(2, 1001))->needs(through_focus);
 
   PsfCommandOptions psf;
   CLI::App* psf_cmd = app.add_subcommand("psf", "Diffraction PSF (FFT of the pupil function) per field, polychromatic, with the Strehl ratio");

@@ -47,6 +47,20 @@ int run_mtf(const MtfCommandOptions& options, const GlobalOptions& global) {
   mtf_options.validate();
   const Prescription lens = load_lens(options.common.lens, global);
   const AnalysisContext context(lens, make_analysis_options(options.common));
+  if (options.through_focus_per_mm) {
+    std::vector<double> shifts;
+    for (int i = 0; i < options.focus_steps; ++i) shifts.push_back(-options.focus_range_mm + 2.0 * options.focus_range_mm * i / (options.focus_steps - 1));
+    const ThroughFocusMtf through = compute_through_focus_mtf(context, *options.through_focus_per_mm, shifts, mtf_options);
+    if (!options.common.png.empty()) {
+      write_picture(plot::plot_through_focus_mtf(through, make_plot_options(global)), options.common.png, options.common.lens, global);
+    }
+    if (options.common.json) {
+      std::cout << json_text(through_focus_mtf_json(through), 2) << "\n";
+    } else {
+      std::cout << through.to_string();
+    }
+    return kExitOk;
+  }
   const Mtf mtf = compute_mtf(context, mtf_options);
   if (!options.common.png.empty()) {
     write_picture(plot::plot_mtf(mtf, make_plot_options(global)), options.common.png, options.common.lens, global);

@@ -283,3 +283,15 @@ TEST_CASE("lensmith psf: the PSF per field with its Strehl ratio and centroid, a
   CHECK(big.err.find("--size") != std::string::npos);
   CHECK(run_lensmith("psf sasian-triplet --json-grid").exit_code == 2);
 }
+
+TEST_CASE("lensmith mtf --through-focus: the MTF at one frequency against focus, and its options need it", "[cli][mtf]") {
+  const auto r = run_lensmith("mtf sasian-triplet --pupil-samples 32 --through-focus 30 --focus-range 0.2 --focus-steps 9 --json");
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  CHECK(j["analysis"] == "through_focus_mtf");
+  REQUIRE(j["focus_shifts_mm"].size() == 9);
+  CHECK_THAT(j["focus_shifts_mm"][0].get<double>(), WithinAbs(-0.2, 1e-12));
+  CHECK(j["fields"][0]["tangential"].size() == 9);
+  CHECK(run_lensmith("mtf sasian-triplet --focus-range 0.2").exit_code == 2);
+}

@@ -427,6 +427,30 @@ Canvas plot_mtf(const Mtf& mtf, const PlotOptions& o) {
   return canvas;
 }
 
+Canvas plot_through_focus_mtf(const ThroughFocusMtf& mtf, const PlotOptions& o) {
+  Canvas canvas = one_panel_canvas(o, true);
+  const double top = panel_top(o, true);
+  const double lo = mtf.focus_shifts_mm.empty() ? -1.0 : mtf.focus_shifts_mm.front();
+  const double hi = mtf.focus_shifts_mm.empty() ? 1.0 : std::max(lo + 1e-9, mtf.focus_shifts_mm.back());
+  PlotAxes axes(canvas, {kPanelLeft, top}, {kPanelLeft + kPanelWidth, top + kPanelHeight}, {lo, hi}, {0.0, 1.0});
+  header(canvas, "Through-focus MTF (FFT)", mtf.lens_name,
+         "at " + fixed(mtf.frequency_per_mm, 2) + " cycles/mm; image plane moved along the axis, + away from the lens", o);
+  std::vector<LegendEntry> legend{{"tangential", LineStyle{kText, 2.0}}, {"sagittal", LineStyle{kText, 2.0, 7.0, 5.0}}};
+  for (std::size_t f = 0; f < mtf.fields.size(); ++f) legend.push_back({mtf.fields[f].field_label, LineStyle{field_colour(f), 2.0}});
+  legend_row(canvas, {20.0, header_height(o) + 0.4 * o.font_px}, legend, o);
+  AxesText text;
+  text.font_px = o.font_px;
+  text.x_label = "focus shift (mm)";
+  text.y_label = "modulation";
+  axes.draw_frame(text, true, true, 6, 5);
+  axes.draw_zero_lines(false, true);
+  for (std::size_t f = 0; f < mtf.fields.size(); ++f) {
+    axes.curve(mtf.focus_shifts_mm, mtf.fields[f].tangential, LineStyle{field_colour(f), 2.2});
+    axes.curve(mtf.focus_shifts_mm, mtf.fields[f].sagittal, LineStyle{field_colour(f), 2.2, 8.0, 5.0});
+  }
+  return canvas;
+}
+
 Canvas plot_chromatic_focal_shift(const ChromaticFocalShift& c, const PlotOptions& o) {
   Canvas canvas = one_panel_canvas(o, false);
   const double top = panel_top(o, false);

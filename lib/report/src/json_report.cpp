@@ -298,6 +298,22 @@ ojson psf_json(const Psf& psf, bool include_grid) {
           {"fields", fields}};
 }
 
+ojson through_focus_mtf_json(const ThroughFocusMtf& mtf) {
+  ojson fields = ojson::array();
+  for (const MtfCurve& c : mtf.fields) {
+    fields.push_back({{"relative_field", c.relative_field},
+                      {"field_value", c.field_value},
+                      {"tangential", c.tangential},
+                      {"sagittal", c.sagittal},
+                      {"diffraction_limit", c.diffraction_limit}});
+  }
+  return {{"analysis", "through_focus_mtf"},
+          {"lens", mtf.lens_name},
+          {"frequency_per_mm", mtf.frequency_per_mm},
+          {"focus_shifts_mm", mtf.focus_shifts_mm},
+          {"fields", fields}};
+}
+
 ojson mtf_json(const Mtf& mtf) {
   ojson fields = ojson::array();
   for (const MtfCurve& c : mtf.fields) {

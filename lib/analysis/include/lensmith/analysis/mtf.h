@@ -53,6 +53,23 @@ struct Mtf {
 // Throws what compute_wavefront throws.
 Mtf compute_mtf(const AnalysisContext& context, const MtfOptions& options = {});
 
+// Through-focus MTF: the MTF at one frequency as the image plane moves along the axis by each of
+// `focus_shifts_mm` (mm, + away from the lens), as OpticStudio's "FFT Through Focus MTF": the shift adds the
+// defocus of a spherical wave to the pupil's phase, W_dz = n' dz (1 - cos a) with sin a = rho r_XP / R
+// (Welford sec. 5.4; wavefront_test.cpp checks the form against real rays).
+struct ThroughFocusMtf {
+  std::string lens_name;
+  double frequency_per_mm = 0.0;
+  std::vector<double> focus_shifts_mm;
+  std::vector<MtfCurve> fields;  // tangential, sagittal and diffraction_limit over the shifts (strehl not set)
+  std::string to_string() const;
+  friend std::ostream& operator<<(std::ostream& os, const ThroughFocusMtf& t) { return os << t.to_string(); }
+};
+
+// Throws OptionsError for a frequency that is not > 0 or no shifts, and what compute_mtf throws.
+ThroughFocusMtf compute_through_focus_mtf(const AnalysisContext& context, double frequency_per_mm, const std::vector<double>& focus_shifts_mm,
+                                          const MtfOptions& options = {});
+
 // The diffraction PSF from the same pupil function: |FFT(P)|^2, per wavelength on its own sampling
 // (lambda' R / (M dp)), resampled bilinearly onto the reference wavelength's grid and averaged with equal
 // weights. Each wavelength's PSF is scaled so that its aberration-free pupil's peak is 1: the polychromatic

@@ -45,6 +45,8 @@ Canvas plot_wavefront_map(const Wavefront& wavefront, const PlotOptions& options
 // MTF against spatial frequency (cycles/mm): per field tangential (solid) and sagittal (dashed) in the
 // field's colour, the first field's diffraction limit in black, the Strehl ratios in the header.
 Canvas plot_mtf(const Mtf& mtf, const PlotOptions& options = {});
+// The through-focus MTF: modulation against the focus shift (mm), per field T solid and S dashed.
+Canvas plot_through_focus_mtf(const ThroughFocusMtf& mtf, const PlotOptions& options = {});
 // The PSF per field, in grey on a logarithmic scale over four decades (the Airy rings show), axes in
 // micrometres about the reference chief ray, the Strehl ratio under each (wavefront_plot.cpp).
 Canvas plot_psf(const Psf& psf, const PlotOptions& options = {});

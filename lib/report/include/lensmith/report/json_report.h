@@ -20,6 +20,7 @@ struct RayFan;
 struct Wavefront;
 struct Mtf;
 struct Psf;
+struct ThroughFocusMtf;
 struct DistortionCurve;
 struct FieldCurves;
 struct ChromaticFocalShift;
@@ -47,6 +48,8 @@ ojson wavefront_json(const Wavefront& wavefront, bool include_map);
 // lensmith mtf --json: frequencies (cycles/mm), per field the tangential, sagittal and diffraction-limit
 // curves and the Strehl ratio.
 ojson mtf_json(const Mtf& mtf);
+// lensmith mtf --through-focus --json: the frequency, focus shifts (mm) and per field the curves over them.
+ojson through_focus_mtf_json(const ThroughFocusMtf& mtf);
 // lensmith psf --json: the sampling, per field the Strehl ratio, the centroid and (with `include_grid`) the
 // intensity grid (size x size, row-major from the top row, +y).
 ojson psf_json(const Psf& psf, bool include_grid);
