@@ -322,7 +322,9 @@ ojson mtf_json(const Mtf& mtf) {
                       {"strehl", c.strehl},
                       {"tangential", c.tangential},
                       {"sagittal", c.sagittal},
-                      {"diffraction_limit", c.diffraction_limit}});
+                      {"diffraction_limit", c.diffraction_limit},
+                      {"geometric_tangential", c.geometric_tangential},
+                      {"geometric_sagittal", c.geometric_sagittal}});
   }
   return {{"analysis", "mtf"},
           {"lens", mtf.lens_name},

@@ -37,6 +37,10 @@ struct MtfCurve {
   std::vector<double> tangential;   // per frequency, polychromatic
   std::vector<double> sagittal;
   std::vector<double> diffraction_limit;  // an aberration-free pupil of the same shape (tangential)
+  // The geometric MTF for comparison (compute_mtf only): |mean of exp(2 pi i f y)| over the landing points
+  // of the pupil grid's rays (Smith, Modern Optical Engineering, sec. 11.8), wavelengths averaged as above.
+  std::vector<double> geometric_tangential;
+  std::vector<double> geometric_sagittal;
   double strehl = 0.0;              // the mean over wavelengths of the PSF's peak over the aberration-free one's
 };
 
