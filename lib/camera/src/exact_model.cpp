@@ -25,7 +25,12 @@ Ray ray_towards(const ScenePoint& p, double z_perspective_mm, double target_x, d
   if (p.inverse_depth_per_mm > 0.0) {
     const double depth = distance_mm_from_inverse(p.inverse_depth_per_mm);
     r.position_mm = Eigen::Vector3d(p.tan_x * depth, p.tan_y * depth, z_perspective_mm - depth);
-    r.direction = (Eigen::Vector3d(target_x, target_y, target_z) - r.position_mm).normalized();
+    const Eigen::Vector3d target(target_x, target_y, target_z);
+    r.direction = (target - r.position_mm).normalized();
+    // A far point starts its ray near the lens, on the same line: traced from 1e10 mm away (a renderer's
+    // sky depth: Cycles writes 1e10 m) the intersections lost their precision, and beyond 1e8 m the rays
+    // missed (a sky that vanished under --model exact).
+    if (r.position_mm.z() < start_z_mm) r.position_mm = target + r.direction * ((start_z_mm - target_z) / r.direction.z());
   } else {
     // Light from a point infinitely far along +tangents travels along -tangents.
     r.direction = Eigen::Vector3d(-p.tan_x, -p.tan_y, 1.0).normalized();
