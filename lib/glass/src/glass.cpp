@@ -246,7 +246,12 @@ std::string Glass::to_string() const {
       return "model glass (Cauchy from nd " + format("%.5f", catalog_nd_) + ", Vd " + format("%.2f", catalog_vd_) + ")";
     case Formula::Sellmeier:
     case Formula::Sellmeier2:
-    case Formula::Polynomial: break;
+    case Formula::Polynomial:
+    case Formula::Herzberger:
+    case Formula::AgfSellmeier2:
+    case Formula::Conrady:
+    case Formula::Handbook1:
+    case Formula::Handbook2: break;
   }
   std::string s = vendor_.empty() ? name_ : vendor_ + " " + name_;
   s += " (formula " + std::to_string(static_cast<int>(formula_)) + ", " + wavelength_text(range_nm_.min_nm) + "-" +

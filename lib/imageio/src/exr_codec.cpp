@@ -447,8 +447,8 @@ Metadata read_exr_metadata(const fs::path& path) {
       value = shortest_float_text(v->value().x) + ", " + shortest_float_text(v->value().y);
     } else if (const auto* w = dynamic_cast<const Imf::V2iAttribute*>(&a)) {
       value = std::to_string(w->value().x) + ", " + std::to_string(w->value().y);
-    } else if (const auto* c = dynamic_cast<const Imf::ChromaticitiesAttribute*>(&a)) {
-      const Imf::Chromaticities& k = c->value();
+    } else if (const auto* primaries = dynamic_cast<const Imf::ChromaticitiesAttribute*>(&a)) {
+      const Imf::Chromaticities& k = primaries->value();
       for (const float x : {k.red.x, k.red.y, k.green.x, k.green.y, k.blue.x, k.blue.y, k.white.x, k.white.y}) {
         value += (value.empty() ? "" : ", ") + shortest_float_text(x);
       }
