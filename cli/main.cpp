@@ -78,7 +78,8 @@ int anamorphic_output_width(const Camera& camera, int width_px, bool desqueeze, 
     if (desqueeze && !global.quiet) std::cerr << "note: --desqueeze has no effect: the lens is not anamorphic\n";
     return 0;
   }
-  const int narrowed = std::clamp(static_cast<int>(std::lround(width_px / squeeze)), 1, width_px);
+  // A squeeze below 1 (an x section with the longer focal length) stretches the sensor's picture instead.
+  const int narrowed = std::max(1, static_cast<int>(std::lround(width_px / squeeze)));
   if (!global.quiet) {
     std::cerr << "note: anamorphic squeeze " << format_rounded(squeeze, 4) << ": ";
     if (desqueeze) {

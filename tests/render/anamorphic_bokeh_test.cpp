@@ -142,6 +142,8 @@ TEST_CASE("Squeezing a picture's columns integrates each new pixel's share of th
   CHECK_THAT((thirds[0] + thirds[1] + thirds[2]) / 3.0, WithinRel(4.0, 1e-6));              // the row's mean kept
   // The nearest sample takes the pixel under each new pixel's centre (depths are not averaged).
   CHECK(squeeze_columns_nearest(row, 4, 1, 1, 3) == std::vector<float>{1.0f, 5.0f, 7.0f});
-  CHECK_THROWS_AS(squeeze_columns(row, 4, 1, 1, 5), OptionsError);
+  // A squeeze below 1 stretches: each old pixel spread over the new ones it covers.
+  CHECK(squeeze_columns(std::vector<float>{1.0f, 3.0f}, 2, 1, 1, 4) == std::vector<float>{1.0f, 1.0f, 3.0f, 3.0f});
+  CHECK_THROWS_AS(squeeze_columns(row, 4, 1, 1, 0), OptionsError);
   CHECK_THROWS_AS(squeeze_columns(row, 3, 1, 1, 2), OptionsError);
 }

@@ -57,11 +57,11 @@ std::vector<float> extend_edges(std::span<const float> samples, int width, int h
 // wide (the inverse of extend_edges). Throws OptionsError when the box is not inside the picture.
 std::vector<float> crop_pixels(std::span<const float> samples, int full_width, int channels, int left, int top, int width, int height);
 
-// Interleaved samples of a width x height picture narrowed to `new_width` columns (1..width): each new
-// column the mean over its width / new_width share of the row, fractional pixels by their overlap, as a
-// sensor pixel that many times wider integrates the light (an anamorphic lens's squeezed picture; no
-// negative lobes to ring around highlights, and the mean of every row kept). Throws OptionsError for
-// sizes that do not match.
+// Interleaved samples of a width x height picture resampled to `new_width` columns (>= 1; fewer squeeze,
+// more stretch): each new column the mean over its width / new_width share of the row, fractional pixels
+// by their overlap, as a sensor pixel that many times wider integrates the light (an anamorphic lens's
+// squeezed picture; no negative lobes to ring around highlights, and the mean of every row kept). Throws
+// OptionsError for sizes that do not match.
 std::vector<float> squeeze_columns(std::span<const float> samples, int width, int height, int channels, int new_width);
 // The same narrowed by taking each new column's value from the old pixel under its centre: for what
 // must not be averaged (a depth).
