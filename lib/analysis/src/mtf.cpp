@@ -69,8 +69,10 @@ Complex otf_at(const std::vector<Complex>& otf, int m, double s, bool along_y) {
 }
 
 // The pupil function of a wavefront map, and the same pupil without aberration, in the corner of m x m
-// arrays (rows from py = -1).
-void fill_pupil(const WavefrontMap& map, int m, std::vector<Complex>& pupil, std::vector<Complex>& perfect) {
+// arrays (rows from py = -1). `defocus_waves` (waves of the map's wavelength per unit 1 - cos a) and
+// `sine_per_rho` (sin a at the rim) add a spherical wave's defocus, n' dz (1 - cos a) (through focus).
+void fill_pupil(const WavefrontMap& map, int m, std::vector<Complex>& pupil, std::vector<Complex>& perfect, double defocus_waves = 0.0,
+                double sine_per_rho = 0.0) {
   const int n = map.grid;
   pupil.assign(static_cast<std::size_t>(m) * static_cast<std::size_t>(m), 0.0);
   perfect.assign(pupil.size(), 0.0);
@@ -79,7 +81,12 @@ void fill_pupil(const WavefrontMap& map, int m, std::vector<Complex>& pupil, std
       const OpdSample& o = map.map[static_cast<std::size_t>(row) * static_cast<std::size_t>(n) + static_cast<std::size_t>(col)];
       if (o.status != RayStatus::Ok || !std::isfinite(o.opd_waves)) continue;
       const std::size_t at = static_cast<std::size_t>(row) * static_cast<std::size_t>(m) + static_cast<std::size_t>(col);
-      pupil[at] = std::polar(1.0, 2.0 * kPi * o.opd_waves);
+      double w = o.opd_waves;
+      if (defocus_waves != 0.0) {
+        const double sin_a = std::min(1.0, std::hypot(o.px, o.py) * sine_per_rho);
+        w += defocus_waves * (1.0 - std::sqrt(1.0 - sin_a * sin_a));
+      }
+      pupil[at] = std::polar(1.0, 2.0 * kPi * w);
       perfect[at] = 1.0;
     }
   }
@@ -154,15 +161,12 @@ Mtf compute_mtf(const AnalysisContext& context, const MtfOptions& options) {
       fill_pupil(map, m, pupil, perfect);
       const Transfer real = transfer(std::move(pupil), m, fft), ideal = transfer(std::move(perfect), m, fft);
       curve.strehl += real.psf_peak / ideal.psf_peak / static_cast<double>(waves);
-      // The geometric MTF: the spot's landing points (the same grid's rays), Fourier transformed directly.
+      // The geometric MTF: the landing points of the wavefront's own rays, Fourier transformed directly.
       std::vector<double> xs, ys;
-      const FieldPoint field = context.field_at(map.relative_field);
       for (const OpdSample& o : map.map) {
         if (o.status != RayStatus::Ok || !std::isfinite(o.opd_waves)) continue;
-        const TracedRay r = context.trace(field, {o.px, o.py}, map.wavelength_nm);
-        if (!r.ok()) continue;
-        xs.push_back(r.image_ray.position_mm.x() - map.reference.x_mm);
-        ys.push_back(r.image_ray.position_mm.y() - map.reference.y_mm);
+        xs.push_back(o.x_mm - map.reference.x_mm);
+        ys.push_back(o.y_mm - map.reference.y_mm);
       }
       for (std::size_t i = 0; i < nf && !xs.empty(); ++i) {
         Complex gt = 0.0, gs = 0.0;
@@ -220,17 +224,12 @@ ThroughFocusMtf compute_through_focus_mtf(const AnalysisContext& context, double
     for (double dz : focus_shifts_mm) {
       Complex t = 0.0, s = 0.0, limit = 0.0;
       for (std::size_t k = 0; k < waves; ++k) {
-        WavefrontMap map = wavefront.maps[f + k];
+        const WavefrontMap& map = wavefront.maps[f + k];
         const double wave_mm = medium_wavelength_mm(context, map.wavelength_nm);
         const double radius = std::abs(map.reference_radius_mm);
         // n' dz (1 - cos a) in waves of the vacuum wavelength = dz (1 - cos a) / lambda'.
-        for (OpdSample& o : map.map) {
-          if (!std::isfinite(o.opd_waves)) continue;
-          const double sin_a = std::min(1.0, std::hypot(o.px, o.py) * exit_pupil_radius_mm / radius);
-          o.opd_waves += dz * (1.0 - std::sqrt(1.0 - sin_a * sin_a)) / wave_mm;
-        }
         std::vector<Complex> pupil, perfect;
-        fill_pupil(map, m, pupil, perfect);
+        fill_pupil(map, m, pupil, perfect, dz / wave_mm, exit_pupil_radius_mm / radius);
         const Transfer real = transfer(std::move(pupil), m, fft), ideal = transfer(std::move(perfect), m, fft);
         const double shift = frequency_per_mm / (step_mm / (wave_mm * radius));
         t += otf_at(real.otf, m, shift, true) / static_cast<double>(waves);

@@ -112,6 +112,8 @@ Wavefront compute_wavefront(const AnalysisContext& context, const WavefrontOptio
         const TracedRay r = context.trace(field, {px, py}, wavelength);
         s.status = r.status;
         if (r.ok()) {
+          s.x_mm = r.image_ray.position_mm.x();
+          s.y_mm = r.image_ray.position_mm.y();
           s.opd_waves = sphere.opd_waves(r);
           if (!std::isfinite(s.opd_waves)) s.status = RayStatus::Missed;
         }

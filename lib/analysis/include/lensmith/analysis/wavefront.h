@@ -33,6 +33,7 @@ struct OpdSample {
   double px = 0.0, py = 0.0;  // normalised pupil coordinates
   double opd_waves = 0.0;
   RayStatus status = RayStatus::Ok;
+  double x_mm = 0.0, y_mm = 0.0;  // where the ray meets the image plane, global frame (the geometric MTF's spot)
 };
 
 struct WavefrontMap {
