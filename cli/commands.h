@@ -119,6 +119,18 @@ struct LayoutCommandOptions {
 };
 int run_layout(const LayoutCommandOptions& options, const GlobalOptions& global);
 
+struct OptimizeCommandOptions {
+  std::string lens;
+  std::string merit;              // --merit: the merit file (docs/optimize.md)
+  std::string output;             // -o: the optimised lens, lensmith JSON
+  std::string png;                // --png: the layouts before and after
+  int iterations = 50;            // --iterations: per stage (1-10000)
+  bool keep_model_glass = false;  // --keep-model-glass: no substitution of catalogue glasses
+  int threads = 0;                // --threads
+  bool json = false;
+};
+int run_optimize(const OptimizeCommandOptions& options, const GlobalOptions& global);
+
 struct FanCommandOptions {
   RealRayCommandOptions common;
   int samples = 41;  // --samples: pupil points per fan, odd

@@ -320,6 +320,20 @@ int main(int argc, char** argv) {
   layout_cmd->add_option("--aim", layout.common.aim, "Ray aiming: real (the default where the lens allows it: rays fill the real stop) or paraxial (the default for mirror systems and those with tilts or toroids)")->check(aim_words);
   layout_cmd->add_option("--png", layout.common.png, "Write the drawing to this PNG file (written atomically; never the input)");
 
+  OptimizeCommandOptions optimize;
+  CLI::App* optimize_cmd = app.add_subcommand("optimize", "Optimise a lens by damped least squares on a merit file's variables and operands (docs/optimize.md)");
+  optimize_cmd->add_option("lens", optimize.lens, lens_help)->required();
+  optimize_cmd->add_option("--merit", optimize.merit, "Merit file: variables, operands with targets or limits and weights (docs/optimize.md)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  optimize_cmd->add_option("-o,--output", optimize.output, "The optimised lens, a lensmith JSON lens file (written atomically; never an input)")->required();
+  optimize_cmd->add_option("--png", optimize.png, "Write the layouts before and after to this PNG file");
+  optimize_cmd->add_option("--iterations", optimize.iterations, "Most Levenberg-Marquardt iterations per stage (default 50; 1-10000)")->check(range(1, 10000));
+  optimize_cmd->add_flag("--keep-model-glass", optimize.keep_model_glass,
+                         "Keep the model glasses the glass variables chose (default: each replaced by the nearest catalogue glass, the rest re-optimised)");
+  optimize_cmd->add_option("--threads", optimize.threads, "Threads for the derivatives (default 0 = all cores, or the CPUs a Slurm task was given)")->check(range(0, 4096));
+  optimize_cmd->add_flag("--json", optimize.json, "Print one JSON object (schema: docs/cli.md)");
+
   FanCommandOptions fan;
   CLI::App* fan_cmd = app.add_subcommand("fan", "Transverse ray fans (ey against py, ex against px) per field and wavelength");
   add_real_ray_options(fan_cmd, fan.common);
@@ -668,6 +682,7 @@ int main(int argc, char** argv) {
     if (*mtf_cmd) return run_mtf(mtf, global);
     if (*psf_cmd) return run_psf(psf, global);
     if (*layout_cmd) return run_layout(layout, global);
+    if (*optimize_cmd) return run_optimize(optimize, global);
     if (*analyze_cmd) return run_analyze(analyze, global);
     if (*bokeh_cmd) {
       // Options of one method given to the other are an error, not silently ignored.

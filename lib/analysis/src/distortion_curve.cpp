@@ -19,7 +19,12 @@ namespace {
 constexpr double kAxialLimitField = 1e-4;
 }  // namespace
 
-void DistortionOptions::validate() const { analysis_detail::check_count("DistortionOptions::field_samples", field_samples, 2, 1001); }
+void DistortionOptions::validate() const {
+  analysis_detail::check_count("DistortionOptions::field_samples", field_samples, 2, 1001);
+  for (double f : relative_fields) {
+    if (!(f >= 0.0 && f <= 1.0)) throw OptionsError("DistortionOptions::relative_fields: " + std::to_string(f) + " is not in [0, 1]");
+  }
+}
 
 DistortionCurve compute_distortion(const AnalysisContext& context, const DistortionOptions& options) {
   options.validate();
@@ -39,7 +44,9 @@ DistortionCurve compute_distortion(const AnalysisContext& context, const Distort
 
   // Probe the field before tracing: a lens without a field fails here with a clear message.
   (void)context.field_at(1.0);
-  for (double relative : analysis_detail::relative_field_samples(options.field_samples)) {
+  const std::vector<double> fields =
+      options.relative_fields.empty() ? analysis_detail::relative_field_samples(options.field_samples) : options.relative_fields;
+  for (double relative : fields) {
     DistortionPoint p;
     p.relative_field = relative;
     p.field_value = context.field_value(relative);

@@ -15,6 +15,7 @@
 #include "lensmith/analysis/relative_illumination.h"
 #include "lensmith/analysis/spot_diagram.h"
 #include "lensmith/core/units.h"
+#include "lensmith/design/optimizer.h"
 #include "lensmith/paraxial/paraxial_spectral_table.h"
 #include "lensmith/paraxial/paraxial_system.h"
 #include "lensmith/polyfit/lens_fit.h"
@@ -433,6 +434,56 @@ ojson fit_json(const LensFit& fit) {
   j["poly_ns_per_ray"] = t.poly_ns_per_ray;
   j["speedup"] = t.exact_ns_per_ray / t.poly_ns_per_ray;
   return j;
+}
+
+ojson optimize_json(const OptimizeResult& result, const std::vector<OptimizeProgress>& history) {
+  ojson variables = ojson::array();
+  for (std::size_t j = 0; j < result.merit_function.variables.size(); ++j) {
+    const DesignVariable& v = result.merit_function.variables[j];
+    variables.push_back({{"name", v.name()},
+                         {"unit", v.unit()},
+                         {"surface", v.surface},
+                         {"start", number_or_null(result.start_values[j])},
+                         {"result", number_or_null(result.result_values[j])},
+                         {"min", v.min ? number_or_null(*v.min) : ojson(nullptr)},
+                         {"max", v.max ? number_or_null(*v.max) : ojson(nullptr)},
+                         {"at_bound", static_cast<bool>(result.at_bound[j])}});
+  }
+  ojson operands = ojson::array();
+  for (std::size_t i = 0; i < result.merit_function.operands.size(); ++i) {
+    const Operand& o = result.merit_function.operands[i];
+    ojson row = {{"operand", o.label()},
+                 {"unit", o.unit()},
+                 {"goal", o.goal()},
+                 {"target", o.target ? number_or_null(*o.target) : ojson(nullptr)},
+                 {"min", o.min ? number_or_null(*o.min) : ojson(nullptr)},
+                 {"max", o.max ? number_or_null(*o.max) : ojson(nullptr)},
+                 {"weight", o.weight},
+                 {"start", number_or_null(result.before.operands[i].value)},
+                 {"result", number_or_null(result.after.operands[i].value)},
+                 {"start_merit", number_or_null(result.before.operands[i].contribution)},
+                 {"result_merit", number_or_null(result.after.operands[i].contribution)}};
+    if (!result.after.operands[i].failure.empty()) row["failure"] = result.after.operands[i].failure;
+    operands.push_back(row);
+  }
+  ojson substitutions = ojson::array();
+  for (const SubstitutedGlass& s : result.substitutions) {
+    substitutions.push_back({{"surface", s.surface}, {"model_nd", s.model_nd}, {"model_vd", s.model_vd}, {"glass", s.glass}, {"nd", s.nd}, {"vd", s.vd}});
+  }
+  ojson steps = ojson::array();
+  for (const OptimizeProgress& p : history) {
+    steps.push_back({{"stage", p.stage}, {"iteration", p.iteration}, {"merit", number_or_null(p.merit)}, {"step_accepted", p.step_accepted}});
+  }
+  return {{"lens", result.start.name},
+          {"merit_start", number_or_null(result.before.merit)},
+          {"merit_result", number_or_null(result.after.merit)},
+          {"iterations", result.iterations},
+          {"evaluations", result.evaluations},
+          {"termination", result.termination},
+          {"variables", variables},
+          {"operands", operands},
+          {"substitutions", substitutions},
+          {"history", steps}};
 }
 
 }  // namespace lensmith

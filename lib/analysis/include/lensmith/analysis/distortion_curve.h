@@ -15,6 +15,8 @@ namespace lensmith {
 
 struct DistortionOptions {
   int field_samples = 21;  // evenly spaced relative fields from 0 to 1, 2 to 1001
+  // These relative fields (each in [0, 1]) instead of the even samples, when not empty.
+  std::vector<double> relative_fields;
   void validate() const;   // throws OptionsError
 };
 

@@ -7,6 +7,8 @@
 // number (a distance at infinity, a ray that died) is written as null.
 #pragma once
 
+#include <vector>
+
 #include <nlohmann/json.hpp>
 
 namespace lensmith {
@@ -27,6 +29,8 @@ struct ChromaticFocalShift;
 struct RelativeIllumination;
 struct PupilShape;
 class LensFit;
+struct OptimizeResult;
+struct OptimizeProgress;
 
 using ojson = nlohmann::ordered_json;
 
@@ -61,5 +65,9 @@ ojson illumination_json(const RelativeIllumination& illumination);
 ojson pupil_json(const PupilShape& shape);
 // `lensmith fit --json` without the output file name: the fit, its held-out errors and its timing.
 ojson fit_json(const LensFit& fit);
+// `lensmith optimize --json`: the variables and operands before and after (each operand's value in its own
+// unit, its goal and weight, its part of the merit), the merit, the iterations, glass substitutions, and the
+// merit after each iteration (`history`).
+ojson optimize_json(const OptimizeResult& result, const std::vector<OptimizeProgress>& history);
 
 }  // namespace lensmith

@@ -1,0 +1,449 @@
+// Damped least squares with Ceres (Levenberg-Marquardt trust region), central-difference derivatives of
+// the merit function's residuals, bounds by Ceres' projection, glass substitution and a polishing stage.
+#include "lensmith/design/optimizer.h"
+
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+
+#include <ceres/ceres.h>
+#include <omp.h>
+
+#include "lensmith/core/errors.h"
+#include "lensmith/core/number_parsing.h"
+#include "lensmith/glass/glass_catalog.h"
+#include "lensmith/paraxial/paraxial_system.h"
+
+namespace lensmith {
+
+namespace {
+
+// Finite-difference steps (central differences). Each is about 1e-6 of what a designer would call a
+// small change: small enough that the truncation error (step^2) vanishes, large enough above the tracer's
+// rounding (about 1e-13 mm on landing points) that the quotient keeps seven or more digits.
+constexpr double kRelativeStep = 1e-6;
+constexpr double kAbbeStep = 1e-4;
+// Variables are handed to Ceres divided by a scale 1e5 times their step, so that a step of the solver of
+// about 1 is a designer's small change and the step norms Ceres reports are comparable across variables.
+constexpr double kScalePerStep = 1e5;
+
+// The lens's characteristic length, mm: |EFL| when it has one, else its length (an afocal lens).
+double characteristic_length_mm(const Prescription& lens) {
+  try {
+    const double efl = std::abs(ParaxialSystem(lens).efl_mm());
+    if (std::isfinite(efl) && efl > 0.0) return efl;
+  } catch (const Error&) {
+  }
+  return std::max(1.0, std::abs(lens.last_vertex_z_mm()));
+}
+
+double step_of(const DesignVariable& v, double length_mm) {
+  using K = DesignVariable::Kind;
+  switch (v.kind) {
+    case K::Curvature: return kRelativeStep / length_mm;
+    case K::Thickness: return kRelativeStep * length_mm;
+    case K::Conic: return kRelativeStep;
+    case K::Asphere: return kRelativeStep / std::pow(length_mm, v.asphere_power - 1);
+    case K::GlassIndex: return kRelativeStep;
+    case K::GlassAbbe: return kAbbeStep;
+  }
+  return kRelativeStep;
+}
+
+bool is_glass(const DesignVariable& v) {
+  return v.kind == DesignVariable::Kind::GlassIndex || v.kind == DesignVariable::Kind::GlassAbbe;
+}
+
+// The merit function as Ceres sees it: one parameter block (the scaled variables), the residuals of
+// evaluate_merit, and a Jacobian by central differences computed in parallel.
+class MeritCost final : public ceres::CostFunction {
+ public:
+  MeritCost(const Prescription& lens, const MeritFunction& merit, std::vector<double> scales, int residuals, int threads,
+            std::atomic<std::size_t>& evaluations)
+      : lens_(lens), merit_(merit), scales_(std::move(scales)), threads_(threads), evaluations_(evaluations) {
+    set_num_residuals(residuals);
+    mutable_parameter_block_sizes()->push_back(static_cast<int>(scales_.size()));
+  }
+
+  Prescription lens_at(const double* x) const {
+    Prescription lens = lens_;
+    for (std::size_t j = 0; j < scales_.size(); ++j) merit_.variables[j].apply(lens, x[j] * scales_[j]);
+    if (merit_.efl_solve) merit_.efl_solve->apply(lens);
+    return lens;
+  }
+
+  bool evaluate_at(const double* x, std::vector<double>& residuals) const {
+    ++evaluations_;
+    Prescription lens;
+    try {
+      lens = lens_at(x);
+    } catch (const Error&) {
+      return false;  // the solve has no answer here
+    }
+    const MeritEvaluation e = evaluate_merit(lens, merit_);
+    if (!e.ok() || static_cast<int>(e.residuals.size()) != num_residuals()) return false;
+    for (double r : e.residuals) {
+      if (!std::isfinite(r)) return false;
+    }
+    residuals = e.residuals;
+    return true;
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const double* x = parameters[0];
+    const int n = static_cast<int>(scales_.size());
+    const int m = num_residuals();
+    std::vector<double> centre;
+    if (!evaluate_at(x, centre)) return false;
+    std::copy(centre.begin(), centre.end(), residuals);
+    if (jacobians == nullptr || jacobians[0] == nullptr) return true;
+    // Columns j: residuals at x +- h e_j (h in scaled units: the variable's step). Where one side leaves the
+    // region where the merit can be computed, the other side and the centre make a one-sided difference.
+    const double h = 1.0 / kScalePerStep;
+    std::vector<std::vector<double>> plus(static_cast<std::size_t>(n)), minus(static_cast<std::size_t>(n));
+    std::vector<char> plus_ok(static_cast<std::size_t>(n)), minus_ok(static_cast<std::size_t>(n));
+#pragma omp parallel for schedule(dynamic) num_threads(threads_)
+    for (int k = 0; k < 2 * n; ++k) {
+      const int j = k / 2;
+      std::vector<double> shifted(x, x + n);
+      shifted[static_cast<std::size_t>(j)] += (k % 2 == 0 ? h : -h);
+      auto& out = k % 2 == 0 ? plus[static_cast<std::size_t>(j)] : minus[static_cast<std::size_t>(j)];
+      auto& ok = k % 2 == 0 ? plus_ok[static_cast<std::size_t>(j)] : minus_ok[static_cast<std::size_t>(j)];
+      ok = evaluate_at(shifted.data(), out) ? 1 : 0;
+    }
+    double* J = jacobians[0];
+    for (int j = 0; j < n; ++j) {
+      const auto u = static_cast<std::size_t>(j);
+      for (int i = 0; i < m; ++i) {
+        const auto r = static_cast<std::size_t>(i);
+        double d = 0.0;
+        if (plus_ok[u] && minus_ok[u]) {
+          d = (plus[u][r] - minus[u][r]) / (2.0 * h);
+        } else if (plus_ok[u]) {
+          d = (plus[u][r] - centre[r]) / h;
+        } else if (minus_ok[u]) {
+          d = (centre[r] - minus[u][r]) / h;
+        } else {
+          return false;
+        }
+        J[i * n + j] = d;
+      }
+    }
+    return true;
+  }
+
+ private:
+  const Prescription& lens_;
+  const MeritFunction& merit_;
+  std::vector<double> scales_;
+  int threads_;
+  std::atomic<std::size_t>& evaluations_;
+};
+
+class ProgressCallback final : public ceres::IterationCallback {
+ public:
+  // `merit_per_cost`: 2 for the least-squares solver (its cost is half the sum of squares), 1 for the line search.
+  ProgressCallback(const OptimizeOptions& options, std::string stage, double merit_per_cost)
+      : options_(options), stage_(std::move(stage)), merit_per_cost_(merit_per_cost) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    if (options_.progress) {
+      OptimizeProgress p;
+      p.iteration = summary.iteration;
+      p.merit = merit_per_cost_ * summary.cost;
+      p.step_norm = summary.step_norm;
+      p.step_accepted = summary.step_is_successful;
+      p.stage = stage_;
+      options_.progress(p);
+    }
+    return ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  const OptimizeOptions& options_;
+  std::string stage_;
+  double merit_per_cost_;
+};
+
+// The merit itself (the sum of squares) and its gradient 2 J^T r over the variables not held at a bound, for
+// Ceres' line-search minimiser. Damped least squares (Gauss-Newton's J^T J) knows nothing of the residuals'
+// own curvature, which is all there is where the optimum leaves residuals that cannot vanish: a singlet's
+// spherical aberration is smallest at the best form, where dS_I/dX = 0 and J^T J is singular along the
+// bending, so Levenberg-Marquardt crawls there. BFGS builds that curvature from successive gradients.
+class MeritGradient final : public ceres::FirstOrderFunction {
+ public:
+  MeritGradient(const MeritCost& cost, std::vector<double> x, std::vector<int> free, std::vector<double> lower, std::vector<double> upper)
+      : cost_(cost), x_(std::move(x)), free_(std::move(free)), lower_(std::move(lower)), upper_(std::move(upper)) {}
+
+  int NumParameters() const override { return static_cast<int>(free_.size()); }
+
+  // The full scaled vector with the free variables from `parameters`.
+  std::vector<double> full(const double* parameters) const {
+    std::vector<double> x = x_;
+    for (std::size_t k = 0; k < free_.size(); ++k) x[static_cast<std::size_t>(free_[k])] = parameters[k];
+    return x;
+  }
+
+  bool Evaluate(const double* parameters, double* merit, double* gradient) const override {
+    const std::vector<double> x = full(parameters);
+    // Outside a bound the evaluation fails: the line search then shortens its step.
+    for (std::size_t j = 0; j < x.size(); ++j) {
+      if (x[j] < lower_[j] || x[j] > upper_[j]) return false;
+    }
+    const auto m = static_cast<std::size_t>(cost_.num_residuals());
+    const std::size_t n = x.size();
+    std::vector<double> r(m), J(gradient != nullptr ? m * n : 0);
+    const double* blocks[] = {x.data()};
+    double* jacobians[] = {J.data()};
+    if (!cost_.Evaluate(blocks, r.data(), gradient != nullptr ? jacobians : nullptr)) return false;
+    double sum = 0.0;
+    for (double v : r) sum += v * v;
+    *merit = sum;
+    if (gradient != nullptr) {
+      for (std::size_t k = 0; k < free_.size(); ++k) {
+        double g = 0.0;
+        for (std::size_t i = 0; i < m; ++i) g += 2.0 * r[i] * J[i * n + static_cast<std::size_t>(free_[k])];
+        gradient[k] = g;
+      }
+    }
+    return true;
+  }
+
+ private:
+  const MeritCost& cost_;
+  std::vector<double> x_;
+  std::vector<int> free_;
+  std::vector<double> lower_, upper_;
+};
+
+struct StageResult {
+  Prescription lens;
+  int iterations = 0;
+  std::string termination;
+};
+
+// One Levenberg-Marquardt run over `merit`'s variables from `lens`.
+StageResult run_stage(const Prescription& lens, const MeritFunction& merit, const OptimizeOptions& options, const std::string& stage,
+                      std::atomic<std::size_t>& evaluations) {
+  const double length = characteristic_length_mm(lens);
+  const std::size_t n = merit.variables.size();
+  std::vector<double> scales(n), x(n);
+  for (std::size_t j = 0; j < n; ++j) {
+    scales[j] = step_of(merit.variables[j], length) * kScalePerStep;
+    x[j] = merit.variables[j].value(lens) / scales[j];
+  }
+  const MeritEvaluation start = evaluate_merit(lens, merit);
+  ++evaluations;
+  if (!start.ok()) {
+    for (std::size_t i = 0; i < start.operands.size(); ++i) {
+      if (!start.operands[i].failure.empty()) {
+        throw ComputationError("the merit function cannot be evaluated on the " + std::string(stage == "optimise" ? "starting" : "substituted") +
+                               " lens: operands[" + std::to_string(i) + "] (" + merit.operands[i].label() + "): " + start.operands[i].failure);
+      }
+    }
+  }
+  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  auto* cost = new MeritCost(lens, merit, scales, static_cast<int>(start.residuals.size()), threads, evaluations);
+  ceres::Problem problem;
+  problem.AddResidualBlock(cost, nullptr, x.data());
+  for (std::size_t j = 0; j < n; ++j) {
+    const DesignVariable& v = merit.variables[j];
+    if (v.min) problem.SetParameterLowerBound(x.data(), static_cast<int>(j), *v.min / scales[j]);
+    if (v.max) problem.SetParameterUpperBound(x.data(), static_cast<int>(j), *v.max / scales[j]);
+  }
+  ceres::Solver::Options so;
+  so.minimizer_type = ceres::TRUST_REGION;
+  so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = options.max_iterations;
+  so.function_tolerance = options.merit_tolerance;
+  so.gradient_tolerance = 1e-14;
+  so.parameter_tolerance = 1e-12;
+  so.num_threads = 1;
+  so.logging_type = ceres::SILENT;
+  ProgressCallback callback(options, stage, 2.0);
+  so.callbacks.push_back(&callback);
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+  StageResult out{cost->lens_at(x.data()), static_cast<int>(summary.iterations.size()) - 1, summary.message};
+
+  // Then BFGS on the merit over the variables Levenberg-Marquardt left off their bounds (MeritGradient says why).
+  std::vector<double> lower(n, -std::numeric_limits<double>::infinity()), upper(n, std::numeric_limits<double>::infinity());
+  std::vector<int> free;
+  for (std::size_t j = 0; j < n; ++j) {
+    const DesignVariable& v = merit.variables[j];
+    if (v.min) lower[j] = *v.min / scales[j];
+    if (v.max) upper[j] = *v.max / scales[j];
+    const double margin = 1e-9 * std::max(1.0, std::abs(x[j]));
+    if (x[j] - lower[j] > margin && upper[j] - x[j] > margin) free.push_back(static_cast<int>(j));
+  }
+  if (!free.empty()) {
+    auto* gradient = new MeritGradient(*cost, x, free, lower, upper);
+    std::vector<double> p;
+    for (int j : free) p.push_back(x[static_cast<std::size_t>(j)]);
+    ceres::GradientProblem polish_problem(gradient);
+    ceres::GradientProblemSolver::Options go;
+    go.line_search_direction_type = ceres::BFGS;
+    go.max_num_iterations = options.max_iterations;
+    go.function_tolerance = options.merit_tolerance;
+    go.gradient_tolerance = 1e-14;
+    go.parameter_tolerance = 1e-12;
+    go.logging_type = ceres::SILENT;
+    ProgressCallback polish_callback(options, stage + ", BFGS", 1.0);
+    go.callbacks.push_back(&polish_callback);
+    ceres::GradientProblemSolver::Summary polish;
+    ceres::Solve(go, polish_problem, p.data(), &polish);
+    const std::vector<double> polished = gradient->full(p.data());
+    out.lens = cost->lens_at(polished.data());
+    out.iterations += static_cast<int>(polish.iterations.size()) - 1;
+    out.termination += " Then BFGS: " + polish.message;
+  }
+  return out;
+}
+
+std::string fixed_text(double v, int significant) { return std::isfinite(v) ? format_rounded(v, significant) : "-"; }
+
+}  // namespace
+
+void OptimizeOptions::validate() const {
+  if (max_iterations < 1 || max_iterations > 10000) throw OptionsError("OptimizeOptions::max_iterations = " + std::to_string(max_iterations) + ": must be 1 to 10000");
+  if (!(merit_tolerance > 0.0 && merit_tolerance < 1.0)) throw OptionsError("OptimizeOptions::merit_tolerance must be in (0, 1)");
+  if (threads < 0) throw OptionsError("OptimizeOptions::threads must be >= 0");
+}
+
+const Glass& nearest_catalogue_glass(double nd, double vd) {
+  struct Candidate {
+    double nd, vd;
+    const Glass* glass;
+  };
+  static const std::vector<Candidate> candidates = [] {
+    std::vector<Candidate> list;
+    for (const Glass& g : GlassCatalog::builtin().glasses()) {
+      if (g.status() == Glass::Status::Obsolete || g.status() == Glass::Status::Special) continue;
+      const double gvd = g.vd();
+      if (!std::isfinite(gvd) || g.is_air()) continue;
+      list.push_back({g.nd(), gvd, &g});
+    }
+    return list;
+  }();
+  // One glass-map distance: 0.01 in nd counts as 1 in Vd (OptimizeOptions::substitute_glass).
+  const Candidate* best = nullptr;
+  double best_distance = std::numeric_limits<double>::infinity();
+  for (const Candidate& c : candidates) {
+    const double d = std::hypot((c.nd - nd) / 0.01, c.vd - vd);
+    if (d < best_distance) {
+      best_distance = d;
+      best = &c;
+    }
+  }
+  if (best == nullptr) throw ComputationError("no catalogue glass to substitute");
+  return *best->glass;
+}
+
+OptimizeResult optimize(const Prescription& lens, const MeritFunction& merit, const OptimizeOptions& options) {
+  options.validate();
+  merit.validate(lens);
+  lens.validate();
+  OptimizeResult result;
+  result.start = lens;
+  result.merit_function = merit;
+  for (const DesignVariable& v : merit.variables) result.start_values.push_back(v.value(lens));
+  std::atomic<std::size_t> evaluations{0};
+  result.before = evaluate_merit(lens, merit);
+  Prescription solved = lens;
+  if (merit.efl_solve) merit.efl_solve->apply(solved);
+  StageResult stage = run_stage(solved, merit, options, "optimise", evaluations);
+  result.iterations = stage.iterations;
+  result.termination = stage.termination;
+  Prescription current = stage.lens;
+
+  bool has_glass = false;
+  for (const DesignVariable& v : merit.variables) has_glass = has_glass || is_glass(v);
+  if (options.substitute_glass && has_glass) {
+    std::vector<int> done;
+    for (const DesignVariable& v : merit.variables) {
+      if (!is_glass(v) || std::find(done.begin(), done.end(), v.surface) != done.end()) continue;
+      done.push_back(v.surface);
+      Surface& s = current.surfaces.at(static_cast<std::size_t>(v.surface - 1));
+      SubstitutedGlass sub;
+      sub.surface = v.surface;
+      sub.model_nd = s.medium.nd();
+      sub.model_vd = s.medium.vd();
+      const Glass& glass = nearest_catalogue_glass(sub.model_nd, sub.model_vd);
+      s.material = MaterialSpec::catalog(glass.name(), glass.vendor());
+      s.medium = glass;
+      sub.glass = glass.vendor() + " " + glass.name();
+      sub.nd = glass.nd();
+      sub.vd = glass.vd();
+      result.substitutions.push_back(sub);
+    }
+    MeritFunction rest = merit;
+    rest.variables.clear();
+    for (const DesignVariable& v : merit.variables) {
+      if (!is_glass(v)) rest.variables.push_back(v);
+    }
+    if (!rest.variables.empty()) {
+      StageResult polish = run_stage(current, rest, options, "polish after glass substitution", evaluations);
+      current = polish.lens;
+      result.iterations += polish.iterations;
+      result.termination += "; after glass substitution: " + polish.termination;
+    }
+  }
+  result.result = current;
+  result.after = evaluate_merit(current, merit);
+  for (const DesignVariable& v : merit.variables) {
+    const double value = v.value(current);
+    result.result_values.push_back(value);
+    const double tolerance = 1e-9 * std::max(1.0, std::abs(value));
+    result.at_bound.push_back((v.min && std::abs(value - *v.min) <= tolerance) || (v.max && std::abs(value - *v.max) <= tolerance));
+  }
+  result.evaluations = evaluations + 1;
+  return result;
+}
+
+std::string OptimizeResult::to_string() const {
+  std::ostringstream os;
+  char line[256];
+  os << "Optimised: " << start.name << "\n\n";
+  std::snprintf(line, sizeof line, "%-46s %16s %16s\n", "variable", "start", "result");
+  os << line;
+  for (std::size_t j = 0; j < merit_function.variables.size(); ++j) {
+    const DesignVariable& v = merit_function.variables[j];
+    const std::string name = v.name() + (v.unit().empty() ? "" : " (" + v.unit() + ")");
+    std::snprintf(line, sizeof line, "%-46s %16s %16s%s\n", name.c_str(), fixed_text(start_values[j], 8).c_str(),
+                  fixed_text(result_values[j], 8).c_str(), at_bound[j] ? "  at its bound" : "");
+    os << line;
+  }
+  if (merit_function.efl_solve) {
+    const int k = merit_function.efl_solve->surface;
+    const std::string name = "curvature of surface " + std::to_string(k) + " (1/mm)";
+    std::snprintf(line, sizeof line, "%-46s %16s %16s  solved for EFL %s mm\n", name.c_str(),
+                  fixed_text(start.surfaces.at(static_cast<std::size_t>(k - 1)).curvature_per_mm, 8).c_str(),
+                  fixed_text(result.surfaces.at(static_cast<std::size_t>(k - 1)).curvature_per_mm, 8).c_str(),
+                  format_number(merit_function.efl_solve->efl_mm).c_str());
+    os << line;
+  }
+  os << "\n";
+  std::snprintf(line, sizeof line, "%-44s %12s %8s %13s %13s %12s %12s\n", "operand", "goal", "weight", "start", "result", "start merit",
+                "result merit");
+  os << line;
+  for (std::size_t i = 0; i < merit_function.operands.size(); ++i) {
+    const Operand& o = merit_function.operands[i];
+    const std::string name = o.label() + (o.unit().empty() ? "" : " (" + o.unit() + ")");
+    std::snprintf(line, sizeof line, "%-44s %12s %8s %13s %13s %12s %12s\n", name.c_str(), o.goal().c_str(), format_rounded(o.weight, 4).c_str(),
+                  fixed_text(before.operands[i].value, 7).c_str(), fixed_text(after.operands[i].value, 7).c_str(),
+                  fixed_text(before.operands[i].contribution, 4).c_str(), fixed_text(after.operands[i].contribution, 4).c_str());
+    os << line;
+  }
+  os << "\nmerit " << fixed_text(before.merit, 6) << " -> " << fixed_text(after.merit, 6) << " in " << iterations << " iterations, " << evaluations
+     << " evaluations (" << termination << ")\n";
+  for (const SubstitutedGlass& s : substitutions) {
+    std::snprintf(line, sizeof line, "glass after surface %d: model nd %.4f Vd %.2f -> %s (nd %.5f, Vd %.2f)\n", s.surface, s.model_nd, s.model_vd,
+                  s.glass.c_str(), s.nd, s.vd);
+    os << line;
+  }
+  return os.str();
+}
+
+}  // namespace lensmith
