@@ -154,6 +154,7 @@ struct MtfCommandOptions {
   std::optional<double> through_focus_per_mm;  // --through-focus F: the MTF at F cycles/mm against focus
   double focus_range_mm = 0.1;                // --focus-range: shifts from -R to +R
   int focus_steps = 21;                       // --focus-steps
+  bool fresnel = false;                       // --fresnel: the pupil amplitude from uncoated Fresnel transmittance
 };
 int run_mtf(const MtfCommandOptions& options, const GlobalOptions& global);
 
@@ -162,6 +163,7 @@ struct PsfCommandOptions {
   int pupil_samples = 64;  // --pupil-samples
   int size = 128;          // --size: samples across the picture
   bool grid_in_json = false;  // --json-grid
+  bool fresnel = false;       // --fresnel
 };
 int run_psf(const PsfCommandOptions& options, const GlobalOptions& global);
 

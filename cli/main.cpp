@@ -282,6 +282,7 @@ int main(int argc, char** argv) {
   mtf_cmd->add_option("--focus-range", mtf.focus_range_mm, "With --through-focus: shifts from -MM to +MM (default 0.1; > 0)")
       ->check(positive())
       ->needs(through_focus);
+  mtf_cmd->add_flag("--fresnel", mtf.fresnel, "Apodise the pupil by each ray's uncoated Fresnel transmittance (default: amplitude 1 where rays pass)");
   mtf_cmd->add_option("--focus-steps", mtf.focus_steps, "With --through-focus: shifts (default 21; 2-1001)")->check(range(2, 1001))->needs(through_focus);
 
   PsfCommandOptions psf;
@@ -291,6 +292,7 @@ int main(int argc, char** argv) {
   psf_cmd->add_option("--size", psf.size, "PSF samples across (default 128; 8 to 4 x --pupil-samples, rounded up to a power of two)")
       ->check(range(8, 2048));
   psf_cmd->add_flag("--json-grid", psf.grid_in_json, "With --json: the intensity grid too");
+  psf_cmd->add_flag("--fresnel", psf.fresnel, "Apodise the pupil by each ray's uncoated Fresnel transmittance (default: amplitude 1 where rays pass)");
 
   SeidelCommandOptions seidel;
   CLI::App* seidel_cmd = app.add_subcommand("seidel", "Third-order (Seidel) aberrations per surface and summed, and Born & Wolf's B..F");

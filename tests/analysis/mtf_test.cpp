@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "lensmith/analysis/mtf.h"
+#include "lensmith/analysis/wavefront.h"
 #include "lensmith/core/units.h"
 #include "lensmith/glass/glass_catalog.h"
 #include "reference_lenses.h"
@@ -183,4 +184,47 @@ TEST_CASE("The geometric MTF of a defocused perfect lens is that of a uniform bl
     CHECK_THAT(c.geometric_tangential[i], WithinAbs(disc, 0.01));
     CHECK_THAT(c.geometric_sagittal[i], WithinAbs(disc, 0.01));
   }
+}
+
+TEST_CASE("With Fresnel transmittance the pupil amplitude is what uncoated glass transmits at each ray's incidence", "[analysis][mtf]") {
+  // The Cartesian ellipsoid opened to a 100 mm beam: at the rim the surface's slope dz/dr = c r / sqrt(1 -
+  // (1 + k) c^2 r^2) = 1.5 gives 56.3 degrees of incidence (Brewster's angle for n = 1.5), so the amplitude
+  // falls from the centre's normal incidence to the rim. Each sample against the Fresnel equations (Born &
+  // Wolf sec. 1.5.3) at the angle the conic's own slope gives, not the tracer's normals.
+  using C = testing::CartesianEllipsoid;
+  Prescription lens = testing::cartesian_ellipsoid(0.0);
+  lens.surfaces[0].semi_diameter_mm = 52.0;
+  lens.aperture.value = 100.0;
+  const AnalysisContext context(lens, on_axis());
+  WavefrontOptions options;
+  options.grid = 41;
+  options.zernike_terms = 1;
+  options.transmittance = true;
+  const WavefrontMap m = compute_wavefront(context, options).maps.front();
+  const double c = 1.0 / C::kRadiusMm, k = lens.surfaces[0].conic, n = C::kIndex;
+  auto expected = [&](double r_mm) {
+    const double slope = c * r_mm / std::sqrt(1.0 - (1.0 + k) * c * c * r_mm * r_mm);
+    const double cos_i = 1.0 / std::sqrt(1.0 + slope * slope), sin_i = slope * cos_i;
+    const double cos_t = std::sqrt(1.0 - sin_i * sin_i / (n * n));
+    const double rs = (cos_i - n * cos_t) / (cos_i + n * cos_t), rp = (n * cos_i - cos_t) / (n * cos_i + cos_t);
+    return std::sqrt(1.0 - 0.5 * (rs * rs + rp * rp));
+  };
+  const auto at = [&](int row, int col) { return m.map[static_cast<std::size_t>(row * 41 + col)]; };
+  // (row, col) = (20, 20) is the centre, (20, 30) px = 0.5, (20, 40) px = 1; 50 mm pupil radius.
+  CHECK_THAT(at(20, 20).amplitude, WithinRel(std::sqrt(0.96), 1e-12));  // 1 - ((n - 1) / (n + 1))^2
+  CHECK_THAT(at(20, 30).amplitude, WithinRel(expected(25.0), 1e-9));
+  CHECK_THAT(at(20, 40).amplitude, WithinRel(expected(50.0), 1e-9));
+  CHECK(at(20, 40).amplitude < at(20, 20).amplitude - 0.01);  // 0.962 against 0.980
+  // Without it every passed ray has amplitude 1.
+  options.transmittance = false;
+  CHECK(compute_wavefront(context, options).maps.front().map[20 * 41 + 40].amplitude == 1.0);
+  // An apodised pupil (weaker at the rim) passes less contrast at high frequencies than the uniform one of the
+  // same shape: the diffraction-limited MTF at 0.7 of the cutoff falls.
+  MtfOptions mtf;
+  mtf.pupil_samples = 32;
+  mtf.frequency_samples = 11;
+  const Mtf uniform = compute_mtf(context, mtf);
+  mtf.transmittance = true;
+  const Mtf apodised = compute_mtf(context, mtf);
+  CHECK(apodised.fields[0].diffraction_limit[7] < uniform.fields[0].diffraction_limit[7]);
 }

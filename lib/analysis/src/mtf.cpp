@@ -86,8 +86,10 @@ void fill_pupil(const WavefrontMap& map, int m, std::vector<Complex>& pupil, std
         const double sin_a = std::min(1.0, std::hypot(o.px, o.py) * sine_per_rho);
         w += defocus_waves * (1.0 - std::sqrt(1.0 - sin_a * sin_a));
       }
-      pupil[at] = std::polar(1.0, 2.0 * kPi * w);
-      perfect[at] = 1.0;
+      // The amplitude (1, or the ray's Fresnel transmittance's root) apodises both: the aberration-free pupil
+      // is the same pupil without its phase.
+      pupil[at] = std::polar(o.amplitude, 2.0 * kPi * w);
+      perfect[at] = o.amplitude;
     }
   }
 }
@@ -104,9 +106,10 @@ double medium_wavelength_mm(const AnalysisContext& context, double nm) {
 }
 
 // The OPD maps a pupil function is made of (no Zernike fit, short fans).
-Wavefront pupil_wavefront(const AnalysisContext& context, int pupil_samples) {
+Wavefront pupil_wavefront(const AnalysisContext& context, int pupil_samples, bool transmittance) {
   WavefrontOptions w;
   w.grid = pupil_samples;
+  w.transmittance = transmittance;
   w.zernike_terms = 1;
   w.fan_samples = 3;
   return compute_wavefront(context, w);
@@ -125,7 +128,7 @@ void MtfOptions::validate() const {
 
 Mtf compute_mtf(const AnalysisContext& context, const MtfOptions& options) {
   options.validate();
-  const Wavefront wavefront = pupil_wavefront(context, options.pupil_samples);
+  const Wavefront wavefront = pupil_wavefront(context, options.pupil_samples, options.transmittance);
   const int n = options.pupil_samples;
   const int m = transform_size(n, options.padding);
   const double exit_pupil_radius_mm = 0.5 * context.paraxial().exit_pupil().diameter_mm;
@@ -206,7 +209,7 @@ ThroughFocusMtf compute_through_focus_mtf(const AnalysisContext& context, double
     throw OptionsError("through-focus MTF: the frequency must be > 0 cycles/mm, got " + std::to_string(frequency_per_mm));
   }
   if (focus_shifts_mm.empty()) throw OptionsError("through-focus MTF: no focus shifts given");
-  const Wavefront wavefront = pupil_wavefront(context, options.pupil_samples);
+  const Wavefront wavefront = pupil_wavefront(context, options.pupil_samples, options.transmittance);
   const int n = options.pupil_samples, m = transform_size(n, options.padding);
   const double exit_pupil_radius_mm = 0.5 * context.paraxial().exit_pupil().diameter_mm;
   const double step_mm = 2.0 * exit_pupil_radius_mm / (n - 1);
@@ -268,7 +271,7 @@ void PsfOptions::validate() const {
 
 Psf compute_psf(const AnalysisContext& context, const PsfOptions& options) {
   options.validate();
-  const Wavefront wavefront = pupil_wavefront(context, options.pupil_samples);
+  const Wavefront wavefront = pupil_wavefront(context, options.pupil_samples, options.transmittance);
   const int n = options.pupil_samples, m = transform_size(n, options.padding);
   const double step_mm = 2.0 * (0.5 * context.paraxial().exit_pupil().diameter_mm) / (n - 1);
   // The image-plane sampling of a wavelength's transform: lambda' R / (m dp).

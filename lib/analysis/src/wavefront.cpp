@@ -14,6 +14,7 @@
 #include "lensmith/core/errors.h"
 #include "lensmith/core/number_parsing.h"
 #include "lensmith/core/units.h"
+#include "lensmith/trace/fresnel.h"
 #include "lensmith/paraxial/paraxial_system.h"
 #include "analysis_detail.h"
 
@@ -109,13 +110,16 @@ Wavefront compute_wavefront(const AnalysisContext& context, const WavefrontOptio
 
       auto sample = [&](double px, double py) {
         OpdSample s{px, py, kNan, RayStatus::Ok};
-        const TracedRay r = context.trace(field, {px, py}, wavelength);
+        std::vector<SurfaceHit> path;
+        const TracedRay r = context.trace(field, {px, py}, wavelength, options.transmittance ? &path : nullptr);
         s.status = r.status;
         if (r.ok()) {
           s.x_mm = r.image_ray.position_mm.x();
           s.y_mm = r.image_ray.position_mm.y();
           s.opd_waves = sphere.opd_waves(r);
           if (!std::isfinite(s.opd_waves)) s.status = RayStatus::Missed;
+          // The amplitude is the square root of the intensity transmittance.
+          if (options.transmittance) s.amplitude = std::sqrt(path_transmittance(context.tracer(), r.object_ray.direction, path, wavelength));
         }
         return s;
       };

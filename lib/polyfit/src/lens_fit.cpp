@@ -18,6 +18,7 @@
 #include "lensmith/core/units.h"
 #include "lensmith/paraxial/paraxial_system.h"
 #include "lensmith/polyfit/polynomial_fit.h"
+#include "lensmith/trace/fresnel.h"
 #include "lensmith/trace/sequential_tracer.h"
 
 namespace lensmith {
@@ -52,14 +53,6 @@ struct Candidate {
   double transmittance = 0.0;
   std::vector<double> hit_x, hit_y;  // position on every surface (index surface - 1)
 };
-
-// Unpolarised Fresnel transmittance of one interface (Born & Wolf sec. 1.5.3): the mean of the s
-// and p intensity transmittances, from the indices and the cosines on both sides.
-double fresnel_transmittance(double n1, double cos1, double n2, double cos2) {
-  const double rs = (n1 * cos1 - n2 * cos2) / (n1 * cos1 + n2 * cos2);
-  const double rp = (n2 * cos1 - n1 * cos2) / (n2 * cos1 + n1 * cos2);
-  return 1.0 - 0.5 * (rs * rs + rp * rp);
-}
 
 struct Sampler {
   const SequentialTracer& tracer;
@@ -96,8 +89,8 @@ struct Sampler {
     c.hit_x.assign(surfaces, 0.0);
     c.hit_y.assign(surfaces, 0.0);
     c.in_domain = c.passes = true;
-    c.transmittance = 1.0;
-    Eigen::Vector3d incoming = ray.direction;
+    // Backward through each surface: from the medium after it into the medium before it.
+    c.transmittance = path_transmittance(tracer, ray.direction, path, c.wavelength_nm, /*backward=*/true);
     for (const SurfaceHit& h : path) {
       const std::size_t k = static_cast<std::size_t>(h.surface - 1);
       c.hit_x[k] = h.point_mm.x();
@@ -105,12 +98,6 @@ struct Sampler {
       const double r = std::hypot(h.point_mm.x(), h.point_mm.y());
       c.passes = c.passes && r <= semi_diameter[k];
       c.in_domain = c.in_domain && r <= options.aperture_margin * semi_diameter[k];
-      // Backward through surface k: from the medium after it into the medium before it.
-      c.transmittance *= fresnel_transmittance(tracer.index_after(h.surface, c.wavelength_nm),
-                                               std::abs(incoming.dot(h.normal)),
-                                               tracer.index_after(h.surface - 1, c.wavelength_nm),
-                                               std::abs(h.direction_after.dot(h.normal)));
-      incoming = h.direction_after;
     }
     // The object-space ray, as light travels it, where it meets surface 1.
     const Eigen::Vector3d f = -t.ray.direction;

@@ -27,6 +27,9 @@ struct MtfOptions {
   int padding = 4;                 // transform size = pupil_samples x padding, rounded up to a power of two (2 to 16)
   int frequency_samples = 51;      // points of each curve from 0 to max_frequency (2 to 1001)
   double max_frequency_per_mm = 0.0;  // 0: the diffraction cutoff 1 / (lambda_min N_w) of the shortest wavelength
+  // The pupil's amplitude from each ray's uncoated Fresnel transmittance (WavefrontOptions::transmittance):
+  // an apodisation. Off: amplitude 1 wherever a ray passes (OpticStudio's default, polarisation off).
+  bool transmittance = false;
   void validate() const;           // throws OptionsError
 };
 
@@ -83,6 +86,7 @@ struct PsfOptions {
   int pupil_samples = 64;   // pupil grid across the unit pupil (16 to 512)
   int padding = 4;          // transform size = pupil_samples x padding, rounded up to a power of two (2 to 16)
   int size = 128;           // output samples across, centred (8 to the transform size)
+  bool transmittance = false;  // as MtfOptions::transmittance
   void validate() const;    // throws OptionsError
 };
 

@@ -25,6 +25,10 @@ struct WavefrontOptions {
   int fan_samples = 41;     // points of each OPD fan from -1 to 1, odd (3 to 1001)
   ZernikeOrdering ordering = ZernikeOrdering::Fringe;
   int zernike_terms = 37;   // terms fitted (1 to the ordering's maximum: Fringe 37, Standard 231)
+  // Fill OpdSample::amplitude with the square root of each ray's uncoated Fresnel transmittance
+  // (lensmith/trace/fresnel.h), for the MTF's and PSF's pupil amplitude. Off: amplitude 1 (OpticStudio's
+  // FFT MTF without polarisation).
+  bool transmittance = false;
   void validate() const;    // throws OptionsError
 };
 
@@ -34,6 +38,7 @@ struct OpdSample {
   double opd_waves = 0.0;
   RayStatus status = RayStatus::Ok;
   double x_mm = 0.0, y_mm = 0.0;  // where the ray meets the image plane, global frame (the geometric MTF's spot)
+  double amplitude = 1.0;         // the pupil function's modulus here: 1, or sqrt(transmittance) (WavefrontOptions)
 };
 
 struct WavefrontMap {
