@@ -22,7 +22,12 @@ void check_rays(const py::array& array, const char* name) {
   }
   if (array.ndim() != 2 || array.shape(1) != 3) {
     std::string shape = "(";
-    for (py::ssize_t i = 0; i < array.ndim(); ++i) shape += (i ? ", " : "") + std::to_string(array.shape(i));
+    for (py::ssize_t i = 0; i < array.ndim(); ++i) {
+      // Appended piece by piece: GCC 12's LTO flags `const char* + std::string` here with a spurious
+      // -Wstringop-overflow, which the warnings-as-errors build would turn into a failure.
+      if (i > 0) shape += ", ";
+      shape += std::to_string(array.shape(i));
+    }
     throw py::value_error(std::string(name) + ": expected shape (N, 3), got " + shape + ")");
   }
 }

@@ -30,7 +30,7 @@ class CountingIterator {
     ++*this;
     return old;
   }
-  friend bool operator==(const CountingIterator& a, const CountingIterator& b) { return a.p_ == b.p_; }
+  [[maybe_unused]] friend bool operator==(const CountingIterator& a, const CountingIterator& b) { return a.p_ == b.p_; }
   friend bool operator!=(const CountingIterator& a, const CountingIterator& b) { return a.p_ != b.p_; }
 
  private:
