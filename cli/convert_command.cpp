@@ -5,7 +5,6 @@
 #include "commands.h"
 #include "lensmith/core/errors.h"
 #include "lensmith/core/text_file.h"
-#include "lensmith/render/image_io.h"
 #include "lensmith/paraxial/paraxial_system.h"
 #include "lensmith/prescription/lens_json.h"
 

@@ -13,7 +13,6 @@
 #include "lensmith/design/optimizer.h"
 #include "lensmith/plot/layout_plot.h"
 #include "lensmith/prescription/lens_json.h"
-#include "lensmith/render/image_io.h"
 #include "lensmith/report/json_report.h"
 
 namespace lensmith::cli {

@@ -3,8 +3,6 @@
 // the maps of lens_fit.h fitted to them; held-out errors and timings; Newton aiming on the fit.
 #include "lensmith/polyfit/lens_fit.h"
 
-#include <omp.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -471,8 +469,8 @@ LensFit LensFit::fit(const Prescription& lens, const LensFitOptions& options,
     }
     const std::size_t count = x.size();
     std::vector<double> ox(count), oy(count), odx(count), ody(count);
-    const int threads = omp_get_max_threads();
-    omp_set_num_threads(1);
+    // One thread for the exact tracer, by its own argument: the polynomial's batch is serial, and the
+    // caller's OpenMP settings are not touched (a library call must not change process-wide state).
     const double exact_s = median_seconds(5, [&] {
       batch.resize(count);
       for (std::size_t i = 0; i < count; ++i) {
@@ -485,10 +483,9 @@ LensFit LensFit::fit(const Prescription& lens, const LensFitOptions& options,
         batch.n[i] = -dz;
         batch.wavelength_nm[i] = nm[i];
       }
-      tracer.trace_batch(batch, TraceDirection::Backward);
+      tracer.trace_batch(batch, TraceDirection::Backward, /*threads=*/1);
     });
     const double poly_s = median_seconds(5, [&] { fit.outer_rays(x, y, dx, dy, nm, ox, oy, odx, ody); });
-    omp_set_num_threads(threads);
     fit.timing_.exact_ns_per_ray = 1e9 * exact_s / static_cast<double>(count);
     fit.timing_.poly_ns_per_ray = 1e9 * poly_s / static_cast<double>(count);
   }

@@ -564,32 +564,4 @@ std::vector<std::pair<std::string, std::string>> read_image_metadata(const fs::p
   return read_image_metadata_pairs(path);
 }
 
-void ensure_writable_location(const fs::path& output) {
-  std::error_code ec;
-  const fs::path dir = output.has_parent_path() ? output.parent_path() : fs::path(".");
-  if (!fs::is_directory(dir, ec)) {
-    throw IoError("cannot write " + output.string() + ": the folder " + dir.string() + " does not exist");
-  }
-  if (fs::is_directory(output, ec)) throw IoError("cannot write " + output.string() + ": it is a folder");
-}
-
-void ensure_not_an_input(const fs::path& output, const std::vector<fs::path>& inputs) {
-  for (const fs::path& input : inputs) {
-    std::error_code ec;
-    bool same = false;
-    if (fs::exists(output, ec) && fs::exists(input, ec)) {
-      same = fs::equivalent(output, input, ec) && !ec;
-    } else {
-      std::error_code ec_output, ec_input;
-      const fs::path a = fs::weakly_canonical(fs::absolute(output), ec_output);
-      const fs::path b = fs::weakly_canonical(fs::absolute(input), ec_input);
-      same = !ec_output && !ec_input && a == b;
-    }
-    if (same) {
-      throw UsageError("output " + output.string() + " is the input " + input.string() +
-                       ": lensmith never overwrites its inputs; choose another output file");
-    }
-  }
-}
-
 }  // namespace lensmith

@@ -6,6 +6,8 @@
 // loop allocates nothing and throws nothing. docs/trace.md explains the choices made here.
 #include "lensmith/trace/sequential_tracer.h"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -1173,8 +1175,10 @@ TraceResult trace_one(const Core& impl, const Ray& ray, std::vector<SurfaceHit>*
 constexpr int kLanes = 4;
 
 template <bool kForward>
-void trace_many(const Core& impl, const RayBatchView& batch) {
+void trace_many(const Core& impl, const RayBatchView& batch, int threads) {
   const auto count = static_cast<std::ptrdiff_t>(batch.count);
+  // The team for this call only (num_threads): the caller's OpenMP settings stay as they are.
+  const int team = threads > 0 ? threads : omp_get_max_threads();
   const auto groups = (count + kLanes - 1) / kLanes;
   const int surfaces = static_cast<int>(impl.count());
   const double *const x = batch.x_mm, *const y = batch.y_mm, *const z = batch.z_mm;
@@ -1198,7 +1202,7 @@ void trace_many(const Core& impl, const RayBatchView& batch) {
   };
   if (impl.general) {
     // One ray at a time through the frames (no lanes: the frame changes dominate).
-#pragma omp parallel for schedule(static) if (count >= kParallelBatchThreshold)
+#pragma omp parallel for schedule(static) if (count >= kParallelBatchThreshold) num_threads(team)
     for (std::ptrdiff_t i = 0; i < count; ++i) {
       State s{};
       int died_at = 0;
@@ -1212,7 +1216,7 @@ void trace_many(const Core& impl, const RayBatchView& batch) {
     }
     return;
   }
-#pragma omp parallel for schedule(static) if (count >= kParallelBatchThreshold)
+#pragma omp parallel for schedule(static) if (count >= kParallelBatchThreshold) num_threads(team)
   for (std::ptrdiff_t group = 0; group < groups; ++group) {
     const std::ptrdiff_t first = group * kLanes;
     const int lanes = static_cast<int>(std::min<std::ptrdiff_t>(kLanes, count - first));
@@ -1277,7 +1281,7 @@ TraceResult SequentialTracer::trace(const Ray& ray, TraceDirection direction, st
   return direction == TraceDirection::Forward ? trace_forward(ray, path) : trace_backward(ray, path);
 }
 
-void SequentialTracer::trace_batch(RayBatch& batch, TraceDirection direction) const {
+void SequentialTracer::trace_batch(RayBatch& batch, TraceDirection direction, int threads) const {
   const std::size_t count = batch.size();
   if (batch.y_mm.size() != count || batch.z_mm.size() != count || batch.l.size() != count ||
       batch.m.size() != count || batch.n.size() != count || batch.wavelength_nm.size() != count ||
@@ -1296,10 +1300,10 @@ void SequentialTracer::trace_batch(RayBatch& batch, TraceDirection direction) co
   view.wavelength_nm = batch.wavelength_nm.data();
   view.status = batch.status.data();
   view.surface = batch.surface.data();
-  trace_batch(view, direction);
+  trace_batch(view, direction, threads);
 }
 
-void SequentialTracer::trace_batch(const RayBatchView& rays, TraceDirection direction) const {
+void SequentialTracer::trace_batch(const RayBatchView& rays, TraceDirection direction, int threads) const {
   if (rays.count == 0) return;
   if (!rays.x_mm || !rays.y_mm || !rays.z_mm || !rays.l || !rays.m || !rays.n || !rays.wavelength_nm || !rays.status || !rays.surface ||
       !rays.x_out_mm || !rays.y_out_mm || !rays.z_out_mm || !rays.l_out || !rays.m_out || !rays.n_out) {
@@ -1309,9 +1313,9 @@ void SequentialTracer::trace_batch(const RayBatchView& rays, TraceDirection dire
     throw OptionsError("RayBatchView: strides must be >= 1 (the wavelength's >= 0)");
   }
   if (direction == TraceDirection::Forward) {
-    trace_many<true>(*impl_, rays);
+    trace_many<true>(*impl_, rays, threads);
   } else {
-    trace_many<false>(*impl_, rays);
+    trace_many<false>(*impl_, rays, threads);
   }
 }
 

@@ -1,9 +1,11 @@
 // Reading user text files and writing outputs safely.
 #pragma once
 
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace lensmith {
 
@@ -28,6 +30,14 @@ std::string shown_text(std::string_view text, std::size_t max_length = 32);
 // Whether the bytes are well-formed UTF-8 (RFC 3629: no overlong forms, surrogates or code points
 // above U+10FFFF).
 bool is_valid_utf8(std::string_view bytes);
+
+// The one rule for outputs: never an input. Throws UsageError (the command line's fault, exit 2) when
+// `output` names the same file as one of `inputs` (the same file on disk when both exist, else the same
+// normalised absolute path).
+void ensure_not_an_input(const std::filesystem::path& output, const std::vector<std::filesystem::path>& inputs);
+// Throws IoError when `output` cannot be written where it is: its folder does not exist, or it is a
+// folder. Checked before a long computation, so that it does not end in a failed write.
+void ensure_writable_location(const std::filesystem::path& output);
 
 // Writes `contents` to `path` through a temporary file in the same folder and a rename, so a
 // crash never leaves a half-written output. Throws IoError.

@@ -14,6 +14,7 @@
 
 #include "lensmith/camera/pinhole_frame.h"
 #include "lensmith/core/errors.h"
+#include "lensmith/core/text_file.h"
 #include "lensmith/imageio/image_file.h"
 #include "lensmith/imageio/raster.h"
 #include "lensmith/render/image.h"
@@ -217,11 +218,6 @@ void write_float_exr(const std::filesystem::path& path, const Image& image, cons
 // Throws IoError.
 std::vector<std::pair<std::string, std::string>> read_image_metadata(const std::filesystem::path& path);
 
-// Throws UsageError when `output` names the same file as one of `inputs` (the same file on disk
-// when both exist, else the same normalised absolute path), so a command cannot overwrite its input.
-void ensure_not_an_input(const std::filesystem::path& output, const std::vector<std::filesystem::path>& inputs);
-// Throws IoError when `output` cannot be written where it is: its folder does not exist, or it is a
-// folder. Checked before a long computation, so that it does not end in a failed write.
-void ensure_writable_location(const std::filesystem::path& output);
+// ensure_not_an_input and ensure_writable_location: lensmith/core/text_file.h, beside the atomic writer.
 
 }  // namespace lensmith

@@ -106,10 +106,11 @@ class SequentialTracer {
   TraceResult trace_backward(const Ray& ray, std::vector<SurfaceHit>* path = nullptr) const;
   TraceResult trace(const Ray& ray, TraceDirection direction, std::vector<SurfaceHit>* path = nullptr) const;
 
-  // Traces every ray of `batch` in `direction`, multi-threaded (OpenMP), without allocating per ray.
-  void trace_batch(RayBatch& batch, TraceDirection direction) const;
+  // Traces every ray of `batch` in `direction`, multi-threaded (OpenMP), without allocating per ray, on
+  // `threads` threads (0: OpenMP's default team; the process's OpenMP settings are not changed).
+  void trace_batch(RayBatch& batch, TraceDirection direction, int threads = 0) const;
   // The same on arrays the caller owns; throws OptionsError for a null pointer or a bad stride.
-  void trace_batch(const RayBatchView& rays, TraceDirection direction) const;
+  void trace_batch(const RayBatchView& rays, TraceDirection direction, int threads = 0) const;
 
   const Prescription& lens() const { return lens_; }
   double vertex_z_mm(int surface) const;  // 1-based
