@@ -155,6 +155,7 @@ struct MtfCommandOptions {
   double focus_range_mm = 0.1;                // --focus-range: shifts from -R to +R
   int focus_steps = 21;                       // --focus-steps
   bool fresnel = false;                       // --fresnel: the pupil amplitude from uncoated Fresnel transmittance
+  std::vector<double> weights;                // --weights: one per wavelength (default equal)
 };
 int run_mtf(const MtfCommandOptions& options, const GlobalOptions& global);
 
@@ -164,6 +165,7 @@ struct PsfCommandOptions {
   int size = 128;          // --size: samples across the picture
   bool grid_in_json = false;  // --json-grid
   bool fresnel = false;       // --fresnel
+  std::vector<double> weights;  // --weights
 };
 int run_psf(const PsfCommandOptions& options, const GlobalOptions& global);
 

@@ -112,6 +112,14 @@ CLI::Validator positive() {
       },
       "> 0", "positive");
 }
+CLI::Validator non_negative() {
+  return CLI::Validator(
+      [](std::string& text) {
+        double v = 0.0;
+        return CLI::detail::lexical_cast(text, v) && v >= 0.0 && std::isfinite(v) ? std::string() : "must be >= 0, got " + text;
+      },
+      ">= 0", "non-negative");
+}
 // lo < value < hi.
 CLI::Validator open_range(double lo, double hi) {
   const std::string limits = "between " + format_rounded(lo, 8) + " and " + format_rounded(hi, 8) + " (exclusive)";
@@ -282,6 +290,9 @@ int main(int argc, char** argv) {
   mtf_cmd->add_option("--focus-range", mtf.focus_range_mm, "With --through-focus: shifts from -MM to +MM (default 0.1; > 0)")
       ->check(positive())
       ->needs(through_focus);
+  mtf_cmd->add_option("--weights", mtf.weights, "Wavelength weights of the polychromatic MTF, one per wavelength, comma separated, each >= 0 (default: equal)")
+      ->delimiter(',')
+      ->check(non_negative());
   mtf_cmd->add_flag("--fresnel", mtf.fresnel, "Apodise the pupil by each ray's uncoated Fresnel transmittance (default: amplitude 1 where rays pass)");
   mtf_cmd->add_option("--focus-steps", mtf.focus_steps, "With --through-focus: shifts (default 21; 2-1001)")->check(range(2, 1001))->needs(through_focus);
 
@@ -292,6 +303,9 @@ int main(int argc, char** argv) {
   psf_cmd->add_option("--size", psf.size, "PSF samples across (default 128; 8 to 4 x --pupil-samples, rounded up to a power of two)")
       ->check(range(8, 2048));
   psf_cmd->add_flag("--json-grid", psf.grid_in_json, "With --json: the intensity grid too");
+  psf_cmd->add_option("--weights", psf.weights, "Wavelength weights of the polychromatic PSF, one per wavelength, comma separated, each >= 0 (default: equal)")
+      ->delimiter(',')
+      ->check(non_negative());
   psf_cmd->add_flag("--fresnel", psf.fresnel, "Apodise the pupil by each ray's uncoated Fresnel transmittance (default: amplitude 1 where rays pass)");
 
   SeidelCommandOptions seidel;

@@ -45,6 +45,7 @@ int run_mtf(const MtfCommandOptions& options, const GlobalOptions& global) {
   mtf_options.max_frequency_per_mm = options.max_frequency_per_mm.value_or(0.0);
   mtf_options.frequency_samples = options.frequency_samples;
   mtf_options.transmittance = options.fresnel;
+  mtf_options.wavelength_weights = options.weights;
   mtf_options.validate();
   const Prescription lens = load_lens(options.common.lens, global);
   const AnalysisContext context(lens, make_analysis_options(options.common));
@@ -80,6 +81,7 @@ int run_psf(const PsfCommandOptions& options, const GlobalOptions& global) {
   psf_options.pupil_samples = options.pupil_samples;
   psf_options.size = options.size;
   psf_options.transmittance = options.fresnel;
+  psf_options.wavelength_weights = options.weights;
   try {
     psf_options.validate();
   } catch (const OptionsError& e) {

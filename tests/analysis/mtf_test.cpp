@@ -228,3 +228,33 @@ TEST_CASE("With Fresnel transmittance the pupil amplitude is what uncoated glass
   const Mtf apodised = compute_mtf(context, mtf);
   CHECK(apodised.fields[0].diffraction_limit[7] < uniform.fields[0].diffraction_limit[7]);
 }
+
+TEST_CASE("Wavelength weights: all the weight on one wavelength gives that wavelength's own MTF and Strehl ratio", "[analysis][mtf]") {
+  // The polychromatic OTF is the weighted mean of the wavelengths' OTFs (OpticStudio's wavelength weights):
+  // weights 0, 1, 0 on F, d, C must give exactly the MTF computed with the d line alone.
+  AnalysisOptions three;
+  three.relative_fields = {0.7};
+  AnalysisOptions d_only = three;
+  d_only.wavelengths_nm = {kWavelengthD_nm};
+  MtfOptions options;
+  options.pupil_samples = 32;
+  options.frequency_samples = 11;
+  options.max_frequency_per_mm = 100.0;
+  const Mtf alone = compute_mtf(AnalysisContext(testing::sasian_triplet(), d_only), options);
+  options.wavelength_weights = {0.0, 2.0, 0.0};  // normalised: the scale does not matter
+  const AnalysisContext context(testing::sasian_triplet(), three);
+  const Mtf weighted = compute_mtf(context, options);
+  for (std::size_t i = 0; i < alone.frequencies_per_mm.size(); ++i) {
+    CHECK_THAT(weighted.fields[0].tangential[i], WithinAbs(alone.fields[0].tangential[i], 1e-12));
+    CHECK_THAT(weighted.fields[0].sagittal[i], WithinAbs(alone.fields[0].sagittal[i], 1e-12));
+    CHECK_THAT(weighted.fields[0].geometric_tangential[i], WithinAbs(alone.fields[0].geometric_tangential[i], 1e-12));
+  }
+  CHECK_THAT(weighted.fields[0].strehl, WithinAbs(alone.fields[0].strehl, 1e-12));
+  // And they matter: equal weights give another curve.
+  options.wavelength_weights.clear();
+  CHECK(std::abs(compute_mtf(context, options).fields[0].tangential[5] - alone.fields[0].tangential[5]) > 1e-3);
+  options.wavelength_weights = {1.0, 1.0};
+  CHECK_THROWS_WITH(compute_mtf(context, options), Catch::Contains("2 weights for 3 wavelengths"));
+  options.wavelength_weights = {0.0, 0.0, 0.0};
+  CHECK_THROWS_WITH(compute_mtf(context, options), Catch::Contains("at least one weight"));
+}

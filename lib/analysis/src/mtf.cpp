@@ -115,6 +115,25 @@ Wavefront pupil_wavefront(const AnalysisContext& context, int pupil_samples, boo
   return compute_wavefront(context, w);
 }
 
+// Each wavelength's share of the polychromatic OTF and PSF: `weights` normalised to sum 1 (one per analysed
+// wavelength, each >= 0), or equal shares when empty (OpticStudio weights the OTFs so).
+std::vector<double> wavelength_shares(const std::vector<double>& weights, std::size_t waves, const char* who) {
+  if (weights.empty()) return std::vector<double>(waves, 1.0 / static_cast<double>(waves));
+  if (weights.size() != waves) {
+    throw OptionsError(std::string(who) + "::wavelength_weights: " + std::to_string(weights.size()) + " weights for " + std::to_string(waves) +
+                       " wavelengths: give one per wavelength");
+  }
+  double sum = 0.0;
+  for (double w : weights) {
+    if (!(std::isfinite(w) && w >= 0.0)) throw OptionsError(std::string(who) + "::wavelength_weights: each weight must be finite and >= 0");
+    sum += w;
+  }
+  if (!(sum > 0.0)) throw OptionsError(std::string(who) + "::wavelength_weights: at least one weight must be > 0");
+  std::vector<double> shares;
+  for (double w : weights) shares.push_back(w / sum);
+  return shares;
+}
+
 }  // namespace
 
 void MtfOptions::validate() const {
@@ -138,6 +157,7 @@ Mtf compute_mtf(const AnalysisContext& context, const MtfOptions& options) {
   out.lens_name = wavefront.lens_name;
   out.wavelengths_nm = wavefront.wavelengths_nm;
   const std::size_t waves = out.wavelengths_nm.size();
+  const std::vector<double> share = wavelength_shares(options.wavelength_weights, waves, "MtfOptions");
   // The cutoff at the reference wavelength on axis (the first field's radius); the curves run to the
   // shortest wavelength's, the highest any wavelength passes.
   // The wavelength in the image space's medium sets the scale.
@@ -163,7 +183,7 @@ Mtf compute_mtf(const AnalysisContext& context, const MtfOptions& options) {
       std::vector<Complex> pupil, perfect;
       fill_pupil(map, m, pupil, perfect);
       const Transfer real = transfer(std::move(pupil), m, fft), ideal = transfer(std::move(perfect), m, fft);
-      curve.strehl += real.psf_peak / ideal.psf_peak / static_cast<double>(waves);
+      curve.strehl += real.psf_peak / ideal.psf_peak * share[k];
       // The geometric MTF: the landing points of the wavefront's own rays, Fourier transformed directly.
       std::vector<double> xs, ys;
       for (const OpdSample& o : map.map) {
@@ -178,16 +198,16 @@ Mtf compute_mtf(const AnalysisContext& context, const MtfOptions& options) {
           gt += std::polar(1.0, w * ys[r]);
           gs += std::polar(1.0, w * xs[r]);
         }
-        geometric_t[i] += gt / static_cast<double>(xs.size() * waves);
-        geometric_s[i] += gs / static_cast<double>(xs.size() * waves);
+        geometric_t[i] += gt * share[k] / static_cast<double>(xs.size());
+        geometric_s[i] += gs * share[k] / static_cast<double>(xs.size());
       }
       // A shift of one sample is the frequency step / (lambda R).
       const double per_sample = step_mm / (medium_wavelength_mm(map.wavelength_nm) * std::abs(map.reference_radius_mm));
       for (std::size_t i = 0; i < nf; ++i) {
         const double shift = out.frequencies_per_mm[i] / per_sample;
-        t[i] += otf_at(real.otf, m, shift, true) / static_cast<double>(waves);
-        s[i] += otf_at(real.otf, m, shift, false) / static_cast<double>(waves);
-        limit[i] += otf_at(ideal.otf, m, shift, true) / static_cast<double>(waves);
+        t[i] += otf_at(real.otf, m, shift, true) * share[k];
+        s[i] += otf_at(real.otf, m, shift, false) * share[k];
+        limit[i] += otf_at(ideal.otf, m, shift, true) * share[k];
       }
     }
     for (std::size_t i = 0; i < nf; ++i) {
@@ -214,6 +234,7 @@ ThroughFocusMtf compute_through_focus_mtf(const AnalysisContext& context, double
   const double exit_pupil_radius_mm = 0.5 * context.paraxial().exit_pupil().diameter_mm;
   const double step_mm = 2.0 * exit_pupil_radius_mm / (n - 1);
   const std::size_t waves = wavefront.wavelengths_nm.size();
+  const std::vector<double> share = wavelength_shares(options.wavelength_weights, waves, "MtfOptions");
   ThroughFocusMtf out;
   out.lens_name = wavefront.lens_name;
   out.frequency_per_mm = frequency_per_mm;
@@ -235,9 +256,9 @@ ThroughFocusMtf compute_through_focus_mtf(const AnalysisContext& context, double
         fill_pupil(map, m, pupil, perfect, dz / wave_mm, exit_pupil_radius_mm / radius);
         const Transfer real = transfer(std::move(pupil), m, fft), ideal = transfer(std::move(perfect), m, fft);
         const double shift = frequency_per_mm / (step_mm / (wave_mm * radius));
-        t += otf_at(real.otf, m, shift, true) / static_cast<double>(waves);
-        s += otf_at(real.otf, m, shift, false) / static_cast<double>(waves);
-        limit += otf_at(ideal.otf, m, shift, true) / static_cast<double>(waves);
+        t += otf_at(real.otf, m, shift, true) * share[k];
+        s += otf_at(real.otf, m, shift, false) * share[k];
+        limit += otf_at(ideal.otf, m, shift, true) * share[k];
       }
       curve.tangential.push_back(std::abs(t));
       curve.sagittal.push_back(std::abs(s));
@@ -283,6 +304,7 @@ Psf compute_psf(const AnalysisContext& context, const PsfOptions& options) {
   out.wavelengths_nm = wavefront.wavelengths_nm;
   out.size = options.size;
   const std::size_t waves = out.wavelengths_nm.size();
+  const std::vector<double> share = wavelength_shares(options.wavelength_weights, waves, "PsfOptions");
   std::size_t reference = 0;
   for (std::size_t k = 0; k < waves; ++k) {
     if (out.wavelengths_nm[k] == wavefront.reference_wavelength_nm) reference = k;
@@ -306,7 +328,7 @@ Psf compute_psf(const AnalysisContext& context, const PsfOptions& options) {
       double ideal_peak = 0.0, peak = 0.0;
       for (const Complex& c : perfect) ideal_peak = std::max(ideal_peak, std::norm(c));
       for (const Complex& c : pupil) peak = std::max(peak, std::norm(c));
-      field.strehl += peak / ideal_peak / static_cast<double>(waves);
+      field.strehl += peak / ideal_peak * share[k];
       // Sample the periodic transform at each output point, bilinearly. The transform's index runs
       // against the image coordinate: a wavefront leading at +x (W rising with px) sends its light to -x
       // (e_x = -(R / n') dW/dx), while its transform peaks at a positive index.
@@ -324,7 +346,7 @@ Psf compute_psf(const AnalysisContext& context, const PsfOptions& options) {
           const double tu = u - i, tv = v - j;
           const double value = (1 - tu) * (1 - tv) * at(i, j) + tu * (1 - tv) * at(i + 1, j) + (1 - tu) * tv * at(i, j + 1) + tu * tv * at(i + 1, j + 1);
           field.intensity[static_cast<std::size_t>(r) * static_cast<std::size_t>(size) + static_cast<std::size_t>(c)] +=
-              value / ideal_peak / static_cast<double>(waves);
+              value / ideal_peak * share[k];
         }
       }
     }
@@ -350,7 +372,7 @@ std::string Psf::to_string() const {
   os << "PSF (FFT of the pupil function): " << lens_name << "\n";
   std::snprintf(cell, sizeof cell, "%d x %d samples %.3f um apart (%.1f um across)", size, size, um_from_mm(spacing_mm),
                 um_from_mm(spacing_mm * size));
-  os << cell << ", about the reference chief ray; polychromatic, equal weights; 1 = the aberration-free peak.\n";
+  os << cell << ", about the reference chief ray; polychromatic, weighted as given (else equal weights); 1 = the aberration-free peak.\n";
   for (const FieldPsf& f : fields) {
     double peak = 0.0;
     for (double v : f.intensity) peak = std::max(peak, v);
@@ -366,7 +388,7 @@ std::string Mtf::to_string() const {
   char cell[128];
   os << "MTF (FFT of the pupil function): " << lens_name << "\n";
   std::snprintf(cell, sizeof cell, "%.1f", cutoff_per_mm);
-  os << "Diffraction cutoff " << cell << " cycles/mm at the reference wavelength on axis; polychromatic, equal weights over";
+  os << "Diffraction cutoff " << cell << " cycles/mm at the reference wavelength on axis; polychromatic, weighted as given (else equal weights) over";
   for (double w : wavelengths_nm) os << " " << w;
   os << " nm.\n";
   for (const MtfCurve& c : fields) {

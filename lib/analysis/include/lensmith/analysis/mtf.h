@@ -1,13 +1,14 @@
 // The diffraction MTF (and Strehl ratio) of real rays by FFT of the pupil function (Goodman, Introduction
 // to Fourier Optics, sec. 6.3-6.4; OpticStudio's "FFT MTF"): the pupil function P = A exp(2 pi i W) on the
-// wavefront's pupil grid (A = 1 where the ray passes, 0 where it dies or outside the pupil; W the OPD in
+// wavefront's pupil grid (A = 1 where the ray passes, or the root of its Fresnel transmittance with
+// `transmittance`; 0 where it dies or outside the pupil; W the OPD in
 // waves, lensmith/analysis/wavefront.h), zero-padded, and the optical transfer function as its
 // autocorrelation, computed as the inverse transform of |FFT(P)|^2. A pupil sample step dp (mm, on the
 // paraxial exit pupil, whose radius the unit pupil coordinate stands for) is a spatial frequency step
 // dp / (lambda R) in cycles/mm, R the reference sphere's radius: the cutoff 2 r_XP / (lambda R) is
-// 1 / (lambda N_w). Polychromatic curves are the wavelengths' OTFs averaged with equal weights (lensmith's
-// prescriptions carry no wavelength weights) at common frequencies, and the polychromatic Strehl ratio the
-// mean of the wavelengths' (each PSF's peak over its aberration-free peak). Tangential: frequencies along y (the field's direction);
+// 1 / (lambda N_w). Polychromatic curves are the wavelengths' OTFs averaged with the given weights (equal
+// by default: lensmith's prescriptions carry no wavelength weights) at common frequencies, and the
+// polychromatic Strehl ratio the same average of the wavelengths' (each PSF's peak over its aberration-free peak). Tangential: frequencies along y (the field's direction);
 // sagittal: along x.
 //
 // FFT: Eigen's FFT module (unsupported/Eigen/FFT, kissfft underneath), which Eigen 3.4 already brings: no
@@ -30,6 +31,10 @@ struct MtfOptions {
   // The pupil's amplitude from each ray's uncoated Fresnel transmittance (WavefrontOptions::transmittance):
   // an apodisation. Off: amplitude 1 wherever a ray passes (OpticStudio's default, polarisation off).
   bool transmittance = false;
+  // Each analysed wavelength's weight in the polychromatic OTF, Strehl ratio and geometric MTF, one per
+  // wavelength (>= 0, normalised to sum 1), as a lens file's wavelength weights; empty: equal weights.
+  // The count is checked against the context's wavelengths (OptionsError).
+  std::vector<double> wavelength_weights;
   void validate() const;           // throws OptionsError
 };
 
@@ -87,6 +92,7 @@ struct PsfOptions {
   int padding = 4;          // transform size = pupil_samples x padding, rounded up to a power of two (2 to 16)
   int size = 128;           // output samples across, centred (8 to the transform size)
   bool transmittance = false;  // as MtfOptions::transmittance
+  std::vector<double> wavelength_weights;  // as MtfOptions::wavelength_weights
   void validate() const;    // throws OptionsError
 };
 
