@@ -19,7 +19,8 @@ TEST_CASE("A merit file's variables and operands are read as written", "[design]
     ],
     "operands": [
       {"type": "efl", "target": 50, "weight": 100},
-      {"type": "spot_rms", "fields": [0, 1], "wavelengths_nm": [486.1, 656.3], "rings": 3, "reference": "chief"},
+      {"type": "spot_rms", "fields": [0, 1], "wavelengths_nm": [486.1, 656.3], "rings": 3, "reference": "chief",
+       "field_weights": [1, 2], "wavelength_weights": [1, 0.5]},
       {"type": "edge_thickness", "surface": 1, "min": 1, "height_mm": 9},
       {"type": "seidel", "term": "S4", "max": 0.01},
       {"type": "distortion", "field": 1, "min": -1, "max": 1}
@@ -41,6 +42,8 @@ TEST_CASE("A merit file's variables and operands are read as written", "[design]
   CHECK(m.operands[1].relative_fields == std::vector<double>{0.0, 1.0});
   CHECK(m.operands[1].wavelengths_nm == std::vector<double>{486.1, 656.3});
   CHECK(m.operands[1].rings == 3);
+  CHECK(m.operands[1].field_weights == std::vector<double>{1.0, 2.0});
+  CHECK(m.operands[1].wavelength_weights == std::vector<double>{1.0, 0.5});
   CHECK_FALSE(m.operands[1].centroid_reference);
   CHECK(m.operands[2].height_mm == 9.0);
   CHECK(m.operands[3].term == "S4");

@@ -310,3 +310,37 @@ TEST_CASE("A merit function that does not fit the lens is refused with the varia
   merit.operands = {target(Operand::Kind::Efl, 100.0)};
   CHECK_THROWS_WITH(optimize(lens, merit), Catch::Contains("outside its bounds"));
 }
+
+TEST_CASE("Field and wavelength weights: a spot or wavefront operand weighted onto one field and wavelength measures that alone", "[design][merit]") {
+  // The weighted RMS weights each (field, wavelength) pair's mean square by the product of its weights: all
+  // the weight on field 0.7 and the d line must read what an operand of that field and wavelength alone reads.
+  const Prescription lens = testing::sasian_triplet();
+  Operand spot;
+  spot.kind = Operand::Kind::SpotRms;
+  spot.relative_fields = {0.0, 0.7};
+  spot.field_weights = {0.0, 3.0};
+  spot.wavelength_weights = {0.0, 1.0, 0.0};
+  Operand alone = spot;
+  alone.relative_fields = {0.7};
+  alone.wavelengths_nm = {kWavelengthD_nm};
+  alone.field_weights.clear();
+  alone.wavelength_weights.clear();
+  Operand wavefront = spot;
+  wavefront.kind = Operand::Kind::WavefrontRms;
+  Operand wavefront_alone = alone;
+  wavefront_alone.kind = Operand::Kind::WavefrontRms;
+  const MeritFunction merit{{variable(DesignVariable::Kind::Curvature, 1)}, {spot, alone, wavefront, wavefront_alone}, {}, {}};
+  merit.validate(lens);
+  const MeritEvaluation e = evaluate_merit(lens, merit);
+  REQUIRE(e.ok());
+  CHECK_THAT(e.operands[0].value, WithinRel(e.operands[1].value, 1e-12));
+  CHECK_THAT(e.operands[2].value, WithinRel(e.operands[3].value, 1e-12));
+  // Equal weights are the plain RMS over every ray: the weights change the value.
+  Operand equal = spot;
+  equal.field_weights.clear();
+  equal.wavelength_weights.clear();
+  CHECK(std::abs(evaluate_merit(lens, MeritFunction{merit.variables, {equal}, {}, {}}).operands[0].value - e.operands[0].value) > 1e-4);
+  // A weight list of the wrong length is refused.
+  spot.field_weights = {1.0};
+  CHECK_THROWS_WITH((MeritFunction{merit.variables, {spot}, {}, {}}.validate(lens)), Catch::Contains("field_weights: 1 weights for 2"));
+}

@@ -69,33 +69,61 @@ void require(const TracedRay& ray, const FieldPoint&, const std::string& what) {
   }
 }
 
-// Per-ray residuals of the RMS spot: each landing point's offset from the field's reference, x and y,
-// times sqrt(weight / rays), so that their squares sum to weight x RMS^2.
+// The weight of each (field, wavelength) pair, normalised to sum 1: the product of the operand's field and
+// wavelength weights (equal where not given).
+std::vector<double> pair_shares(const Operand& o, std::size_t fields, std::size_t wavelengths) {
+  std::vector<double> shares;
+  double sum = 0.0;
+  for (std::size_t f = 0; f < fields; ++f) {
+    for (std::size_t w = 0; w < wavelengths; ++w) {
+      const double fw = o.field_weights.empty() ? 1.0 : o.field_weights[f];
+      const double ww = o.wavelength_weights.empty() ? 1.0 : o.wavelength_weights[w];
+      shares.push_back(fw * ww);
+      sum += fw * ww;
+    }
+  }
+  for (double& s : shares) s /= sum;
+  return shares;
+}
+
+// Per-ray residuals of the RMS spot: each landing point's offset from its field's reference, x and y, times
+// sqrt(weight x its pair's share / the pair's rays), so that their squares sum to weight x the weighted mean
+// square radius. The centroid reference is the field's centroid over its wavelengths, weighted alike.
 double spot_rms(const Prescription& lens, const Operand& o, const MeritFunction& merit, std::vector<double>& residuals) {
   const AnalysisContext context(lens, analysis_options(o, merit));
   PupilSampling sampling;
   sampling.rings = o.rings;
   const std::vector<PupilCoordinate> pupil = sampling.samples();
-  std::vector<double> dx, dy;
-  for (double relative : o.relative_fields) {
+  const std::size_t waves = context.wavelengths_nm().size();
+  const std::vector<double> shares = pair_shares(o, o.relative_fields.size(), waves);
+  std::vector<double> dx, dy, ray_share;
+  for (std::size_t f = 0; f < o.relative_fields.size(); ++f) {
+    const double relative = o.relative_fields[f];
     const FieldPoint field = context.field_at(relative);
     const std::size_t first = dx.size();
-    double sx = 0.0, sy = 0.0;
-    for (double wavelength : context.wavelengths_nm()) {
+    double sx = 0.0, sy = 0.0, sw = 0.0;
+    for (std::size_t w = 0; w < waves; ++w) {
+      const double share = shares[f * waves + w];
       for (const PupilCoordinate& p : pupil) {
-        const TracedRay ray = context.trace(field, p, wavelength);
+        const TracedRay ray = context.trace(field, p, context.wavelengths_nm()[w]);
         require(ray, field, "spot at field " + std::to_string(relative));
         dx.push_back(ray.image_ray.position_mm.x());
         dy.push_back(ray.image_ray.position_mm.y());
-        sx += dx.back();
-        sy += dy.back();
+        ray_share.push_back(share / static_cast<double>(pupil.size()));
+        sx += share * dx.back();
+        sy += share * dy.back();
+        sw += share;
       }
     }
     double cx = 0.0, cy = 0.0;
     if (o.centroid_reference) {
-      const double n = static_cast<double>(dx.size() - first);
-      cx = sx / n;
-      cy = sy / n;
+      if (sw > 0.0) {
+        cx = sx / sw;
+        cy = sy / sw;
+      } else {  // a field of weight 0: its rays count for nothing, whatever they are measured from
+        cx = dx[first];
+        cy = dy[first];
+      }
     } else {
       const Eigen::Vector3d chief = context.reference_ray(field, context.reference_wavelength_nm()).image_ray.position_mm;
       cx = chief.x();
@@ -106,18 +134,18 @@ double spot_rms(const Prescription& lens, const Operand& o, const MeritFunction&
       dy[i] -= cy;
     }
   }
-  const double scale = std::sqrt(o.weight / static_cast<double>(dx.size()));
   double sum = 0.0;
   for (std::size_t i = 0; i < dx.size(); ++i) {
+    const double scale = std::sqrt(o.weight * ray_share[i]);
     residuals.push_back(scale * dx[i]);
     residuals.push_back(scale * dy[i]);
-    sum += dx[i] * dx[i] + dy[i] * dy[i];
+    sum += ray_share[i] * (dx[i] * dx[i] + dy[i] * dy[i]);
   }
-  return std::sqrt(sum / static_cast<double>(dx.size()));
+  return std::sqrt(sum);
 }
 
 // Per-point residuals of the RMS wavefront error: every map's OPD less its mean (piston), over the grid's
-// points inside the unit pupil, times sqrt(weight / points).
+// points inside the unit pupil, times sqrt(weight x the map's share / its points).
 double wavefront_rms(const Prescription& lens, const Operand& o, const MeritFunction& merit, std::vector<double>& residuals) {
   const AnalysisContext context(lens, analysis_options(o, merit));
   WavefrontOptions options;
@@ -125,29 +153,30 @@ double wavefront_rms(const Prescription& lens, const Operand& o, const MeritFunc
   options.fan_samples = 3;
   options.zernike_terms = 1;
   const Wavefront wavefront = compute_wavefront(context, options);
-  std::vector<double> opd;
-  for (const WavefrontMap& map : wavefront.maps) {
-    const std::size_t first = opd.size();
-    double sum = 0.0;
+  const std::vector<double> shares = pair_shares(o, o.relative_fields.size(), wavefront.wavelengths_nm.size());
+  double sum = 0.0;
+  for (std::size_t k = 0; k < wavefront.maps.size(); ++k) {
+    const WavefrontMap& map = wavefront.maps[k];
+    std::vector<double> opd;
+    double total = 0.0;
     for (const OpdSample& s : map.map) {
       if (s.px * s.px + s.py * s.py > 1.0) continue;
       if (s.status != RayStatus::Ok || !std::isfinite(s.opd_waves)) {
         throw ComputationError("wavefront at field " + std::to_string(map.relative_field) + ": a ray dies (" + std::string(to_string(s.status)) + ")");
       }
       opd.push_back(s.opd_waves);
-      sum += s.opd_waves;
+      total += s.opd_waves;
     }
-    const double mean = sum / static_cast<double>(opd.size() - first);
-    for (std::size_t i = first; i < opd.size(); ++i) opd[i] -= mean;
+    if (opd.empty()) throw ComputationError("wavefront: no pupil point on the grid");
+    const double mean = total / static_cast<double>(opd.size());
+    const double point_share = shares[k] / static_cast<double>(opd.size());
+    const double scale = std::sqrt(o.weight * point_share);
+    for (double w : opd) {
+      residuals.push_back(scale * (w - mean));
+      sum += point_share * (w - mean) * (w - mean);
+    }
   }
-  if (opd.empty()) throw ComputationError("wavefront: no pupil point on the grid");
-  const double scale = std::sqrt(o.weight / static_cast<double>(opd.size()));
-  double sum = 0.0;
-  for (double w : opd) {
-    residuals.push_back(scale * w);
-    sum += w * w;
-  }
-  return std::sqrt(sum / static_cast<double>(opd.size()));
+  return std::sqrt(sum);
 }
 
 // The largest distance from the axis at `surface` of the chief ray and the four marginal rays of each field.

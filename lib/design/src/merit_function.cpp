@@ -248,6 +248,21 @@ void MeritFunction::validate(const Prescription& lens) const {
     for (double w : o.wavelengths_nm) {
       if (!(w > 100.0 && w < 20000.0)) throw OptionsError(where + "wavelength " + format_number(w) + " nm: must be in (100, 20000)");
     }
+    const auto check_weights = [&](const std::vector<double>& weights, std::size_t expected, const char* what) {
+      if (weights.empty()) return;
+      if (!o.is_minimised()) throw OptionsError(where + what + " apply to spot_rms and wavefront_rms only");
+      if (weights.size() != expected) {
+        throw OptionsError(where + what + ": " + std::to_string(weights.size()) + " weights for " + std::to_string(expected) + ": give one each");
+      }
+      double sum = 0.0;
+      for (double w : weights) {
+        if (!(std::isfinite(w) && w >= 0.0)) throw OptionsError(where + what + ": each weight must be >= 0");
+        sum += w;
+      }
+      if (!(sum > 0.0)) throw OptionsError(where + what + ": at least one weight must be > 0");
+    };
+    check_weights(o.field_weights, o.relative_fields.size(), "field_weights");
+    check_weights(o.wavelength_weights, o.wavelengths_nm.empty() ? lens.wavelengths_nm.size() : o.wavelengths_nm.size(), "wavelength_weights");
     if (o.rings < 1 || o.rings > kMaxRings) throw OptionsError(where + "rings must be 1 to " + std::to_string(kMaxRings));
     if (o.grid < kMinGrid || o.grid > kMaxGrid) throw OptionsError(where + "grid must be " + std::to_string(kMinGrid) + " to " + std::to_string(kMaxGrid));
   }
@@ -415,6 +430,11 @@ class MeritReader {
         allow({"fields", "wavelengths_nm"});
         if (r.has("fields")) o.relative_fields = numbers(r, "fields");
         if (r.has("wavelengths_nm")) o.wavelengths_nm = numbers(r, "wavelengths_nm");
+        if (o.kind != K::RayHeight) {
+          allow({"field_weights", "wavelength_weights"});
+          if (r.has("field_weights")) o.field_weights = numbers(r, "field_weights");
+          if (r.has("wavelength_weights")) o.wavelength_weights = numbers(r, "wavelength_weights");
+        }
         if (o.kind == K::SpotRms) {
           allow({"rings", "reference"});
           if (r.has("rings")) o.rings = whole(r, "rings", 1, kMaxRings);

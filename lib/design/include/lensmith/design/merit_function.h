@@ -69,6 +69,11 @@ struct Operand {
   std::string term;                             // Seidel: S1, S2, S3, S4, S5, C1, C2
   std::vector<double> relative_fields{0.0, 0.7, 1.0};  // SpotRms, WavefrontRms, RayHeight; Distortion: the first
   std::vector<double> wavelengths_nm;           // SpotRms, WavefrontRms: empty = the lens's
+  // SpotRms, WavefrontRms: each field's and each wavelength's weight (>= 0, not all 0), one per field and per
+  // wavelength; empty = equal. The operand's value is then the weighted RMS: each (field, wavelength) pair's
+  // mean square weighted by the product of its two weights (OpticStudio's field and wavelength weights).
+  std::vector<double> field_weights;
+  std::vector<double> wavelength_weights;
   int rings = 4;                                // SpotRms: hexapolar rings (1 + 3 rings (rings + 1) rays)
   int grid = 12;                                // WavefrontRms: pupil samples across
   bool centroid_reference = true;               // SpotRms: about the polychromatic centroid (else the chief ray)
