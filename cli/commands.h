@@ -73,6 +73,9 @@ struct RealRayCommandOptions {
 // Helpers the real-ray commands share (real_ray_command.cpp).
 // The library options for `options`; throws OptionsError for an unknown --image or --aim word.
 AnalysisOptions make_analysis_options(const RealRayCommandOptions& options);
+// What `lensmith layout` draws by default, also for `lensmith optimize --png`: bundles that fill the real stop
+// where real aiming exists (unless `aim_given`), on axis only for a lens without a field (unless `field_given`).
+void apply_layout_defaults(const Prescription& lens, bool aim_given, bool field_given, AnalysisOptions& analysis);
 // Plot options with the default font; warns once on stderr (unless quiet) when there is none.
 plot::PlotOptions make_plot_options(const GlobalOptions& global);
 struct SeidelCommandOptions {

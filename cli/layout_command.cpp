@@ -11,12 +11,7 @@ namespace lensmith::cli {
 int run_layout(const LayoutCommandOptions& options, const GlobalOptions& global) {
   const Prescription lens = load_lens(options.common.lens, global);
   AnalysisOptions analysis = make_analysis_options(options.common);
-  // Drawn bundles fill the real stop where real aiming exists (rotationally symmetric refracting lenses).
-  if (options.common.aim.empty()) {
-    analysis.aiming = lens.why_no_real_ray_aiming() ? RayAiming::ParaxialEntrancePupil : RayAiming::RealStop;
-  }
-  // Without a field the bundles are drawn on axis only (a lens file need not give one).
-  if (!lens.field && !options.common.field_angle_deg) analysis.relative_fields = {0.0};
+  apply_layout_defaults(lens, !options.common.aim.empty(), options.common.field_angle_deg.has_value(), analysis);
   const AnalysisContext context(lens, analysis);
   LayoutOptions layout_options;
   layout_options.rays_per_field = options.rays;

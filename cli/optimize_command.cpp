@@ -9,6 +9,7 @@
 #include "lensmith/analysis/lens_layout.h"
 #include "lensmith/core/errors.h"
 #include "lensmith/core/json_text.h"
+#include "lensmith/core/number_parsing.h"
 #include "lensmith/core/text_file.h"
 #include "lensmith/design/optimizer.h"
 #include "lensmith/plot/layout_plot.h"
@@ -24,8 +25,7 @@ plot::Canvas layout_picture(Prescription lens, const std::string& title, const M
   lens.name = title;
   AnalysisOptions analysis;
   analysis.max_field_angle_deg = merit.field_angle_deg;
-  analysis.aiming = lens.why_no_real_ray_aiming() ? RayAiming::ParaxialEntrancePupil : RayAiming::RealStop;
-  if (!lens.field && !merit.field_angle_deg) analysis.relative_fields = {0.0};
+  apply_layout_defaults(lens, /*aim_given=*/false, merit.field_angle_deg.has_value(), analysis);
   const AnalysisContext context(lens, analysis);
   return plot::plot_lens_layout(compute_lens_layout(context, LayoutOptions{}), make_plot_options(global));
 }
@@ -56,7 +56,7 @@ int run_optimize(const OptimizeCommandOptions& o, const GlobalOptions& global) {
   };
   OptimizeResult result = optimize(lens, merit, options);
   result.result.notes = (result.result.notes.empty() ? "" : result.result.notes + " ") + "Optimised by lensmith optimize with the merit file " + o.merit +
-                        ": merit " + std::to_string(result.before.merit) + " -> " + std::to_string(result.after.merit) + ".";
+                        ": merit " + format_rounded(result.before.merit, 6) + " -> " + format_rounded(result.after.merit, 6) + ".";
   write_file_atomically(o.output, write_lens_json(result.result));
   if (!o.png.empty()) {
     const plot::Canvas before = layout_picture(result.start, lens.name + " (start)", merit, global);

@@ -31,6 +31,13 @@ AnalysisOptions make_analysis_options(const RealRayCommandOptions& options) {
   return a;
 }
 
+void apply_layout_defaults(const Prescription& lens, bool aim_given, bool field_given, AnalysisOptions& analysis) {
+  // Real aiming is for rotationally symmetric refracting lenses (Prescription::why_no_real_ray_aiming).
+  if (!aim_given) analysis.aiming = lens.why_no_real_ray_aiming() ? RayAiming::ParaxialEntrancePupil : RayAiming::RealStop;
+  // A lens file need not give a field.
+  if (!lens.field && !field_given) analysis.relative_fields = {0.0};
+}
+
 plot::PlotOptions make_plot_options(const GlobalOptions& global) {
   plot::PlotOptions o;
   static bool warned = false;

@@ -110,7 +110,8 @@ Wavefront compute_wavefront(const AnalysisContext& context, const WavefrontOptio
 
       auto sample = [&](double px, double py) {
         OpdSample s{px, py, kNan, RayStatus::Ok};
-        std::vector<SurfaceHit> path;
+        thread_local std::vector<SurfaceHit> path;  // reused: no allocation per ray
+        path.clear();
         const TracedRay r = context.trace(field, {px, py}, wavelength, options.transmittance ? &path : nullptr);
         s.status = r.status;
         if (r.ok()) {

@@ -63,7 +63,7 @@ double seidel_term(const SeidelSums& s, const std::string& term) {
 
 // A traced ray that died is not a number the least squares can use: the evaluation fails, and the optimiser
 // steps back (a trust region that shrinks) rather than step into lenses that lose rays.
-void require(const TracedRay& ray, const FieldPoint&, const std::string& what) {
+void require(const TracedRay& ray, const std::string& what) {
   if (!ray.ok()) {
     throw ComputationError(what + ": a ray dies at surface " + std::to_string(ray.surface) + " (" + std::string(to_string(ray.status)) + ")");
   }
@@ -106,7 +106,7 @@ double spot_rms(const Prescription& lens, const Operand& o, const MeritFunction&
       const double share = shares[f * waves + w];
       for (const PupilCoordinate& p : pupil) {
         const TracedRay ray = context.trace(field, p, context.wavelengths_nm()[w]);
-        require(ray, field, "spot at field " + std::to_string(relative));
+        require(ray, "spot at field " + std::to_string(relative));
         dx.push_back(ray.image_ray.position_mm.x());
         dy.push_back(ray.image_ray.position_mm.y());
         ray_share.push_back(share / static_cast<double>(pupil.size()));
@@ -191,7 +191,7 @@ double ray_height(const Prescription& lens, const Operand& o, const MeritFunctio
       for (const PupilCoordinate& p : kRays) {
         path.clear();
         const TracedRay ray = context.trace(field, p, wavelength, &path);
-        require(ray, field, "ray height at field " + std::to_string(relative));
+        require(ray, "ray height at field " + std::to_string(relative));
         for (const SurfaceHit& hit : path) {
           if (hit.surface == o.surface) largest = std::max(largest, std::hypot(hit.point_mm.x(), hit.point_mm.y()));
         }

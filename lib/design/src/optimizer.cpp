@@ -52,6 +52,13 @@ double step_of(const DesignVariable& v, double length_mm) {
   return kRelativeStep;
 }
 
+// Whether `value` (the variable's unit) sits on one of its bounds, to 1e-9 of its size: where Ceres'
+// projection left it, and what BFGS must then hold fixed.
+bool on_bound(const DesignVariable& v, double value) {
+  const double tolerance = 1e-9 * std::max(1.0, std::abs(value));
+  return (v.min && std::abs(value - *v.min) <= tolerance) || (v.max && std::abs(value - *v.max) <= tolerance);
+}
+
 bool is_glass(const DesignVariable& v) {
   return v.kind == DesignVariable::Kind::GlassIndex || v.kind == DesignVariable::Kind::GlassAbbe;
 }
@@ -275,8 +282,7 @@ StageResult run_stage(const Prescription& lens, const MeritFunction& merit, cons
     const DesignVariable& v = merit.variables[j];
     if (v.min) lower[j] = *v.min / scales[j];
     if (v.max) upper[j] = *v.max / scales[j];
-    const double margin = 1e-9 * std::max(1.0, std::abs(x[j]));
-    if (x[j] - lower[j] > margin && upper[j] - x[j] > margin) free.push_back(static_cast<int>(j));
+    if (!on_bound(v, x[j] * scales[j])) free.push_back(static_cast<int>(j));
   }
   if (!free.empty()) {
     auto* gradient = new MeritGradient(*cost, x, free, lower, upper);
@@ -395,8 +401,7 @@ OptimizeResult optimize(const Prescription& lens, const MeritFunction& merit, co
   for (const DesignVariable& v : merit.variables) {
     const double value = v.value(current);
     result.result_values.push_back(value);
-    const double tolerance = 1e-9 * std::max(1.0, std::abs(value));
-    result.at_bound.push_back((v.min && std::abs(value - *v.min) <= tolerance) || (v.max && std::abs(value - *v.max) <= tolerance));
+    result.at_bound.push_back(on_bound(v, value));
   }
   result.evaluations = evaluations + 1;
   return result;
