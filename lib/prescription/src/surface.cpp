@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "lensmith/core/units.h"
+#include "lensmith/prescription/conic_profile.h"
 
 namespace lensmith {
 
@@ -55,19 +56,9 @@ double Surface::paraxial_curvature_per_mm(Section section) const {
 namespace {
 
 // The conic-plus-even-polynomial profile z(u), u = r^2, and dz/du (Standard surfaces, and a toroid's y curve
-// with u = y^2); false outside the conic's domain.
+// with u = y^2); false outside the conic's domain. conic_profile.h is its one home.
 bool profile(double c, double conic, const Surface::EvenAsphere& a, double u, double& z, double& dz_du) {
-  const double d = 1.0 - (1.0 + conic) * c * c * u;
-  if (!(d > 0.0)) return false;  // beyond the conic's rim, or on it where the slope is infinite
-  const double root = std::sqrt(d);
-  double q = 0.0, dq = 0.0;
-  for (std::size_t j = a.size(); j-- > 0;) {
-    dq = dq * u + q;
-    q = q * u + a[j];
-  }
-  z = c * u / (1.0 + root) + u * q;
-  dz_du = 0.5 * c / root + q + u * dq;
-  return std::isfinite(z) && std::isfinite(dz_du);
+  return conic_profile(c, 1.0 + conic, a.data(), static_cast<int>(a.size()), u, z, dz_du);
 }
 
 }  // namespace
@@ -129,20 +120,10 @@ bool Surface::sag_and_slope(double x, double y, double& sag, double& dz_dx, doub
 
 double Surface::radius_mm() const { return curvature_per_mm == 0.0 ? kInfinity : 1.0 / curvature_per_mm; }
 
-double Surface::max_semi_diameter_mm() const {
-  const double kc2 = (1.0 + conic) * curvature_per_mm * curvature_per_mm;
-  return kc2 > 0.0 ? 1.0 / std::sqrt(kc2) : kInfinity;
-}
+double Surface::max_semi_diameter_mm() const { return conic_max_radius_mm(curvature_per_mm, 1.0 + conic); }
 
 double Surface::sag_mm(double r_mm) const {
-  const double c = curvature_per_mm;
-  const double u = r_mm * r_mm;
-  const double d = 1.0 - (1.0 + conic) * c * c * u;
-  if (d < 0.0) return std::numeric_limits<double>::quiet_NaN();
-  double poly = 0.0;
-  for (std::size_t j = even_asphere.size(); j-- > 0;) poly = poly * u + even_asphere[j];
-  // c u / (1 + sqrt(d)): the conic's sag without cancellation near the vertex.
-  return c * u / (1.0 + std::sqrt(d)) + u * poly;
+  return conic_sag(curvature_per_mm, 1.0 + conic, even_asphere.data(), static_cast<int>(even_asphere.size()), r_mm * r_mm);
 }
 
 bool SurfaceAperture::passes(double x_mm, double y_mm, double tolerance_mm) const {

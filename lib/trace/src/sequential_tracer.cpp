@@ -23,6 +23,7 @@
 #include "lensmith/core/errors.h"
 #include "lensmith/core/units.h"
 #include "lensmith/paraxial/paraxial_system.h"
+#include "lensmith/prescription/conic_profile.h"
 #include "lensmith/trace/surface_frames.h"
 
 namespace lensmith {
@@ -152,23 +153,10 @@ inline bool intersect_conic(double c, double one_plus_conic, double x0, double y
   return true;
 }
 
-// Sag of an even asphere z(u), u = r^2, and dz/du: z = c u / (1 + sqrt(D)) + sum_j a_2j u^j with
-// D = 1 - (1 + k) c^2 u, dz/du = c / (2 sqrt(D)) + sum_j j a_2j u^(j-1). False outside the domain (D <= 0).
+// Sag of an even asphere z(u), u = r^2, and dz/du (conic_profile.h, the one home of the shape); false
+// outside the domain (D <= 0).
 inline bool asphere_sag(const SurfaceGeometry& g, double u, double& sag, double& slope) {
-  const double c = g.curvature_per_mm;
-  const double d = 1.0 - g.one_plus_conic * c * c * u;
-  if (!(d > 0.0)) return false;
-  const double root = std::sqrt(d);
-  // Horner on q(u) = sum_j a[j] u^j; the polynomial is u q(u), its derivative q + u q'.
-  double q = 0.0;
-  double dq = 0.0;
-  for (int j = g.asphere_terms - 1; j >= 0; --j) {
-    dq = dq * u + q;
-    q = q * u + g.asphere[static_cast<std::size_t>(j)];
-  }
-  sag = c * u / (1.0 + root) + u * q;
-  slope = 0.5 * c / root + q + u * dq;
-  return true;
+  return conic_profile(g.curvature_per_mm, g.one_plus_conic, g.asphere.data(), g.asphere_terms, u, sag, slope);
 }
 
 // The asphere crossing at parameter t along the ray from (x0, y0, z0): checks the domain and, when
