@@ -47,7 +47,8 @@ int run_fit(const FitCommandOptions& o, const GlobalOptions& global) {
   const Prescription lens = load_lens(o.lens, global);
 
   ProgressBar bar("fitting", !global.quiet);
-  const LensFit fit = LensFit::fit(lens, options, [&](double f) { bar.update(f); });
+  LensFit fit = LensFit::fit(lens, options, [&](double f) { bar.update(f); });
+  fit.measure_speed(lens);
   bar.finish();
   if (!o.output.empty()) fit.write(o.output);
 

@@ -400,7 +400,10 @@ void bind_render(py::module_& m) {
              o.validate();
              const Prescription p = lens.checked();
              py::gil_scoped_release release;
-             return std::make_shared<LensFit>(LensFit::fit(p, o));
+             // As `lensmith fit`: a fit asked for by name reports its speed (a render's own fit does not).
+             auto fit = std::make_shared<LensFit>(LensFit::fit(p, o));
+             fit->measure_speed(p);
+             return fit;
            }, py::arg("lens"), py::arg("degree") = 7, py::arg("terms") = 0, py::arg("training_rays") = 30000, py::arg("test_rays") = 10000,
            py::arg("seed") = 2016, py::arg("image_radius_mm") = py::none(), py::arg("f_number") = py::none())
       .def_static("load", [](const std::string& path) { return std::make_shared<LensFit>(LensFit::read(path)); }, py::arg("path"))

@@ -142,8 +142,9 @@ Camera Camera::from_lens(const Prescription& lens, const CameraOptions& options,
   // The stop's clear aperture follows the f-number (an iris), so the exact tracer clips the beam
   // that the paraxial pupils describe; the other clear apertures stay as prescribed (vignetting).
   const ParaxialSystem at_n(*at_f_number);
-  const std::size_t stop = static_cast<std::size_t>(at_n.stop_surface() - 1);
-  const double stop_mm = std::abs(at_n.marginal_ray().rows[stop].y_mm);
+  const StopOpening opening = stop_opened_to_f_number(as_camera, n);
+  const std::size_t stop = static_cast<std::size_t>(opening.surface - 1);
+  const double stop_mm = opening.semi_diameter_mm;
   const double widest_stop_mm = at_f_number->surfaces[stop].max_semi_diameter_mm();
   if (stop_mm > widest_stop_mm) {
     // Marginal heights scale as 1 / N: the stop is as wide as its surface at N stop_mm / widest.

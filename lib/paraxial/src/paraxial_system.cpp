@@ -586,4 +586,12 @@ std::string ParaxialSystem::to_string() const {
   return os.str();
 }
 
+StopOpening stop_opened_to_f_number(const Prescription& lens, double f_number) {
+  Prescription at_n = lens;
+  at_n.aperture = ApertureSpec{ApertureSpec::Kind::ImageSpaceFNumber, f_number};
+  const ParaxialSystem p(at_n);
+  const int stop = p.stop_surface();
+  return {stop, std::abs(p.marginal_ray().rows[static_cast<std::size_t>(stop - 1)].y_mm)};
+}
+
 }  // namespace lensmith

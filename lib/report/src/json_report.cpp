@@ -430,9 +430,17 @@ ojson fit_json(const LensFit& fit) {
   j["sensor_direction_rms_mrad"] = e.sensor_direction_rms_mrad;
   j["vignetting_mismatch"] = e.vignetting_mismatch;
   j["fit_seconds"] = t.fit_seconds;
-  j["exact_ns_per_ray"] = t.exact_ns_per_ray;
-  j["poly_ns_per_ray"] = t.poly_ns_per_ray;
-  j["speedup"] = t.exact_ns_per_ray / t.poly_ns_per_ray;
+  // The speed only where it was measured (LensFit::measure_speed; `lensmith fit` does, a fit made in
+  // a render does not).
+  if (t.speed_measured()) {
+    j["exact_ns_per_ray"] = t.exact_ns_per_ray;
+    j["poly_ns_per_ray"] = t.poly_ns_per_ray;
+    j["speedup"] = t.exact_ns_per_ray / t.poly_ns_per_ray;
+  } else {
+    j["exact_ns_per_ray"] = nullptr;
+    j["poly_ns_per_ray"] = nullptr;
+    j["speedup"] = nullptr;
+  }
   return j;
 }
 

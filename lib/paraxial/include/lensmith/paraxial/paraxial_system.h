@@ -161,4 +161,14 @@ class ParaxialSystem {
   std::string field_description_;    // the maximum field as the prescription states it, for to_string()
 };
 
+// The stop an iris opens for an image-space f-number (object at infinity, lens.aperture replaced by
+// that f-number): the stop surface (1-based) and the paraxial marginal ray's height there, mm. One
+// home for the camera (Camera::from_lens, which clips there) and the fits (LensFit::fit, which samples
+// the beam it passes). Throws as ParaxialSystem does.
+struct StopOpening {
+  int surface = 0;
+  double semi_diameter_mm = 0.0;
+};
+StopOpening stop_opened_to_f_number(const Prescription& lens, double f_number);
+
 }  // namespace lensmith

@@ -109,13 +109,15 @@ struct LensFitErrors {
   friend std::ostream& operator<<(std::ostream& os, const LensFitErrors& e) { return os << e.to_string(); }
 };
 
-// Times measured when the fit was made, on one thread, for the same held-out rays from the sensor to
-// the outer pupil: the exact tracer's batch path (unclipped) and the fit's batch evaluation of the
-// sensor -> outer map (LensFit::outer_rays, no clipping). Median of 5 runs.
+// How long the fit took to make, and (LensFit::measure_speed, on request: a fit made for a render does
+// not spend time on it) the cost per ray on one thread from the sensor to the outer pupil of the exact
+// tracer's batch path (unclipped) and of the fit's batch evaluation (LensFit::outer_rays, no
+// clipping), on the same rays, median of 5 runs; 0 when not measured.
 struct LensFitTiming {
   double fit_seconds = 0.0;  // sampling, term selection and coefficients, all threads
   double exact_ns_per_ray = 0.0;
   double poly_ns_per_ray = 0.0;
+  bool speed_measured() const { return exact_ns_per_ray > 0.0 && poly_ns_per_ray > 0.0; }
   std::string to_string() const;
   friend std::ostream& operator<<(std::ostream& os, const LensFitTiming& t) { return os << t.to_string(); }
 };
@@ -174,6 +176,11 @@ class LensFit {
   // the tracer throws.
   static LensFit fit(const Prescription& lens, const LensFitOptions& options = {},
                      const std::function<void(double)>& progress = {});
+
+  // Measures the fit's speed against the exact tracer through `lens` (the prescription it was made
+  // from: OptionsError otherwise) on passing rays of its own stream, as many as the fit's test rays,
+  // and records it in timing(). One thread each; the process's OpenMP settings are not changed.
+  void measure_speed(const Prescription& lens);
 
   // Versioned JSON ("lensmith-fit", version 1). read() throws LensFileError with file:line:col for
   // malformed files; write() goes through a temporary file and a rename.

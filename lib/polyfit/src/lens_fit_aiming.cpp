@@ -1,0 +1,196 @@
+// Newton aiming on the fitted maps (lens_fit.h): the sensor-side direction, or the outer-pupil position
+// from an object point, whose fitted ray crosses the stop at a requested point; the front surface's
+// sag and the object-side rays the outer maps take.
+#include <cmath>
+
+#include "lens_fit_stages.h"
+#include "lensmith/core/number_parsing.h"
+#include "lensmith/prescription/conic_profile.h"
+
+namespace lensmith {
+
+using polyfit_detail::in_domain;
+using polyfit_detail::normalised;
+
+namespace {
+
+// The fitted 2x2 system of a Newton aim, solved; false when singular.
+bool solve2(const std::array<double, 4>& j, double fx, double fy, double& dx, double& dy) {
+  const double det = j[0] * j[3] - j[1] * j[2];
+  if (!(std::abs(det) > 0.0) || !std::isfinite(det)) return false;
+  dx = (j[3] * fx - j[1] * fy) / det;
+  dy = (j[0] * fy - j[2] * fx) / det;
+  return true;
+}
+
+// Damped Newton on two unknowns: `residual(u, ex, ey, jacobian or null)` gives the stop miss (mm) at
+// u and, when asked, d(miss) / du; false when u leaves the fit's domain. Each step is halved until
+// the miss falls (the stop map is nearly linear, so the full step is almost always taken). Fills
+// the iterations, miss, Jacobian and convergence of `aim`; returns the last accepted u.
+template <class Residual>
+std::array<double, 2> damped_newton(std::array<double, 2> u, const Residual& residual, const FitAimOptions& options,
+                                    FitAim& aim) {
+  double ex = 0.0, ey = 0.0;
+  std::array<double, 4> j{};
+  if (!residual(u, ex, ey, &j)) return u;
+  aim.jacobian = j;
+  aim.miss_mm = std::hypot(ex, ey);
+  for (aim.iterations = 0; aim.iterations < options.max_iterations && aim.miss_mm > options.tolerance_mm;) {
+    ++aim.iterations;
+    double sx, sy;
+    if (!solve2(j, ex, ey, sx, sy)) return u;
+    bool improved = false;
+    for (double step = 1.0; step > 1e-3 && !improved; step *= 0.5) {
+      const std::array<double, 2> trial{u[0] - step * sx, u[1] - step * sy};
+      double tx, ty;
+      if (!residual(trial, tx, ty, nullptr) || std::hypot(tx, ty) >= aim.miss_mm) continue;
+      u = trial;
+      improved = true;
+    }
+    if (!improved) return u;
+    residual(u, ex, ey, &j);
+    aim.jacobian = j;
+    aim.miss_mm = std::hypot(ex, ey);
+  }
+  aim.converged = aim.miss_mm <= options.tolerance_mm;
+  return u;
+}
+
+}  // namespace
+
+void FitAimOptions::validate() const {
+  if (!(tolerance_mm > 0.0 && std::isfinite(tolerance_mm))) {
+    throw OptionsError("aim tolerance must be a finite length > 0 mm, got " + format_number(tolerance_mm));
+  }
+  if (max_iterations < 1) throw OptionsError("aim needs at least 1 iteration, got " + std::to_string(max_iterations));
+}
+
+FitAim LensFit::aim_from_sensor(double x_mm, double y_mm, double stop_x_mm, double stop_y_mm, double wavelength_nm,
+                                const FitAimOptions& options) const {
+  options.validate();
+  const double lambda = normalised_wavelength(wavelength_nm);
+  const double ps = scales_.sensor_position_mm, ds = scales_.sensor_direction;
+  // First guess: toward the paraxial exit-pupil image of the stop point.
+  const double px = stop_x_mm * pupils_.exit_per_stop, py = stop_y_mm * pupils_.exit_per_stop;
+  double fx = x_mm - px, fy = y_mm - py, fz = sensor_z_mm_ - pupils_.z_exit_pupil_mm;
+  if (fz < 0.0) fx = -fx, fy = -fy, fz = -fz;
+  const double norm = std::sqrt(fx * fx + fy * fy + fz * fz);
+  FitAim aim;
+  aim.ray = PlaneRay{x_mm, y_mm, fx / norm, fy / norm};
+  const RotationalMap& map = sensor_clip_;
+  std::array<double, 2> at;
+  std::array<double, 8> jac;
+  auto residual = [&](const std::array<double, 2>& u, double& ex, double& ey, std::array<double, 4>* j) {
+    const PolyPoint va = normalised(PlaneRay{x_mm, y_mm, u[0], u[1]}, ps, ds, lambda);
+    if (!in_domain(va)) return false;
+    // Output 0 is the stop; its Jacobian columns 2, 3 are d/d(dx, dy) in normalised units.
+    if (j) {
+      map.evaluate_with_jacobian(va, 0, at, jac);
+      *j = {jac[2] / ds, jac[3] / ds, jac[6] / ds, jac[7] / ds};
+    } else {
+      at = map.evaluate_output(va, 0);
+    }
+    ex = at[0] - stop_x_mm;
+    ey = at[1] - stop_y_mm;
+    return true;
+  };
+  const auto u = damped_newton({aim.ray.dx, aim.ray.dy}, residual, options, aim);
+  aim.ray = PlaneRay{x_mm, y_mm, u[0], u[1]};
+  return aim;
+}
+
+std::array<double, 2> LensFit::paraxial_outer_position(const ObjectPoint& o, double stop_x_mm, double stop_y_mm) const {
+  const double w = o.inverse_depth_per_mm;
+  const double ex = stop_x_mm * pupils_.entrance_per_stop, ey = stop_y_mm * pupils_.entrance_per_stop;
+  const double ze = pupils_.z_entrance_pupil_mm;
+  // w times the vector from the object point to the entrance-pupil point (finite at w = 0).
+  const double ux = w * ex - o.tan_x, uy = w * ey - o.tan_y, uz = 1.0 + w * (ze - o.origin_z_mm);
+  return {ex - ux / uz * ze, ey - uy / uz * ze};
+}
+
+FitAim LensFit::aim_from_object(const ObjectPoint& o, double stop_x_mm, double stop_y_mm, double wavelength_nm,
+                                std::optional<std::array<double, 2>> guess, const FitAimOptions& options) const {
+  options.validate();
+  const double lambda = normalised_wavelength(wavelength_nm);
+  const double ps = scales_.outer_position_mm, ds = scales_.outer_direction;
+  const std::array<double, 2> start = guess ? *guess : paraxial_outer_position(o, stop_x_mm, stop_y_mm);
+  const RotationalMap& map = outer_clip_;
+  std::array<double, 2> at;
+  std::array<double, 8> jac;
+  auto residual = [&](const std::array<double, 2>& u, double& ex, double& ey, std::array<double, 4>* j) {
+    const std::optional<OuterLine> found = outer_line(o, u[0], u[1]);
+    if (!found) return false;
+    const OuterLine& l = *found;
+    const PolyPoint va = normalised(l.ray, ps, ds, lambda);
+    if (!in_domain(va)) return false;
+    if (!j) {
+      at = map.evaluate_output(va, 0);
+      ex = at[0] - stop_x_mm;
+      ey = at[1] - stop_y_mm;
+      return true;
+    }
+    map.evaluate_with_jacobian(va, 0, at, jac);
+    ex = at[0] - stop_x_mm;
+    ey = at[1] - stop_y_mm;
+    {
+      // Chain rule through the normalisation and the direction's dependence on the outer position.
+      const double* gx = jac.data();      // d stop_x / d(normalised x, y, dx, dy)
+      const double* gy = jac.data() + 4;  // d stop_y / d(...)
+      *j = {gx[0] / ps + gx[2] / ds * l.ddx_dx + gx[3] / ds * l.ddy_dx,
+            gx[1] / ps + gx[2] / ds * l.ddx_dy + gx[3] / ds * l.ddy_dy,
+            gy[0] / ps + gy[2] / ds * l.ddx_dx + gy[3] / ds * l.ddy_dx,
+            gy[1] / ps + gy[2] / ds * l.ddx_dy + gy[3] / ds * l.ddy_dy};
+    }
+    return true;
+  };
+  FitAim aim;
+  const auto u = damped_newton(start, residual, options, aim);
+  const std::optional<OuterLine> last = outer_line(o, u[0], u[1]);
+  aim.ray = last ? last->ray : PlaneRay{u[0], u[1], 0.0, 0.0};
+  return aim;
+}
+
+std::optional<double> LensFit::front_sag(double r2, double* dz_dr2) const {
+  double z = 0.0, slope = 0.0;
+  if (!conic_profile(front_.curvature_per_mm, 1.0 + front_.conic, front_.even_asphere.data(),
+                     static_cast<int>(front_.even_asphere.size()), r2, z, slope)) {
+    return std::nullopt;
+  }
+  if (dz_dr2) *dz_dr2 = slope;
+  return z;
+}
+
+std::optional<LensFit::OuterLine> LensFit::outer_line(const ObjectPoint& o, double x, double y) const {
+  double dz_ds = 0.0;
+  const std::optional<double> z = front_sag(x * x + y * y, &dz_ds);
+  if (!z) return std::nullopt;
+  // w times the vector from the object point to the surface point (finite at w = 0).
+  const double w = o.inverse_depth_per_mm;
+  const double ux = w * x - o.tan_x, uy = w * y - o.tan_y, uz = 1.0 + w * (*z - o.origin_z_mm);
+  if (uz <= 0.0) return std::nullopt;  // the object point is not in front of the surface
+  const double len = std::sqrt(ux * ux + uy * uy + uz * uz);
+  const double fx = ux / len, fy = uy / len, fz = uz / len;
+  // d(w u) / dx = (w, 0, w dz/dx), d(w u) / dy = (0, w, w dz/dy); d f = (g - f (f.g)) / |w u|.
+  const double zx = 2.0 * x * dz_ds, zy = 2.0 * y * dz_ds;
+  const double fgx = w * (fx + fz * zx), fgy = w * (fy + fz * zy);
+  return OuterLine{PlaneRay{x, y, fx, fy}, (w - fx * fgx) / len, (0.0 - fy * fgx) / len, (0.0 - fx * fgy) / len,
+                   (w - fy * fgy) / len};
+}
+
+std::optional<PlaneRay> LensFit::outer_ray_from_object(const ObjectPoint& o, double x_mm, double y_mm) const {
+  const std::optional<OuterLine> line = outer_line(o, x_mm, y_mm);
+  if (!line) return std::nullopt;
+  return line->ray;
+}
+
+std::optional<std::array<double, 2>> LensFit::stop_from_object(const ObjectPoint& o, double x_mm, double y_mm,
+                                                              double wavelength_nm) const {
+  const std::optional<PlaneRay> ray = outer_ray_from_object(o, x_mm, y_mm);
+  if (!ray) return std::nullopt;
+  const double lambda = normalised_wavelength(wavelength_nm);
+  const PolyPoint v = normalised(*ray, scales_.outer_position_mm, scales_.outer_direction, lambda);
+  if (!in_domain(v)) return std::nullopt;
+  return outer_clip_.evaluate_output(v, 0);
+}
+
+}  // namespace lensmith
