@@ -65,7 +65,6 @@ Candidate RaySampler::make(std::uint64_t stream, std::uint64_t index, std::vecto
   ray.wavelength_nm = c.wavelength_nm;
   const TraceResult t = tracer_.trace_backward(ray, &path);
   if (!t.ok()) return c;
-  c.traced = true;
   const std::size_t surfaces = semi_diameter_.size();
   c.hit_x.assign(surfaces, 0.0);
   c.hit_y.assign(surfaces, 0.0);

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -47,7 +48,7 @@ inline bool in_domain(const PolyPoint& v) {
 
 // One traced candidate of the sampled beam.
 struct Candidate {
-  bool traced = false;      // reached object space (no TIR, no miss) when traced without clipping
+  // Both false when the unclipped trace did not reach object space (a miss, total internal reflection).
   bool in_domain = false;   // within every clear aperture enlarged by the margin
   bool passes = false;      // within every clear aperture
   PlaneRay sensor;
