@@ -806,6 +806,10 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   }
   if (stats.clamped_depths > 0) what << "; " << stats.clamped_depths << " pixels nearer than the lens serves (or beyond --max-blur) clamped";
   report_written(what.str(), global);
+  if (stats.unaimed_rays > 0 && !global.quiet) {
+    std::cerr << "warning: " << stats.unaimed_rays << " rays of the " << to_string(kind)
+              << " model could not be aimed at their stop points and were drawn as stopped: a failure of the model, not the lens's vignetting\n";
+  }
   return kExitOk;
 }
 

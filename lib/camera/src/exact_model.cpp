@@ -10,6 +10,8 @@
 #include <cmath>
 #include <vector>
 
+#include "lensmith/core/errors.h"
+#include "lensmith/core/root_solver_2d.h"
 #include "lensmith/core/units.h"
 #include "model_implementations.h"
 
@@ -40,6 +42,9 @@ Ray ray_towards(const ScenePoint& p, double z_perspective_mm, double target_x, d
   return r;
 }
 
+// Two unit directions this close (rad) are one ray's: rounding of a trace is ~1e-14.
+constexpr double kSameDirection = 1e-9;
+
 }  // namespace
 
 ExactModel::ExactModel(const Camera& camera) : RayModel(camera) {
@@ -67,7 +72,54 @@ ExactModel::ExactModel(const Camera& camera) : RayModel(camera) {
   z_stop_mm_ = free_->vertex_z_mm(stop_surface_);
   for (int k = 1; k <= static_cast<int>(lens.surfaces.size()); ++k) frames_.push_back(free_->surface_frame(k));
   stop_frame_ = frames_[static_cast<std::size_t>(stop_surface_ - 1)];
+  AimOptions aim;
+  aim.aiming = RayAiming::RealStop;
+  aim.tolerance_mm = kAimTolerance * stop_radius_mm_;
+  aim.use_vignetting_factors = false;  // the camera's rays fill the stop; vignetting is traced
+  // RayAimer aims through rotationally symmetric refracting lenses only; the others (tilts,
+  // mirrors) have the beam's own aim alone.
+  if (aim.tolerance_mm > 0.0) {
+    try {
+      aimer_ = std::make_shared<RayAimer>(*free_, aim);
+    } catch (const OptionsError&) {
+      aimer_ = nullptr;
+    }
+  }
   normalisation_ = weight_normalisation_for(camera, [this](auto&&... a) { map_raw(a...); });
+  unaimed_ = 0;  // the count is of the caller's rays
+}
+
+bool ExactModel::aim_by_ray_aimer(const ScenePoint& point, double wavelength_nm, double want_x_mm, double want_y_mm,
+                                  double z_target_mm, double& target_x_mm, double& target_y_mm) const {
+  if (!aimer_ || !(aimer_->stop_radius_mm() > 0.0)) return false;
+  const double z_persp = camera_.z_perspective_mm();
+  FieldPoint field;
+  if (point.inverse_depth_per_mm > 0.0) {
+    const double depth = distance_mm_from_inverse(point.inverse_depth_per_mm);
+    field = FieldPoint::object_point_mm(Eigen::Vector3d(point.tan_x * depth, point.tan_y * depth, z_persp - depth));
+  } else {
+    // Light from infinitely far along +tangents travels along -tangents.
+    field = FieldPoint::angle_deg(deg_from_rad(std::atan(-point.tan_y)), deg_from_rad(std::atan(-point.tan_x)));
+  }
+  const double r = aimer_->stop_radius_mm();
+  const AimedRay aimed = aimer_->make_ray(field, PupilCoordinate{want_x_mm / r, want_y_mm / r}, wavelength_nm);
+  if (!aimed.ok() || !(std::abs(aimed.ray.direction.z()) > 0.0)) return false;
+  // RayAimer aims on the stop in the global frame; this model's stop point is in the stop's own
+  // frame (a tilted lens): check where the ray really crosses it.
+  thread_local std::vector<SurfaceHit> path;
+  free_->trace_forward(aimed.ray, &path);
+  const std::size_t stop_index = static_cast<std::size_t>(stop_surface_ - 1);
+  if (path.size() <= stop_index) return false;
+  const Eigen::Vector3d on_stop = stop_frame_.to_local(path[stop_index].point_mm);
+  if (std::hypot(on_stop.x() - want_x_mm, on_stop.y() - want_y_mm) > kAimTolerance * stop_radius_mm_) return false;
+  const double t = (z_target_mm - aimed.ray.position_mm.z()) / aimed.ray.direction.z();
+  target_x_mm = aimed.ray.position_mm.x() + t * aimed.ray.direction.x();
+  target_y_mm = aimed.ray.position_mm.y() + t * aimed.ray.direction.y();
+  if (!(std::isfinite(target_x_mm) && std::isfinite(target_y_mm))) return false;
+  // And that it is this scene point's ray (a lens file's finite object plane would turn an angle
+  // into a point on that plane): the same direction as the ray from the point to the target.
+  const Ray expected = ray_towards(point, z_persp, target_x_mm, target_y_mm, z_target_mm, wavelength_nm, z_target_mm);
+  return (expected.direction - aimed.ray.direction.normalized()).norm() <= kSameDirection;
 }
 
 void ExactModel::map(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
@@ -133,51 +185,37 @@ void ExactModel::map_raw(const ScenePoint& point, double wavelength_nm, std::spa
   // off axis where the stop's image does): with the solid angle of each target seen from the point,
   // the ray's radiometric weight.
   const double target_area = std::abs(i11 * i22 - i12 * i21);
-  const double tolerance = kAimTolerance * stop_radius_mm_;
+  const Matrix2 beam_jacobian{j11, j12, j21, j22};
+  // Each pupil point's aim: at most kAimIterations traces, full steps.
+  RootSolver2dOptions aim_options;
+  aim_options.jacobian = JacobianSource::Broyden;
+  aim_options.line_search = false;
+  aim_options.tolerance = kAimTolerance * stop_radius_mm_;
+  aim_options.max_iterations = kAimIterations - 1;
+  const RootSolver2d aim_solver(aim_options);
 
   for (std::size_t i = 0; i < pupil.size(); ++i) {
     const double want_x = pupil[i].x * stop_radius_mm_, want_y = pupil[i].y * stop_radius_mm_;
-    double tx = cx + i11 * (want_x - s0x) + i12 * (want_y - s0y);
-    double ty = i21 * (want_x - s0x) + i22 * (want_y - s0y);
+    Vector2 target{cx + i11 * (want_x - s0x) + i12 * (want_y - s0y), i21 * (want_x - s0x) + i22 * (want_y - s0y)};
     // Quasi-Newton from the beam's Jacobian, updated by Broyden's rank-one rule from each step's
     // change on the stop: at the rim of a strongly aberrated pupil (the Sasian triplet's frame at
     // 1.2 m) the beam's Jacobian alone converges too slowly, and a ray given up there took the
     // light of its mesh triangles with it (a uniform wall rendered up to 20 % dark, in bands).
-    double b11 = j11, b12 = j12, b21 = j21, b22 = j22;
-    double n11 = i11, n12 = i12, n21 = i21, n22 = i22;
-    double last_sx = 0.0, last_sy = 0.0, step_x = 0.0, step_y = 0.0;
-    bool aimed = false;
-    for (int iteration = 0; iteration < kAimIterations; ++iteration) {
+    auto miss = [&](const Vector2& t, Vector2& r, Matrix2*) {
       double sx, sy;
-      if (!stop_point(tx, ty, sx, sy)) break;
-      const double ex = want_x - sx, ey = want_y - sy;
-      if (std::hypot(ex, ey) <= tolerance) {
-        aimed = true;
-        break;
-      }
-      if (iteration > 0) {
-        // B += (ds - B dt) dt^T / |dt|^2; its inverse recomputed (2 x 2).
-        const double step2 = step_x * step_x + step_y * step_y;
-        const double rx = (sx - last_sx) - (b11 * step_x + b12 * step_y);
-        const double ry = (sy - last_sy) - (b21 * step_x + b22 * step_y);
-        const double c11 = b11 + rx * step_x / step2, c12 = b12 + rx * step_y / step2;
-        const double c21 = b21 + ry * step_x / step2, c22 = b22 + ry * step_y / step2;
-        const double d = c11 * c22 - c12 * c21;
-        if (step2 > 0.0 && std::abs(d) > 0.0 && std::isfinite(d)) {
-          b11 = c11, b12 = c12, b21 = c21, b22 = c22;
-          n11 = c22 / d, n12 = -c12 / d, n21 = -c21 / d, n22 = c11 / d;
-        }
-      }
-      last_sx = sx, last_sy = sy;
-      step_x = n11 * ex + n12 * ey;
-      step_y = n21 * ex + n22 * ey;
-      tx += step_x;
-      ty += step_y;
-    }
-    if (!aimed) {
+      if (!stop_point(t[0], t[1], sx, sy)) return false;
+      r = {sx - want_x, sy - want_y};
+      return true;
+    };
+    // Where the beam's own aim fails (a rim ray of a strongly aberrated pupil, a beam the affine
+    // start misjudges), RayAimer's continuation; a ray neither can aim is counted as a failure.
+    if (!aim_solver.solve(miss, target, &beam_jacobian).converged() &&
+        !aim_by_ray_aimer(point, wavelength_nm, want_x, want_y, z_target, target[0], target[1])) {
       hits[i] = {};
+      unaimed_.fetch_add(1, std::memory_order_relaxed);
       continue;
     }
+    const double tx = target[0], ty = target[1];
     const Ray ray = ray_towards(point, z_persp, tx, ty, z_target, wavelength_nm, start_z);
     const double weight = target_area * patch_solid_angle(point, z_persp, tx, ty, z_target);
     // One unclipped trace: where the ray lands, and how far inside the tightest clear aperture it

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <functional>
 #include <memory>
@@ -14,6 +15,7 @@
 #include "lensmith/core/units.h"
 #include "lensmith/polyfit/lens_fit.h"
 #include "lensmith/seidel/aberration_table.h"
+#include "lensmith/trace/ray_aiming.h"
 #include "lensmith/trace/sequential_tracer.h"
 
 namespace lensmith::camera_detail {
@@ -278,12 +280,19 @@ class ExactModel final : public RayModel {
   bool affine_in_pupil() const override { return false; }
   void map(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
            std::span<SensorHit> hits) const override;
+  std::size_t unaimed_rays() const override { return unaimed_.load(std::memory_order_relaxed); }
 
  private:
   // map() without the normalisation of the weights.
   void map_raw(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil, std::span<SensorHit> hits) const;
 
+  // The stop-plane target of the ray from `point` that RayAimer (the exact tracer's tested aiming,
+  // docs/trace.md) sends through stop point (x, y) mm, checked by tracing it; false when it fails.
+  bool aim_by_ray_aimer(const ScenePoint& point, double wavelength_nm, double want_x_mm, double want_y_mm, double z_target_mm,
+                        double& target_x_mm, double& target_y_mm) const;
+
   std::shared_ptr<const SequentialTracer> free_;     // no clipping: aiming and the final trace
+  std::shared_ptr<const RayAimer> aimer_;            // on free_, real-stop aiming: where the beam's own aim fails
   // Clipping surfaces: 0-based index and semi-diameter (mm), or an explicit aperture (a central obscuration).
   struct Clip {
     std::size_t surface = 0;
@@ -297,6 +306,7 @@ class ExactModel final : public RayModel {
   double stop_radius_mm_ = 0.0;
   double z_stop_mm_ = 0.0;
   WeightNormalisation normalisation_;
+  mutable std::atomic<std::size_t> unaimed_{0};
 };
 
 // poly: a polynomial fit of the lens (lens_fit.h). Each pupil point is aimed by Newton steps on the
@@ -311,6 +321,7 @@ class PolyModel final : public RayModel {
   void map(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
            std::span<SensorHit> hits) const override;
   std::shared_ptr<const LensFit> fit() const override { return fit_; }
+  std::size_t unaimed_rays() const override { return unaimed_.load(std::memory_order_relaxed); }
 
  private:
   void map_raw(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil, std::span<SensorHit> hits) const;
@@ -320,6 +331,7 @@ class PolyModel final : public RayModel {
   std::shared_ptr<const LensFit> fit_;
   double stop_radius_mm_ = 0.0;
   WeightNormalisation normalisation_;
+  mutable std::atomic<std::size_t> unaimed_{0};
 };
 
 }  // namespace lensmith::camera_detail

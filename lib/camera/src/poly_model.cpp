@@ -7,6 +7,7 @@
 
 #include "lensmith/core/errors.h"
 #include "lensmith/core/number_parsing.h"
+#include "lensmith/core/root_solver_2d.h"
 #include "model_implementations.h"
 
 namespace lensmith::camera_detail {
@@ -40,6 +41,7 @@ PolyModel::PolyModel(const Camera& camera, std::shared_ptr<const LensFit> fit) :
                        format_number(camera.min_wavelength_nm()) + "-" + format_number(camera.max_wavelength_nm()) + " nm");
   }
   normalisation_ = weight_normalisation_for(camera, [this](auto&&... a) { map_raw(a...); });
+  unaimed_ = 0;  // the count is of the caller's rays
 }
 
 double PolyModel::outer_solid_angle(const ScenePoint& point, double z_perspective_mm, double x_mm, double y_mm) const {
@@ -68,6 +70,7 @@ void PolyModel::map_raw(const ScenePoint& point, double wavelength_nm, std::span
   const double det = j[0] * j[3] - j[1] * j[2];
   if (!centre.converged || !(std::abs(det) > 0.0)) {
     for (auto& hit : hits) hit = {};
+    unaimed_.fetch_add(hits.size(), std::memory_order_relaxed);
     return;
   }
   const std::array<double, 4> inverse{j[3] / det, -j[1] / det, -j[2] / det, j[0] / det};
@@ -75,29 +78,31 @@ void PolyModel::map_raw(const ScenePoint& point, double wavelength_nm, std::span
   // radiometric weights: the solid angle of that element of surface 1 seen from the point.
   const double outer_area = 1.0 / std::abs(det);
   const double z_persp = camera_.z_perspective_mm();
-  constexpr int kMaxChordSteps = 12;
+  // The chord steps of one pupil point: at most 12 evaluations of the fit, full steps.
+  RootSolver2dOptions chord;
+  chord.jacobian = JacobianSource::Fixed;
+  chord.line_search = false;
+  chord.tolerance = tolerance_mm;
+  chord.max_iterations = 11;
+  const RootSolver2d chord_solver(chord);
   for (std::size_t i = 0; i < pupil.size(); ++i) {
     const double sx = pupil[i].x * stop_radius_mm_, sy = pupil[i].y * stop_radius_mm_;
-    double x = centre.ray.x_mm + inverse[0] * sx + inverse[1] * sy;
-    double y = centre.ray.y_mm + inverse[2] * sx + inverse[3] * sy;
-    bool aimed = false;
-    for (int step = 0; step < kMaxChordSteps; ++step) {
-      const auto at = fit_->stop_from_object(object, x, y, wavelength_nm);
-      if (!at) break;
-      const double ex = (*at)[0] - sx, ey = (*at)[1] - sy;
-      if (ex * ex + ey * ey <= tolerance_mm * tolerance_mm) {
-        aimed = true;
-        break;
-      }
-      x -= inverse[0] * ex + inverse[1] * ey;
-      y -= inverse[2] * ex + inverse[3] * ey;
-    }
+    Vector2 on_outer{centre.ray.x_mm + inverse[0] * sx + inverse[1] * sy, centre.ray.y_mm + inverse[2] * sx + inverse[3] * sy};
+    auto miss = [&](const Vector2& u, Vector2& r, Matrix2*) {
+      const auto at = fit_->stop_from_object(object, u[0], u[1], wavelength_nm);
+      if (!at) return false;
+      r = {(*at)[0] - sx, (*at)[1] - sy};
+      return true;
+    };
+    const bool aimed = chord_solver.solve(miss, on_outer, &j).converged();
+    double x = on_outer[0], y = on_outer[1];
     if (!aimed) {
-      // Far from the centre the chord method may stall: full Newton from here.
+      // Far from the centre the chord method may stall: full Newton from its last point.
       const FitAim aim = fit_->aim_from_object(object, sx, sy, wavelength_nm, std::array<double, 2>{x, y},
                                                {tolerance_mm, 20});
       if (!aim.converged) {
         hits[i] = {};
+        unaimed_.fetch_add(1, std::memory_order_relaxed);
         continue;
       }
       x = aim.ray.x_mm;

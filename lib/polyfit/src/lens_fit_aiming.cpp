@@ -5,6 +5,7 @@
 
 #include "lens_fit_stages.h"
 #include "lensmith/core/number_parsing.h"
+#include "lensmith/core/root_solver_2d.h"
 #include "lensmith/prescription/conic_profile.h"
 
 namespace lensmith {
@@ -14,45 +15,28 @@ using polyfit_detail::normalised;
 
 namespace {
 
-// The fitted 2x2 system of a Newton aim, solved; false when singular.
-bool solve2(const std::array<double, 4>& j, double fx, double fy, double& dx, double& dy) {
-  const double det = j[0] * j[3] - j[1] * j[2];
-  if (!(std::abs(det) > 0.0) || !std::isfinite(det)) return false;
-  dx = (j[3] * fx - j[1] * fy) / det;
-  dy = (j[0] * fy - j[2] * fx) / det;
-  return true;
-}
+// Step halvings of the fits' line search: the shortest step tried is 2^-9 of Newton's.
+constexpr int kMaxStepHalvings = 9;
 
-// Damped Newton on two unknowns: `residual(u, ex, ey, jacobian or null)` gives the stop miss (mm) at
-// u and, when asked, d(miss) / du; false when u leaves the fit's domain. Each step is halved until
-// the miss falls (the stop map is nearly linear, so the full step is almost always taken). Fills
-// the iterations, miss, Jacobian and convergence of `aim`; returns the last accepted u.
+// Damped Newton on two unknowns (RootSolver2d, the Jacobian from the fit): `residual(u, r, jacobian
+// or null)` gives the stop miss (mm) at u and, when asked, d(miss) / du; false when u leaves the
+// fit's domain. Each step is halved (at most 9 times) until the miss falls: the stop map is nearly
+// linear, so the full step is almost always taken. Fills the iterations, miss, Jacobian and
+// convergence of `aim`; returns the last accepted u.
 template <class Residual>
 std::array<double, 2> damped_newton(std::array<double, 2> u, const Residual& residual, const FitAimOptions& options,
                                     FitAim& aim) {
-  double ex = 0.0, ey = 0.0;
-  std::array<double, 4> j{};
-  if (!residual(u, ex, ey, &j)) return u;
-  aim.jacobian = j;
-  aim.miss_mm = std::hypot(ex, ey);
-  for (aim.iterations = 0; aim.iterations < options.max_iterations && aim.miss_mm > options.tolerance_mm;) {
-    ++aim.iterations;
-    double sx, sy;
-    if (!solve2(j, ex, ey, sx, sy)) return u;
-    bool improved = false;
-    for (double step = 1.0; step > 1e-3 && !improved; step *= 0.5) {
-      const std::array<double, 2> trial{u[0] - step * sx, u[1] - step * sy};
-      double tx, ty;
-      if (!residual(trial, tx, ty, nullptr) || std::hypot(tx, ty) >= aim.miss_mm) continue;
-      u = trial;
-      improved = true;
-    }
-    if (!improved) return u;
-    residual(u, ex, ey, &j);
-    aim.jacobian = j;
-    aim.miss_mm = std::hypot(ex, ey);
-  }
-  aim.converged = aim.miss_mm <= options.tolerance_mm;
+  RootSolver2dOptions o;
+  o.jacobian = JacobianSource::Analytic;
+  o.tolerance = options.tolerance_mm;
+  o.max_iterations = options.max_iterations;
+  o.max_halvings = kMaxStepHalvings;
+  const RootSolver2dSummary summary = RootSolver2d(o).solve(residual, u);
+  if (summary.status == RootSolver2dStatus::FailedAtStart) return u;
+  aim.jacobian = summary.jacobian;
+  aim.miss_mm = summary.residual_norm;
+  aim.iterations = summary.iterations;
+  aim.converged = summary.converged();
   return u;
 }
 
@@ -80,7 +64,7 @@ FitAim LensFit::aim_from_sensor(double x_mm, double y_mm, double stop_x_mm, doub
   const RotationalMap& map = sensor_clip_;
   std::array<double, 2> at;
   std::array<double, 8> jac;
-  auto residual = [&](const std::array<double, 2>& u, double& ex, double& ey, std::array<double, 4>* j) {
+  auto residual = [&](const std::array<double, 2>& u, std::array<double, 2>& miss, std::array<double, 4>* j) {
     const PolyPoint va = normalised(PlaneRay{x_mm, y_mm, u[0], u[1]}, ps, ds, lambda);
     if (!in_domain(va)) return false;
     // Output 0 is the stop; its Jacobian columns 2, 3 are d/d(dx, dy) in normalised units.
@@ -90,8 +74,7 @@ FitAim LensFit::aim_from_sensor(double x_mm, double y_mm, double stop_x_mm, doub
     } else {
       at = map.evaluate_output(va, 0);
     }
-    ex = at[0] - stop_x_mm;
-    ey = at[1] - stop_y_mm;
+    miss = {at[0] - stop_x_mm, at[1] - stop_y_mm};
     return true;
   };
   const auto u = damped_newton({aim.ray.dx, aim.ray.dy}, residual, options, aim);
@@ -117,7 +100,7 @@ FitAim LensFit::aim_from_object(const ObjectPoint& o, double stop_x_mm, double s
   const RotationalMap& map = outer_clip_;
   std::array<double, 2> at;
   std::array<double, 8> jac;
-  auto residual = [&](const std::array<double, 2>& u, double& ex, double& ey, std::array<double, 4>* j) {
+  auto residual = [&](const std::array<double, 2>& u, std::array<double, 2>& miss, std::array<double, 4>* j) {
     const std::optional<OuterLine> found = outer_line(o, u[0], u[1]);
     if (!found) return false;
     const OuterLine& l = *found;
@@ -125,13 +108,11 @@ FitAim LensFit::aim_from_object(const ObjectPoint& o, double stop_x_mm, double s
     if (!in_domain(va)) return false;
     if (!j) {
       at = map.evaluate_output(va, 0);
-      ex = at[0] - stop_x_mm;
-      ey = at[1] - stop_y_mm;
+      miss = {at[0] - stop_x_mm, at[1] - stop_y_mm};
       return true;
     }
     map.evaluate_with_jacobian(va, 0, at, jac);
-    ex = at[0] - stop_x_mm;
-    ey = at[1] - stop_y_mm;
+    miss = {at[0] - stop_x_mm, at[1] - stop_y_mm};
     {
       // Chain rule through the normalisation and the direction's dependence on the outer position.
       const double* gx = jac.data();      // d stop_x / d(normalised x, y, dx, dy)

@@ -81,6 +81,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   const render_detail::PupilMeshTable meshes(aperture);
   const FootprintScatter scatter(model, aperture, groups, meshes, options);
   stats.layer_spacing_px = layers.spacing_px;
+  const std::size_t unaimed_before = model.unaimed_rays();
 
   const bool stretch = options.hidden == HiddenSurfaces::Stretch;
   LargeVector<float> layer_rgba(static_cast<std::size_t>(w) * h * 4);
@@ -199,6 +200,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   }
   stats.footprints = footprints;
   stats.triangles = triangles;
+  stats.unaimed_rays = model.unaimed_rays() - unaimed_before;
   return render_detail::finish_composite(result, w, h);
 }
 
@@ -296,6 +298,7 @@ std::string BokehStatistics::to_string() const {
      << " moved, " << footprints << " footprints, " << triangles << " triangles, "
      << clamped_depths << " clamped depths, max |CoC| " << max_abs_coc_px << " px";
   if (deep_samples > 0) os << ", " << deep_samples << " deep samples, " << volume_slabs << " volume slabs";
+  if (unaimed_rays > 0) os << ", " << unaimed_rays << " rays not aimed";
   os << ")";
   return os.str();
 }

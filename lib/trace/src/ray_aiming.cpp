@@ -15,6 +15,7 @@
 #include <Eigen/Geometry>  // cross product
 
 #include "lensmith/core/errors.h"
+#include "lensmith/core/root_solver_2d.h"
 #include "lensmith/core/units.h"
 #include "lensmith/prescription/lens_file.h"
 
@@ -174,16 +175,6 @@ bool runs_forward(const std::vector<SurfaceHit>& path, const std::vector<char>& 
     along = &hit.direction_after;
   }
   return true;
-}
-
-// 2x2 solve J x = b by Cramer's rule; false when J is singular.
-bool solve_2x2(const Eigen::Vector2d& column_x, const Eigen::Vector2d& column_y, const Eigen::Vector2d& b,
-               Eigen::Vector2d& x) {
-  const double determinant = column_x.x() * column_y.y() - column_y.x() * column_x.y();
-  if (!(std::abs(determinant) > 0.0) || !std::isfinite(determinant)) return false;
-  x = Eigen::Vector2d((column_y.y() * b.x() - column_y.x() * b.y()) / determinant,
-                      (column_x.x() * b.y() - column_x.y() * b.x()) / determinant);
-  return x.allFinite();
 }
 
 }  // namespace
@@ -459,46 +450,34 @@ RayAimer::StopSolver::Backward RayAimer::StopSolver::backward(const Target& t, c
   return out;
 }
 
-// Damped Newton on the backward residual from v (updated in place to the best point found), at most
-// max_iterations steps and no more than the ray has left.
+// Damped Newton (RootSolver2d: forward differences, a trust region, Armijo backtracking) on the
+// backward residual from v (updated in place to the best point found), at most max_iterations steps
+// and no more than the ray has left.
 RayAimer::StopSolver::Outcome RayAimer::StopSolver::newton(const Target& t, Eigen::Vector2d& v, Backward& at_v,
                                                           double tolerance, int max_iterations, Work& work) const {
-  at_v = backward(t, v, work);
-  if (!at_v.alive()) return Outcome::Died;
-  for (int iteration = 0;; ++iteration) {
-    const double size = at_v.residual.norm();
-    if (size <= tolerance) return at_v.right_way ? Outcome::Converged : Outcome::Stalled;
-    if (iteration >= max_iterations || work.iterations_left <= 0) return Outcome::OutOfIterations;
-    --work.iterations_left;
-    // Forward differences, or backward ones where the forward neighbour's trace dies (a ray near a rim).
-    Eigen::Vector2d columns[2];
-    for (int axis = 0; axis < 2; ++axis) {
-      Eigen::Vector2d offset(0.0, 0.0);
-      offset[axis] = kTangentStep;
-      Backward side = backward(t, v + offset, work);
-      if (!side.alive()) {
-        offset = -offset;
-        side = backward(t, v + offset, work);
-        if (!side.alive()) return Outcome::Stalled;
-      }
-      columns[axis] = (side.residual - at_v.residual) / offset[axis];
-    }
-    Eigen::Vector2d step;
-    if (!solve_2x2(columns[0], columns[1], -at_v.residual, step)) return Outcome::Stalled;
-    if (step.norm() > kMaxTangentStep) step *= kMaxTangentStep / step.norm();
-    bool moved = false;
-    double fraction = 1.0;
-    for (int halving = 0; halving <= kMaxStepHalvings; ++halving, fraction *= 0.5) {
-      const Eigen::Vector2d trial = v + fraction * step;
-      const Backward at_trial = backward(t, trial, work);
-      if (at_trial.alive() && at_trial.residual.norm() <= (1.0 - kArmijo * fraction) * size) {
-        v = trial;
-        at_v = at_trial;
-        moved = true;
-        break;
-      }
-    }
-    if (!moved) return Outcome::Stalled;
+  RootSolver2dOptions o;
+  o.tolerance = tolerance;
+  o.max_iterations = std::max(0, std::min(max_iterations, work.iterations_left));
+  o.difference_step = kTangentStep;
+  o.max_step = kMaxTangentStep;
+  o.armijo = kArmijo;
+  o.max_halvings = kMaxStepHalvings;
+  Backward last;
+  auto residual = [&](const Vector2& x, Vector2& r, Matrix2*) {
+    last = backward(t, Eigen::Vector2d(x[0], x[1]), work);
+    if (!last.alive()) return false;
+    r = {last.residual.x(), last.residual.y()};
+    return true;
+  };
+  Vector2 x{v.x(), v.y()};
+  const RootSolver2dSummary summary = RootSolver2d(o).solve(residual, x, nullptr, [&] { at_v = last; });
+  v = Eigen::Vector2d(x[0], x[1]);
+  work.iterations_left -= summary.iterations;
+  switch (summary.status) {
+    case RootSolver2dStatus::Converged: return at_v.right_way ? Outcome::Converged : Outcome::Stalled;
+    case RootSolver2dStatus::FailedAtStart: at_v = last; return Outcome::Died;
+    case RootSolver2dStatus::OutOfIterations: return Outcome::OutOfIterations;
+    default: return Outcome::Stalled;  // a dead neighbour on both sides, a singular Jacobian, no decrease
   }
 }
 
@@ -579,40 +558,24 @@ bool RayAimer::StopSolver::polish(const Target& t, const Backward& solved, Ray& 
     w = Eigen::Vector2d(g.dot(t.u1), g.dot(t.u2)) / g.dot(t.nominal);
     step /= std::max((ep_centre - t.beam.origin).norm(), std::max(ep_radius_mm, stop_radius_mm));
   }
-  Eigen::Vector2d residual;
-  if (!miss(w, residual)) return false;
-  for (;;) {
-    const double size = residual.norm();
-    if (size <= options.tolerance_mm) break;
-    if (work.iterations_left <= 0) return false;
-    --work.iterations_left;
-    Eigen::Vector2d columns[2];
-    for (int axis = 0; axis < 2; ++axis) {
-      Eigen::Vector2d offset(0.0, 0.0);
-      offset[axis] = step;
-      Eigen::Vector2d side;
-      if (!miss(w + offset, side)) {
-        offset = -offset;
-        if (!miss(w + offset, side)) return false;
-      }
-      columns[axis] = (side - residual) / offset[axis];
-    }
-    Eigen::Vector2d newton_step;
-    if (!solve_2x2(columns[0], columns[1], -residual, newton_step)) return false;
-    bool moved = false;
-    double fraction = 1.0;
-    for (int halving = 0; halving <= kMaxStepHalvings; ++halving, fraction *= 0.5) {
-      Eigen::Vector2d trial_residual;
-      const Eigen::Vector2d trial = w + fraction * newton_step;
-      if (miss(trial, trial_residual) && trial_residual.norm() < size) {
-        w = trial;
-        residual = trial_residual;
-        moved = true;
-        break;
-      }
-    }
-    if (!moved) return false;
-  }
+  // Newton (RootSolver2d) on the miss, differences of `step`, halving until the miss falls.
+  if (!(std::isfinite(step) && step > 0.0)) return false;  // a pupil of no size
+  RootSolver2dOptions o;
+  o.tolerance = options.tolerance_mm;
+  o.max_iterations = std::max(0, work.iterations_left);
+  o.difference_step = step;
+  o.max_halvings = kMaxStepHalvings;
+  auto residual = [&](const Vector2& x, Vector2& r, Matrix2*) {
+    Eigen::Vector2d e;
+    if (!miss(Eigen::Vector2d(x[0], x[1]), e)) return false;
+    r = {e.x(), e.y()};
+    return true;
+  };
+  Vector2 x{w.x(), w.y()};
+  const RootSolver2dSummary summary = RootSolver2d(o).solve(residual, x);
+  work.iterations_left -= summary.iterations;
+  if (!summary.converged()) return false;
+  w = Eigen::Vector2d(x[0], x[1]);
   ray = make(w);
   return true;
 }

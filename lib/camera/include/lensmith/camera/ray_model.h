@@ -93,6 +93,10 @@ class RayModel {
   const Camera& camera() const { return camera_; }
   // The polynomial fit the poly model maps through; null for the other models.
   virtual std::shared_ptr<const LensFit> fit() const { return nullptr; }
+  // Rays map() could not aim at their pupil point since the model was made (exact, poly; 0 for the
+  // first-order models, which need no aiming). Such a ray comes back as neither ok nor unclipped:
+  // drawn as stopped, it is a failure of the model, not vignetting, and callers report it.
+  virtual std::size_t unaimed_rays() const { return 0; }
   virtual std::string to_string() const;
   friend std::ostream& operator<<(std::ostream& os, const RayModel& m) { return os << m.to_string(); }
 

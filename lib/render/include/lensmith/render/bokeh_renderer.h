@@ -78,6 +78,7 @@ struct BokehStatistics {
   double max_abs_coc_px = 0.0;      // largest |signed CoC| among the source pixels
   std::size_t deep_samples = 0;     // samples of a layered (deep) input
   std::size_t volume_slabs = 0;     // slabs its volumetric samples were cut into
+  std::size_t unaimed_rays = 0;     // rays the model could not aim (RayModel::unaimed_rays), drawn as stopped
   std::string to_string() const;
 };
 
