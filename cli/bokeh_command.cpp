@@ -12,6 +12,7 @@
 
 #include "commands.h"
 #include "progress_bar.h"
+#include "lensmith/camera/camera_spec.h"
 #include "lensmith/color/color_management.h"
 #include "lensmith/color/rgb_primaries.h"
 #include "lensmith/core/errors.h"
@@ -547,8 +548,8 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     const double d = *metadata.focus_from_image_plane_m;
     camera.focus_distance_m = metadata.entrance_pupil_offset_mm
                                   ? d - m_from_mm(*metadata.entrance_pupil_offset_mm)
-                                  : pupil_focus_distance_m(kind, lens ? &*lens : nullptr, o.thin_lens ? thin_focal_mm : std::nullopt, camera,
-                                                           width, height, d);
+                                  : CameraSpec{o.thin_lens ? thin_focal_mm : std::nullopt, camera, width, height}.pupil_focus_distance_m(
+                                        kind, lens ? &*lens : nullptr, d);
     used.push_back("focus " + format_number(d) + " m from the image plane = " + format_rounded(camera.focus_distance_m, 6) +
                    " m from the entrance pupil" + (metadata.entrance_pupil_offset_mm ? " (its entrancePupilOffset)" : " (the lens's)"));
   }
@@ -557,8 +558,8 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     for (std::size_t i = 0; i < used.size(); ++i) std::cerr << (i ? "," : "") << " " << used[i];
     std::cerr << " (the flags override it)\n";
   }
-  std::optional<Camera> cam = camera_for_model(kind, lens ? &*lens : nullptr, o.thin_lens ? thin_focal_mm : std::nullopt, camera,
-                                               width, height);
+  std::optional<Camera> cam =
+      CameraSpec{o.thin_lens ? thin_focal_mm : std::nullopt, camera, width, height}.camera(kind, lens ? &*lens : nullptr);
   if (!cam->is_thin_lens()) warn_about_aperture(*cam, global);
   extras.squeezed_width = anamorphic_output_width(*cam, extras.data_width, o.desqueeze, global);
   if (extras.squeezed_width > 0 && windows.has_overscan()) {

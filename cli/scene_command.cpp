@@ -13,6 +13,7 @@
 #include "commands.h"
 #include "progress_bar.h"
 #include "lensmith/camera/camera.h"
+#include "lensmith/camera/camera_spec.h"
 #include "lensmith/core/errors.h"
 #include "lensmith/core/number_parsing.h"
 #include "lensmith/paraxial/paraxial_system.h"
@@ -116,7 +117,7 @@ int run_scene_render(const SceneRenderOptions& o, const GlobalOptions& global) {
     int squeezed_width = 0;
     if (o.thin_lens) {
       if (!o.focal_length_mm) throw UsageError("--thin-lens needs --focal-length MM");
-      camera = Camera::thin_lens(*o.focal_length_mm, camera_options, o.width_px, o.height_px);
+      camera = CameraSpec{*o.focal_length_mm, camera_options, o.width_px, o.height_px}.camera(RayModelKind::Thin, nullptr);
       meta.lens = "thin lens f = " + format_number(*o.focal_length_mm) + " mm";
       meta.model = "thin lens ground truth";
       out = render_through_thin_lens(scene, *camera, options);
@@ -124,7 +125,7 @@ int run_scene_render(const SceneRenderOptions& o, const GlobalOptions& global) {
       const Prescription lens = load_lens(o.lens, global);
       meta.lens = lens.name.empty() ? o.lens : lens.name;
       meta.model = "exact trace ground truth";
-      camera = Camera::from_lens(lens, camera_options, o.width_px, o.height_px);
+      camera = CameraSpec{std::nullopt, camera_options, o.width_px, o.height_px}.camera(RayModelKind::Exact, &lens);
       warn_about_aperture(*camera, global);
       squeezed_width = anamorphic_output_width(*camera, o.width_px, o.desqueeze, global);
       out = render_through_lens(scene, *camera, options);

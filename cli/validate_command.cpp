@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "commands.h"
+#include "lensmith/camera/camera_spec.h"
 #include "lensmith/core/errors.h"
 #include "lensmith/core/text_file.h"
 #include "lensmith/plot/canvas.h"
@@ -22,7 +23,7 @@ int run_validate(const ValidateCommandOptions& o, const GlobalOptions& global) {
   CameraOptions camera_options;
   camera_options.focus_distance_m = o.focus_m;
   camera_options.f_number = o.f_number;
-  const Camera camera = Camera::from_lens(lens, camera_options, o.width_px, o.height_px);
+  const Camera camera = CameraSpec{std::nullopt, camera_options, o.width_px, o.height_px}.camera(RayModelKind::Exact, &lens);
   warn_about_aperture(camera, global);
   std::vector<RayModelKind> models;
   for (const std::string& m : o.models) models.push_back(parse_ray_model_kind(m));

@@ -13,6 +13,7 @@
 #include "bindings.h"
 #include "lensmith/camera/aperture.h"
 #include "lensmith/camera/camera.h"
+#include "lensmith/camera/camera_spec.h"
 #include "lensmith/camera/ray_model.h"
 #include "lensmith/core/errors.h"
 #include "lensmith/paraxial/paraxial_system.h"
@@ -198,7 +199,7 @@ py::array_t<float> render(const py::array& image, const py::array& depth, py::di
   } else {
     throw UsageError("give focus_m (metres from the entrance pupil) or focus_pixel (x, y)");
   }
-  const std::optional<Camera> cam = camera_for_model(kind, lens ? &*lens : nullptr, thin_focal_mm, camera, width, height);
+  const std::optional<Camera> cam = CameraSpec{thin_focal_mm, camera, width, height}.camera(kind, lens ? &*lens : nullptr);
   float nearest_m = std::numeric_limits<float>::infinity();
   for (float z : depth_map.z_m) nearest_m = std::min(nearest_m, z);
   RayModelOptions model_options;

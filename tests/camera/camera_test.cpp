@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "lensmith/camera/camera_spec.h"
 #include "lensmith/camera/ray_model.h"
 #include "lensmith/core/errors.h"
 #include "lensmith/core/units.h"
@@ -27,49 +28,63 @@ std::vector<SensorHit> hits(const RayModel& m, const ScenePoint& p, double wavel
 }
 
 const std::vector<PupilPoint> kPupil{{0.0, 0.0}, {0.0, 0.7}, {0.0, -0.7}, {0.7, 0.0}, {0.5, 0.5}, {-0.3, 0.6}, {0.0, 0.95}};
+// A few double operations on lengths of 1-2000 mm, or a sum of a hundred weights: a few ulps (2.2e-16) each.
+constexpr double kDoubleRounding = 1e-12;
 
 }  // namespace
 
 TEST_CASE("A thin-lens camera puts the sensor at f s / (s - f) and frames the focus plane like the pinhole image", "[camera]") {
   const double f = 50.0, s = 2000.0;
   const Camera cam = Camera::thin_lens(f, options(2.0, 2.8), 640, 480);
-  CHECK(cam.z_sensor_mm() == Approx(f * s / (s - f)).epsilon(1e-12));
+  CHECK(cam.z_sensor_mm() == Approx(f * s / (s - f)).epsilon(kDoubleRounding));
   // A point on the focus plane images on its own pixel, whatever its depth-of-field blur elsewhere.
   const auto model = make_ray_model(RayModelKind::Thin, cam);
   const PixelPoint input{100.5, 40.5};
   const Tangents t = cam.frame().tangents_at(input);
   for (const SensorHit& h : hits(*model, {t.x, t.y, 1.0 / s}, 550.0, kPupil)) {
     const PixelPoint out = cam.output_pixel(h.x_mm, h.y_mm);
-    CHECK(out.x == Approx(input.x).epsilon(1e-12));
-    CHECK(out.y == Approx(input.y).epsilon(1e-12));
+    CHECK(out.x == Approx(input.x).epsilon(kDoubleRounding));
+    CHECK(out.y == Approx(input.y).epsilon(kDoubleRounding));
   }
 }
 
 TEST_CASE("The signed circle of confusion follows the thin-lens formula, positive in front of the focus plane", "[camera]") {
+  // A difference of two image distances (~87 mm) only 0.09 mm apart near focus: rounding amplified ~1000 times, ~1e-13.
+  constexpr double kCocCancellation = 1e-9;
   const double f = 85.0, n = 1.8, s = 3000.0;
   const Camera cam = Camera::thin_lens(f, options(3.0, n), 1000, 600);
   const double pitch_mm = 36.0 / 1000.0;
   for (const double z : {500.0, 1500.0, 2900.0, 3100.0, 10000.0, 1e9}) {
     const double expected = (f / n) * f * (s - z) / (z * s) / pitch_mm;
-    CHECK(cam.signed_coc_px(1.0 / z) == Approx(expected).epsilon(1e-9));
+    CHECK(cam.signed_coc_px(1.0 / z) == Approx(expected).epsilon(kCocCancellation));
   }
-  CHECK(cam.signed_coc_px(0.0) == Approx(-(f / n) * f / s / pitch_mm).epsilon(1e-9));
+  CHECK(cam.signed_coc_px(0.0) == Approx(-(f / n) * f / s / pitch_mm).epsilon(kCocCancellation));
 }
 
 TEST_CASE("A lens camera focused at infinity puts the sensor at the rear focal point, and the perspective centre at the entrance pupil",
           "[camera]") {
+  // The camera interpolates its first-order data linearly between 64 wavelengths 6.3 nm apart; ParaxialSystem is exact there.
+  constexpr double kSpectralTable = 1e-6;
+  // The camera keeps the f-number it is given (the lens's own): no arithmetic at all; not derived, loose.
+  constexpr double kStoredFNumber = 1e-9;
   const Prescription lens = LensLibrary::load("pbrt-dgauss-50mm").prescription;
   const ParaxialSystem p(lens);
   CameraOptions o = options(kInfinity, p.f_number());
   o.reference_wavelength_nm = p.wavelength_nm();
   const Camera cam = Camera::from_lens(lens, o, 640, 480);
-  CHECK(cam.z_sensor_mm() == Approx(p.z_rear_focal_mm()).epsilon(1e-6));
-  CHECK(cam.z_perspective_mm() == Approx(p.entrance_pupil().z_mm).epsilon(1e-6));
-  CHECK(cam.f_number() == Approx(p.f_number()).epsilon(1e-9));
+  CHECK(cam.z_sensor_mm() == Approx(p.z_rear_focal_mm()).epsilon(kSpectralTable));
+  CHECK(cam.z_perspective_mm() == Approx(p.entrance_pupil().z_mm).epsilon(kSpectralTable));
+  CHECK(cam.f_number() == Approx(p.f_number()).epsilon(kStoredFNumber));
 }
 
 TEST_CASE("On the focus plane the Seidel model with the Seidel sums displaces rays by Born & Wolf's aberration vector, and the paraxial model not at all",
           "[camera]") {
+  // The paraxial model puts the focus plane's axial point on the axis: 0 but for rounding (Approx(0) needs a margin).
+  constexpr double kAxialHit_mm = 1e-12;
+  // Allowance, not derived: the model interpolates B in its table (12 distances, 64 wavelengths); this analysis is at the focus.
+  constexpr double kSeidelTable = 0.02;
+  // The pupil centre's ray has no spherical aberration: 0 but for rounding (Approx(0) needs a margin).
+  constexpr double kPupilCentre_mm = 1e-9;
   const Prescription lens = LensLibrary::load("sasian-triplet").prescription;
   const Camera cam = Camera::from_lens(lens, options(5.0, 4.0), 640, 480);
   const auto paraxial = make_ray_model(RayModelKind::Paraxial, cam);
@@ -78,8 +93,8 @@ TEST_CASE("On the focus plane the Seidel model with the Seidel sums displaces ra
   const ScenePoint on_axis{0.0, 0.0, w};
   const auto p = hits(*paraxial, on_axis, cam.reference_wavelength_nm(), kPupil);
   for (const SensorHit& h : p) {
-    CHECK(h.x_mm == Approx(0.0).margin(1e-12));
-    CHECK(h.y_mm == Approx(0.0).margin(1e-12));
+    CHECK(h.x_mm == Approx(0.0).margin(kAxialHit_mm));
+    CHECK(h.y_mm == Approx(0.0).margin(kAxialHit_mm));
   }
   // On axis only spherical aberration: B rho^3 radially, from the table's coefficients.
   SeidelOptions so;
@@ -92,7 +107,7 @@ TEST_CASE("On the focus plane the Seidel model with the Seidel sums displaces ra
   for (std::size_t i = 0; i < kPupil.size(); ++i) {
     const double rho = std::hypot(kPupil[i].x, kPupil[i].y);
     const double radial = std::hypot(s[i].x_mm, s[i].y_mm);
-    CHECK(radial == Approx(std::abs(c.B_mm) * rho * rho * rho).epsilon(0.02).margin(1e-9));
+    CHECK(radial == Approx(std::abs(c.B_mm) * rho * rho * rho).epsilon(kSeidelTable).margin(kPupilCentre_mm));
   }
 }
 
@@ -163,6 +178,8 @@ TEST_CASE("Stopped down, where the third order is all there is, the fitted coeff
   // Physics: higher-order spherical aberration falls as a higher power of the aperture than the
   // third order (rho^5 against rho^3), so at f/11 the real rays' least-squares third order is the
   // third order: on axis, the two spots agree within 15 %, with and without a fit.
+  // What remains of the higher orders at f/11 (rho^5 against rho^3), and the fit's least squares over a 24 x 24 grid.
+  constexpr double kStoppedDownSpot = 0.15;
   const Prescription lens = LensLibrary::load("pbrt-dgauss-50mm").prescription;
   const Camera cam = Camera::from_lens(lens, options(1.2, 11.0), 1920, 1080);
   const auto fitted = make_ray_model(RayModelKind::Seidel, cam, {0.5, 12, {}, SeidelCoefficients::Fitted});
@@ -171,7 +188,7 @@ TEST_CASE("Stopped down, where the third order is all there is, the fitted coeff
   const double with_fit = rms_spot_mm(*fitted, on_axis, cam.reference_wavelength_nm());
   const double with_sums = rms_spot_mm(*sums, on_axis, cam.reference_wavelength_nm());
   INFO("RMS spot at f/11: fitted " << with_fit * 1e3 << " um, sums " << with_sums * 1e3 << " um");
-  CHECK(with_fit == Approx(with_sums).epsilon(0.15));
+  CHECK(with_fit == Approx(with_sums).epsilon(kStoppedDownSpot));
 }
 
 TEST_CASE("Seidel converges to paraxial as the aperture closes: the aberrated spot shape shrinks at least as 1/N", "[camera]") {
@@ -260,14 +277,14 @@ TEST_CASE("A stop point no ray can reach is counted as a failure of the exact mo
 
 TEST_CASE("Apertures: blades are regular polygons on the unit circle, meshes carry all the light", "[camera]") {
   const Aperture hexagon = Aperture::blades(6, 0.0);
-  CHECK(hexagon.effective_area() == Approx(1.5 * std::sqrt(3.0)).epsilon(1e-12));
+  CHECK(hexagon.effective_area() == Approx(1.5 * std::sqrt(3.0)).epsilon(kDoubleRounding));
   CHECK(hexagon.edge_radius(kPi / 2.0) == Approx(1.0));                    // a corner at the top
   CHECK(hexagon.edge_radius(kPi / 2.0 + kPi / 6.0) == Approx(std::sqrt(3.0) / 2.0));  // mid-edge
   for (const Aperture& a : {Aperture::circular(), hexagon}) {
     const PupilMesh m = a.mesh(4, 24);
     double sum = 0.0;
     for (const PupilTriangle& t : m.triangles) sum += t.weight;
-    CHECK(sum == Approx(1.0).epsilon(1e-12));
+    CHECK(sum == Approx(1.0).epsilon(kDoubleRounding));
   }
   CHECK_THROWS_AS(Aperture::blades(2, 0.0), OptionsError);
   CHECK_THROWS_AS(Aperture::mask(4, 4, std::vector<float>(16, 0.0f)), OptionsError);
@@ -325,6 +342,8 @@ TEST_CASE("Clipping the pupil by a clear aperture's disc leaves the area of two 
   // acos(u) + R^2 acos(v) - sqrt((-d + 1 + R)(d + 1 - R)(d - 1 + R)(d + 1 + R)) / 2,
   // u = (d^2 + 1 - R^2) / 2d, v = (d^2 + R^2 - 1) / 2dR (the circle-circle lens, e.g. Weisstein,
   // MathWorld "Circle-Circle Intersection"). The pupil is a 512-gon (area within 3e-5 of pi).
+  // clip_pupil_polygon draws the disc's arc in chords of at most 0.1 rad, each losing 1 - sin(0.1) / 0.1 = 1.7e-3 of its sector.
+  constexpr double kArcChords = 2e-3;
   const std::vector<PupilPoint> pupil = Aperture::circular().outline(512);
   std::vector<PupilPoint> out, work;
   for (const auto& [d, r] : std::vector<std::pair<double, double>>{{1.2, 1.0}, {0.5, 0.8}, {1.5, 2.0}, {0.3, 2.0}}) {
@@ -341,7 +360,7 @@ TEST_CASE("Clipping the pupil by a clear aperture's disc leaves the area of two 
                  0.5 * std::sqrt((-d + 1.0 + r) * (d + 1.0 - r) * (d - 1.0 + r) * (d + 1.0 + r));
     }
     INFO("disc at distance " << d << ", radius " << r);
-    CHECK(pupil_polygon_area(out) == Approx(expected).epsilon(2e-3));
+    CHECK(pupil_polygon_area(out) == Approx(expected).epsilon(kArcChords));
   }
   // Two discs in turn, and one that misses the pupil.
   const std::vector<PupilDisc> both{{1.2, 0.0, 1.0}, {-1.2, 0.0, 1.0}};
@@ -358,9 +377,11 @@ TEST_CASE("Opened beyond its clear apertures, a lens says at which f-number they
   // Outside truth: the exact model traces a polar grid of the iris on the axis of the focus plane
   // and counts the rays the clear apertures pass. To first order the apertures' images in the pupil
   // are discs centred on it, so the share that passes is (N / N_clear)^2.
+  // The real marginal heights differ from the paraxial ones by a few percent at f/1.4; the iris grid is 64 x 32.
+  constexpr double kRealMarginalRays = 0.03;
   const Prescription lens = LensLibrary::load("pbrt-dgauss-50mm").prescription;
   const Camera cam = Camera::from_lens(lens, options(1.2, 1.4), 640, 360);
-  CHECK(cam.design_f_number() == Approx(ParaxialSystem(lens).f_number()).epsilon(1e-12));
+  CHECK(cam.design_f_number() == Approx(ParaxialSystem(lens).f_number()).epsilon(kDoubleRounding));
   const double clear = cam.fastest_unclipped_f_number();
   REQUIRE(clear > 1.4);
   const auto exact = make_ray_model(RayModelKind::Exact, cam);
@@ -382,7 +403,7 @@ TEST_CASE("Opened beyond its clear apertures, a lens says at which f-number they
   const double first_order = (1.4 / clear) * (1.4 / clear);
   INFO("fastest unclipped f/" << clear << ": first-order share " << first_order << ", exact " << passing / total);
   // The real marginal heights differ from the paraxial ones by a few percent at f/1.4.
-  CHECK(passing / total == Approx(first_order).margin(0.03));
+  CHECK(passing / total == Approx(first_order).margin(kRealMarginalRays));
   // Stopped down past it, nothing but the iris clips on the axis.
   CHECK(Camera::from_lens(lens, options(1.2, 2.2), 640, 360).fastest_unclipped_f_number() < 2.2);
 }
@@ -406,14 +427,43 @@ TEST_CASE("a focus distance from the image plane becomes the thin lens's distanc
           "[camera][focus]") {
   // Thin lens (Hecht, Optics, 5.2.3): object at s from the lens images at v = f s / (s - f); the lens is
   // its own pupil, so the image plane is v behind it and D = s + v.
+  // The fixed-point iteration stops when a step is under 1e-12 of the distance; 1e-10 is a hundred times that.
+  constexpr double kFocusIteration = 1e-10;
   const double f = 50.0, s_m = 1.2;
   const double d_m = s_m + f * s_m * 1000.0 / (s_m * 1000.0 - f) / 1000.0;
-  lensmith::CameraOptions options;
-  options.f_number = 2.0;
-  const double solved = lensmith::pupil_focus_distance_m(lensmith::RayModelKind::Thin, nullptr, f, options, 64, 36, d_m);
-  CHECK(solved == Approx(s_m).epsilon(1e-10));
-  CHECK_THROWS_AS(lensmith::pupil_focus_distance_m(lensmith::RayModelKind::Thin, nullptr, f, options, 64, 36, 0.1),
-                  lensmith::ComputationError);
+  lensmith::CameraSpec spec;
+  spec.thin_lens_focal_length_mm = f;
+  spec.options.f_number = 2.0;
+  spec.width_px = 64;
+  spec.height_px = 36;
+  const double solved = spec.pupil_focus_distance_m(lensmith::RayModelKind::Thin, nullptr, d_m);
+  CHECK(solved == Approx(s_m).epsilon(kFocusIteration));
+  CHECK_THROWS_AS(spec.pupil_focus_distance_m(lensmith::RayModelKind::Thin, nullptr, 0.1), lensmith::ComputationError);
+}
+
+TEST_CASE("A camera specification makes the camera each model needs, and refuses what cannot be photographed", "[camera][spec]") {
+  const Prescription lens = LensLibrary::load("pbrt-dgauss-50mm").prescription;
+  lensmith::CameraSpec spec;
+  spec.options.focus_distance_m = 3.0;
+  spec.width_px = 64;
+  spec.height_px = 36;
+  // A prescription: the exact camera at the lens's own f-number; the thin model: the ideal thin lens of
+  // the lens's paraxial focal length and f-number (ParaxialSystem is the outside truth here).
+  const Camera exact = spec.camera(RayModelKind::Exact, &lens);
+  CHECK_FALSE(exact.is_thin_lens());
+  const Camera thin = spec.camera(RayModelKind::Thin, &lens);
+  CHECK(thin.is_thin_lens());
+  CHECK(thin.f_number() == Approx(ParaxialSystem(lens).f_number()).epsilon(kDoubleRounding));
+  // A thin lens of its own: only the thin model; no lens at all: refused.
+  spec.thin_lens_focal_length_mm = 50.0;
+  spec.options.f_number = 2.0;
+  CHECK(spec.camera(RayModelKind::Thin, nullptr).is_thin_lens());
+  CHECK_THROWS_AS(spec.camera(RayModelKind::Exact, nullptr), lensmith::UsageError);
+  spec.thin_lens_focal_length_mm.reset();
+  CHECK_THROWS_AS(spec.camera(RayModelKind::Paraxial, nullptr), lensmith::UsageError);
+  spec.width_px = 0;
+  CHECK_THROWS_WITH(spec.camera(RayModelKind::Exact, &lens), Catch::Contains("frame is 0 x 36"));
+  CHECK(spec.to_string() == "CameraSpec(a prescription, f/2, focus 3 m, 0 x 36 px)");
 }
 
 TEST_CASE("The exact model maps a point 1e10 m away (a renderer's sky depth) as it maps a point at infinity", "[camera]") {

@@ -76,40 +76,6 @@ LensFitOptions lens_fit_options_for(const Camera& camera) {
   return o;
 }
 
-Camera camera_for_model(RayModelKind kind, const Prescription* lens, std::optional<double> thin_lens_focal_length_mm,
-                        CameraOptions options, int width_px, int height_px) {
-  if (thin_lens_focal_length_mm) {
-    if (kind != RayModelKind::Thin) {
-      throw UsageError("an ideal thin lens has no prescription: only the thin model applies (got " + std::string(to_string(kind)) + ")");
-    }
-    return Camera::thin_lens(*thin_lens_focal_length_mm, options, width_px, height_px);
-  }
-  if (!lens) throw UsageError("a camera needs a lens (a prescription) or a thin lens's focal length");
-  if (kind == RayModelKind::Thin) {
-    const ParaxialSystem paraxial(*lens);
-    if (!options.f_number) options.f_number = paraxial.f_number();
-    return Camera::thin_lens(paraxial.efl_mm(), options, width_px, height_px);
-  }
-  return Camera::from_lens(*lens, options, width_px, height_px);
-}
-
-double pupil_focus_distance_m(RayModelKind kind, const Prescription* lens, std::optional<double> thin_lens_focal_length_mm,
-                              CameraOptions options, int width_px, int height_px, double image_plane_distance_m) {
-  double s = image_plane_distance_m;
-  for (int step = 0; step < 50; ++step) {
-    options.focus_distance_m = s;
-    const Camera camera = camera_for_model(kind, lens, thin_lens_focal_length_mm, options, width_px, height_px);
-    const double next = image_plane_distance_m - m_from_mm(camera.z_sensor_mm() - camera.z_perspective_mm());
-    if (!(next > 0.0)) {
-      throw ComputationError("a focus distance of " + format_number(image_plane_distance_m) +
-                             " m from the image plane is shorter than the lens's own length to its sensor: the lens cannot focus there");
-    }
-    if (std::abs(next - s) <= 1e-12 * image_plane_distance_m) return next;
-    s = next;
-  }
-  throw ComputationError("focus " + format_number(image_plane_distance_m) + " m from the image plane: no focus distance from the pupil found");
-}
-
 std::unique_ptr<RayModel> make_ray_model(RayModelKind kind, const Camera& camera, const RayModelOptions& options) {
   options.validate();
   if (kind == RayModelKind::Thin) {

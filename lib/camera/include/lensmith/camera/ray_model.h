@@ -139,22 +139,7 @@ struct RayModelOptions {
 // made for a render covers what is rendered.
 LensFitOptions lens_fit_options_for(const Camera& camera);
 
-// The camera a model of `kind` renders with (one rule for the command and the Python module): the
-// ideal thin lens of `thin_lens_focal_length_mm` when given (kind must then be Thin); for Thin with a
-// prescription, the ideal thin lens of the lens's focal length and, unless `options` set one, its
-// f-number; otherwise the prescription (Camera::from_lens). Throws UsageError for a thin lens with
-// another kind or neither lens nor focal length, and what the Camera factories throw.
-Camera camera_for_model(RayModelKind kind, const Prescription* lens, std::optional<double> thin_lens_focal_length_mm,
-                        CameraOptions options, int width_px, int height_px);
-
-// The focus distance from the entrance pupil (what CameraOptions::focus_distance_m means) of a
-// camera focused at `image_plane_distance_m` from its image plane, as camera metadata measures it
-// (OpenEXR's focus): the sensor-to-pupil distance grows as the lens focuses nearer, so it is solved
-// by fixed-point iteration on camera_for_model's sensor position (converging in a few steps: the
-// sensor moves by the focus change times the squared magnification). Throws ComputationError when
-// the distance is too short for the lens to focus.
-double pupil_focus_distance_m(RayModelKind kind, const Prescription* lens, std::optional<double> thin_lens_focal_length_mm,
-                              CameraOptions options, int width_px, int height_px, double image_plane_distance_m);
+// The camera a model renders with: CameraSpec::camera (camera_spec.h).
 
 // Thin needs a thin-lens camera; the others a camera made from a prescription. Throws OptionsError
 // for a mismatch (poly: a fit of another lens, a stop wider than the fit's, a frame or wavelength
