@@ -32,6 +32,13 @@ std::string value_of(const std::vector<std::pair<std::string, std::string>>& met
   return "";
 }
 
+// The scatter keeps each source's coverage exactly and nothing reaches the frame's edge: the multiview bound, not derived here.
+constexpr double kScatterCoverage = 0.02;
+// The frame's corner lies more than 12 px beyond the blurred square's reach: 0 (Approx(0) needs a margin), float-sized.
+constexpr double kUntouchedAlpha = 1e-4;
+// The element's premultiplied 0.5 goes with the coverage that alpha carries (thin lens: one colour group); headroom, not derived.
+constexpr double kScatterColour = 0.01;
+
 // A CG element over nothing as a deep image (as renderers write one): one opaque sample per pixel
 // of a 16 x 16 square at 2 m, colour 0.5, no samples elsewhere; 64 x 48 pixels.
 constexpr int kElementWidth = 64, kElementHeight = 48;
@@ -130,6 +137,10 @@ TEST_CASE("lensmith bokeh keeps an RGBA input's alpha, defocused with its colour
   // f/1.4) its alpha spreads
   // like its colour and keeps its total (the scatter conserves energy; nothing reaches the frame's
   // edge), transparent corners stay transparent.
+  // In focus each pixel lands on itself (the tent keeps a pixel-centre point in its pixel): 1 up to rounding; headroom.
+  constexpr double kInFocusAlpha = 1e-3;
+  // The middle lies 8 px inside the square, past its 2.4 px blur radius and the 1 px tent: covered; headroom, not derived.
+  constexpr double kMiddleAlpha = 0.01;
   const int w = 64, h = 48;
   lensmith::Image rgbaz(w, h, 5, 0.0f);
   for (int y = 0; y < h; ++y) {
@@ -152,13 +163,13 @@ TEST_CASE("lensmith bokeh keeps an RGBA input's alpha, defocused with its colour
     REQUIRE(alpha.has_value());
     double total = 0.0;
     for (float a : *alpha) total += a;
-    CHECK(total == Approx(256.0).epsilon(0.02));
-    CHECK((*alpha)[0] == Approx(0.0).margin(1e-4));
+    CHECK(total == Approx(256.0).epsilon(kScatterCoverage));
+    CHECK((*alpha)[0] == Approx(0.0).margin(kUntouchedAlpha));
     if (focus == 2.0) {
-      CHECK((*alpha)[static_cast<std::size_t>(24 * w + 32)] == Approx(1.0).margin(1e-3));
+      CHECK((*alpha)[static_cast<std::size_t>(24 * w + 32)] == Approx(1.0).margin(kInFocusAlpha));
     } else {
-      CHECK((*alpha)[static_cast<std::size_t>(24 * w + 32)] == Approx(1.0).margin(0.01));  // the middle of the square
-      CHECK((*alpha)[static_cast<std::size_t>(24 * w + 22)] > 0.05);                       // spread 2 px beyond its edge
+      CHECK((*alpha)[static_cast<std::size_t>(24 * w + 32)] == Approx(1.0).margin(kMiddleAlpha));  // the middle of the square
+      CHECK((*alpha)[static_cast<std::size_t>(24 * w + 22)] > 0.05);                                 // spread 2 px beyond its edge
     }
   }
   // --keep-depth adds the input's depth as Z beside R, G, B, A.
@@ -193,13 +204,13 @@ TEST_CASE("lensmith bokeh reads a deep OpenEXR as layered input: a CG element ov
   REQUIRE(alpha.has_value());
   double total = 0.0;
   for (float a : *alpha) total += a;
-  CHECK(total == Approx(256.0).epsilon(0.02));  // the scatter keeps the coverage; nothing reaches the frame's edge
-  CHECK((*alpha)[0] == Approx(0.0).margin(1e-4));
+  CHECK(total == Approx(256.0).epsilon(kScatterCoverage));  // the scatter keeps the coverage; nothing reaches the frame's edge
+  CHECK((*alpha)[0] == Approx(0.0).margin(kUntouchedAlpha));
   CHECK((*alpha)[static_cast<std::size_t>(24 * w + 22)] > 0.05);  // spread 2 px beyond the square's edge
   // The colour is the flat element's, premultiplied over black: 0.5 inside, alpha times 0.5 at the rim.
   const lensmith::Image rgb = lensmith::read_radiance_image(out);
-  CHECK(rgb.at(32, 24, 0) == Approx(0.5).margin(0.01));
-  CHECK(rgb.at(22, 24, 0) == Approx(0.5 * (*alpha)[static_cast<std::size_t>(24 * w + 22)]).margin(0.01));
+  CHECK(rgb.at(32, 24, 0) == Approx(0.5).margin(kScatterColour));
+  CHECK(rgb.at(22, 24, 0) == Approx(0.5 * (*alpha)[static_cast<std::size_t>(24 * w + 22)]).margin(kScatterColour));
   // A PNG cannot hold the element's alpha: RGB over black, with a note.
   const auto png = run_lensmith("bokeh --image " + in.string() + " --thin-lens --focal-length 50 --fstop 1.4 --focus 0.5 -o " +
                                 scratch("element-deep.png").string());
@@ -295,6 +306,14 @@ TEST_CASE("lensmith bokeh --method multiview traces a deep element's lens rays, 
           "[cli][bokeh][multiview]") {
   // The deep element above, through Lee et al.'s multiview synthesis: the same coverage (each
   // pixel's alpha is the share of its lens rays the square stops), the colour premultiplied by it.
+  // 64 lens rays a pixel sample the coverage of the blurred rim.
+  constexpr double kMultiviewCoverageTotal = 0.02;
+  // The corner's rays all miss the square and the middle's all hit it: 0 and 1 exactly, up to float rounding.
+  constexpr double kAllOrNoRays = 1e-6;
+  // Inside, every ray sees 0.5 and the spectral round trip over evenly visited nodes is the identity; headroom, not derived.
+  constexpr double kMultiviewInside = 1e-3;
+  // At the rim each ray carries one wavelength: a channel's share of the stopped rays is alpha only up to that sampling.
+  constexpr double kMultiviewRimColour = 0.01;
   const int w = kElementWidth;
   const fs::path in = write_deep_element("element-deep-mv.exr");
   const fs::path out = scratch("element-deep-mv-out.exr");
@@ -312,12 +331,12 @@ TEST_CASE("lensmith bokeh --method multiview traces a deep element's lens rays, 
   double total = 0.0;
   for (float a : *alpha) total += a;
   // Every ray the square stops is coverage; 64 rays a pixel over the blurred rim: within 2 %.
-  CHECK(total == Approx(256.0).epsilon(0.02));
-  CHECK((*alpha)[0] == Approx(0.0).margin(1e-6));
-  CHECK((*alpha)[static_cast<std::size_t>(24 * w + 32)] == Approx(1.0).margin(1e-6));  // inside: every ray stopped
+  CHECK(total == Approx(256.0).epsilon(kMultiviewCoverageTotal));
+  CHECK((*alpha)[0] == Approx(0.0).margin(kAllOrNoRays));
+  CHECK((*alpha)[static_cast<std::size_t>(24 * w + 32)] == Approx(1.0).margin(kAllOrNoRays));  // inside: every ray stopped
   const lensmith::Image rgb = lensmith::read_radiance_image(out);
-  CHECK(rgb.at(32, 24, 0) == Approx(0.5).margin(1e-3));
-  CHECK(rgb.at(22, 24, 0) == Approx(0.5 * (*alpha)[static_cast<std::size_t>(24 * w + 22)]).margin(0.01));
+  CHECK(rgb.at(32, 24, 0) == Approx(0.5).margin(kMultiviewInside));
+  CHECK(rgb.at(22, 24, 0) == Approx(0.5 * (*alpha)[static_cast<std::size_t>(24 * w + 22)]).margin(kMultiviewRimColour));
 }
 
 TEST_CASE("lensmith bokeh refuses options of the other method and apertures multiview cannot sample with traced rays",

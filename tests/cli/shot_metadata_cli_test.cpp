@@ -62,6 +62,10 @@ double max_difference(const fs::path& a, const fs::path& b) {
 TEST_CASE("OpenEXR's focus and aperture attributes set the camera, focus converted from the image plane to the pupil",
           "[cli][metadata]") {
   // Framing as the scene was rendered; focus 1.25 m from the image plane, f/2.8.
+  // OpenEXR's focus, aperture and entrancePupilOffset are float attributes: 2^-24 = 6e-8 relative each.
+  constexpr double kFloatAttribute = 1e-6;
+  // The Canon is scaled to a 35 mm EFL (lenses/README.md): this only tells the lens's focal length from the 50 mm framing's.
+  constexpr double kLensFocalLength_mm = 0.5;
   const fs::path in = scratch("std.exr");
   write_scene(in, {{"lensmith:focal_length_mm", 50.0}, {"lensmith:sensor_width_mm", 36.0}, {"focus", 1.25, true}, {"aperture", 2.8, true}});
   const fs::path out = scratch("std_out.exr");
@@ -73,11 +77,11 @@ TEST_CASE("OpenEXR's focus and aperture attributes set the camera, focus convert
   // (OpenEXR), the difference being its entrance pupil offset.
   const double pupil_m = std::stod(attribute(out, "lensmith:focus_m"));
   const double offset_mm = std::stod(attribute(out, "entrancePupilOffset"));
-  CHECK(std::stod(attribute(out, "focus")) == Approx(1.25).epsilon(1e-6));  // float attribute
-  CHECK(pupil_m + offset_mm / 1000.0 == Approx(1.25).epsilon(1e-6));
+  CHECK(std::stod(attribute(out, "focus")) == Approx(1.25).epsilon(kFloatAttribute));  // float attribute
+  CHECK(pupil_m + offset_mm / 1000.0 == Approx(1.25).epsilon(kFloatAttribute));
   CHECK(offset_mm > 30.0);  // a 35 mm lens focused near 1.2 m: its sensor lies ~36 mm behind its entrance pupil
-  CHECK(std::stod(attribute(out, "FNumber")) == Approx(2.8).epsilon(1e-6));
-  CHECK(std::stod(attribute(out, "focalLength")) == Approx(35.0).margin(0.5));
+  CHECK(std::stod(attribute(out, "FNumber")) == Approx(2.8).epsilon(kFloatAttribute));
+  CHECK(std::stod(attribute(out, "focalLength")) == Approx(35.0).margin(kLensFocalLength_mm));
   // The same picture as the flags would make.
   const fs::path flags = scratch("std_flags.exr");
   REQUIRE(run_lensmith("bokeh --image " + in.string() + " --lens canon-35mm-f1.8-1956 --no-spectral --quiet --fstop 2.8 --focus " +

@@ -38,6 +38,8 @@ bool linear(const Vector2& x, Vector2& r, Matrix2* j) {
 
 // Newton converges quadratically near a simple root: the residual at least squares (times a constant) each step.
 constexpr double kNewtonTolerance = 1e-13;  // a hundred times the rounding of residuals of size ~1
+// |x - x*| <= |J^-1| |r|: at Dennis & Schnabel's root (1, 1) |J^-1| is about 1.1 and |r| <= kNewtonTolerance.
+constexpr double kNewtonRoot = 1e-12;
 
 }  // namespace
 
@@ -54,8 +56,8 @@ TEST_CASE("Newton with the analytic Jacobian finds Dennis & Schnabel's root wher
   };
   const auto summary = RootSolver2d(o).solve(dennis_schnabel, x, nullptr, record);
   REQUIRE(summary.converged());
-  CHECK(x[0] == Approx(1.0).margin(1e-12));
-  CHECK(x[1] == Approx(1.0).margin(1e-12));
+  CHECK(x[0] == Approx(1.0).margin(kNewtonRoot));
+  CHECK(x[1] == Approx(1.0).margin(kNewtonRoot));
   // The full Newton step from (2, 0.5) lands where |F| is larger: the line search shortened it.
   Vector2 full_step;
   Matrix2 j;
@@ -73,6 +75,8 @@ TEST_CASE("Newton with the analytic Jacobian finds Dennis & Schnabel's root wher
 }
 
 TEST_CASE("forward differences find the same root as the analytic Jacobian", "[core][solver]") {
+  // Forward differences, h = 1e-7: h |F''| / 2 (|F''| <= 6) and eps |F| / h, at the last step's point, a step before x.
+  constexpr double kDifferenceJacobian = 1e-5;
   RootSolver2dOptions o;
   o.jacobian = JacobianSource::ForwardDifference;
   o.tolerance = kNewtonTolerance;
@@ -80,16 +84,18 @@ TEST_CASE("forward differences find the same root as the analytic Jacobian", "[c
   Vector2 x{2.0, 0.5};
   const auto summary = RootSolver2d(o).solve(dennis_schnabel, x);
   REQUIRE(summary.converged());
-  CHECK(x[0] == Approx(1.0).margin(1e-12));
-  CHECK(x[1] == Approx(1.0).margin(1e-12));
+  CHECK(x[0] == Approx(1.0).margin(kNewtonRoot));
+  CHECK(x[1] == Approx(1.0).margin(kNewtonRoot));
   // The difference Jacobian at the last step's point agrees with the analytic one to ~ step size.
   Vector2 r;
   Matrix2 j;
   dennis_schnabel(x, r, &j);
-  for (std::size_t k = 0; k < 4; ++k) CHECK(summary.jacobian[k] == Approx(j[k]).margin(1e-5));
+  for (std::size_t k = 0; k < 4; ++k) CHECK(summary.jacobian[k] == Approx(j[k]).margin(kDifferenceJacobian));
 }
 
 TEST_CASE("Broyden's method solves a linear system exactly in at most 2n = 4 steps from a wrong Jacobian (Gay 1979)", "[core][solver]") {
+  // Solved to |r| <= 1e-12 (its tolerance below), and |x - x*| <= |A^-1| |r| with |A^-1| = 0.46.
+  constexpr double kLinearRoot = 1e-12;
   RootSolver2dOptions o;
   o.jacobian = JacobianSource::Broyden;
   o.line_search = false;
@@ -100,12 +106,14 @@ TEST_CASE("Broyden's method solves a linear system exactly in at most 2n = 4 ste
   const auto summary = RootSolver2d(o).solve(linear, x, &identity);
   REQUIRE(summary.converged());
   CHECK(summary.iterations <= 4);
-  CHECK(x[0] == Approx(1.0).margin(1e-12));
-  CHECK(x[1] == Approx(-2.0).margin(1e-12));
+  CHECK(x[0] == Approx(1.0).margin(kLinearRoot));
+  CHECK(x[1] == Approx(-2.0).margin(kLinearRoot));
 }
 
 TEST_CASE("the chord method with twice the true Jacobian halves the error every step", "[core][solver]") {
   // x_k+1 - x* = (I - (2A)^-1 A)(x_k - x*) = (x_k - x*) / 2, so the residual A(x - x*) halves too.
+  // Three halvings are exact in exact arithmetic: the double rounding of three steps on numbers of size ~5.
+  constexpr double kThreeChordSteps = 1e-12;
   RootSolver2dOptions o;
   o.jacobian = JacobianSource::Fixed;
   o.line_search = false;
@@ -122,18 +130,22 @@ TEST_CASE("the chord method with twice the true Jacobian halves the error every 
   Vector2 y{0.0, 0.0};
   const auto stopped = RootSolver2d(o).solve(linear, y, &twice);
   CHECK(stopped.status == RootSolver2dStatus::OutOfIterations);
-  CHECK(stopped.residual_norm == Approx(lensmith::norm_2d(r0) / 8.0).epsilon(1e-12));
+  CHECK(stopped.residual_norm == Approx(lensmith::norm_2d(r0) / 8.0).epsilon(kThreeChordSteps));
 }
 
 TEST_CASE("a trust region shortens a long step to its radius", "[core][solver]") {
+  // A linear residual's difference Jacobian errs only by rounding, eps |r| / h = 2.2e-16 x 10 / 1e-7 = 2e-8 relative.
+  constexpr double kLinearDifference = 1e-6;
+  // x1's residual depends on x1 alone and x0's not on x1: the differences across are exactly 0 and x1 stays 0.
+  constexpr double kUntouchedUnknown = 1e-9;
   RootSolver2dOptions o;
   o.max_step = 1.0;
   o.max_iterations = 1;
   Vector2 x{0.0, 0.0};
   const auto summary = RootSolver2d(o).solve([](const Vector2& p, Vector2& r, Matrix2*) { r = {p[0] - 10.0, p[1]}; return true; }, x);
   CHECK(summary.status == RootSolver2dStatus::OutOfIterations);
-  CHECK(x[0] == Approx(1.0).epsilon(1e-6));  // the difference Jacobian is exact for a linear residual up to rounding
-  CHECK(x[1] == Approx(0.0).margin(1e-9));
+  CHECK(x[0] == Approx(1.0).epsilon(kLinearDifference));  // the difference Jacobian is exact for a linear residual up to rounding
+  CHECK(x[1] == Approx(0.0).margin(kUntouchedUnknown));
 }
 
 TEST_CASE("a solve that cannot go on says why", "[core][solver]") {

@@ -22,6 +22,8 @@ using namespace lensmith;
 using test::thin_camera;
 
 TEST_CASE("EWA: a textured plane in focus comes back nearly as it went in", "[render][ewa]") {
+  // Each neighbour gets 0.39 % of a pixel's weight from its sharp kernel: a 4.0 dot moves a 0.2 pixel by 4 x 0.4 % x 4 = 0.064.
+  constexpr double kOwnKernelSpread = 0.07;
   const int w = 48, h = 32;
   const Camera camera = thin_camera(w, h, 2.0);
   const auto model = make_ray_model(RayModelKind::Thin, camera);
@@ -35,7 +37,7 @@ TEST_CASE("EWA: a textured plane in focus comes back nearly as it went in", "[re
   // of the dot, 0.016 x 4.
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      for (int c = 0; c < 3; ++c) REQUIRE(out.at(x, y, c) == Approx(image.at(x, y, c)).margin(0.07));
+      for (int c = 0; c < 3; ++c) REQUIRE(out.at(x, y, c) == Approx(image.at(x, y, c)).margin(kOwnKernelSpread));
     }
   }
   CHECK(stats.splats_per_level[0] == stats.splats);  // nothing blurred: every pixel its own splat
@@ -44,6 +46,8 @@ TEST_CASE("EWA: a textured plane in focus comes back nearly as it went in", "[re
 
 TEST_CASE("EWA: one bright pixel on a defocused plane keeps its light and spreads as the L2-best Gaussian of its circle of confusion",
           "[render][ewa]") {
+  // The plane's fragments share weights that sum to 1: the bright pixel's light, but for float sums (about 1e-4).
+  constexpr double kBrightPixelLight = 1e-3;
   const int w = 101, h = 101, cx = 50, cy = 50;
   const Camera camera = thin_camera(w, h, 3.0);
   const double z_m = test::near_depth_for_blur(camera, 3.0, 16.0);
@@ -75,7 +79,7 @@ TEST_CASE("EWA: one bright pixel on a defocused plane keeps its light and spread
                                                                       << " px^2, expected " << expected);
       // Light: the plane is one surface, so its black pixels and the bright one share fragments
       // whose weights sum to 1: the bright pixel's light, all of it (float sums: 1e-4).
-      CHECK(total == Approx(1.0).epsilon(1e-3));
+      CHECK(total == Approx(1.0).epsilon(kBrightPixelLight));
       // Spread: the moments of 128 pupil points (8 equal-area rings: a disc's second moment is
       // exact) and of the cut-off, renormalised Gaussian (3 sigma holds 98.9 % of its mass, and
       // the cut-off's tail is narrower: -4.4 % of the variance) against the formula: 6 %. With the
@@ -136,6 +140,8 @@ TEST_CASE("EWA: the level of detail keeps the work per pixel nearly flat as the 
 
 TEST_CASE("EWA: a sharp foreground keeps its colour up to its edge over a blurred background (no intensity leakage)",
           "[render][ewa]") {
+  // The last column gets 0.4 % of the black wall from its own sharp kernel.
+  constexpr double kSharpForeground = 0.01;
   const int w = 240, h = 40, edge = 120;
   const Camera camera = thin_camera(w, h, 0.6);
   const auto model = make_ray_model(RayModelKind::Thin, camera);
@@ -156,7 +162,7 @@ TEST_CASE("EWA: a sharp foreground keeps its colour up to its edge over a blurre
   // it: they stay white (the last column gets 0.4 % of the wall from its own sharp kernel).
   for (int x = edge - 23; x < edge; ++x) {
     INFO("column " << x);
-    CHECK(out.at(x, h / 2, 1) == Approx(1.0).margin(0.01));
+    CHECK(out.at(x, h / 2, 1) == Approx(1.0).margin(kSharpForeground));
   }
   // And the foreground's edge stays sharp: the first wall pixel is dark.
   CHECK(out.at(edge, h / 2, 1) < 0.02);
@@ -166,6 +172,12 @@ TEST_CASE("EWA: a flat wall through a real lens stays flat to the frame's edges"
   // pbrt's double Gauss at f/2, focused at 3 m; the wall at 3 m (in focus) and at 1 m (blurred).
   // Its distortion moves centroids inwards at the edges: the picture continues beyond the frame, so
   // the last columns are reached as the others (without the margin they kept the input's colour).
+  // One surface everywhere: each pixel's fragment is renormalised by its weight (float sums).
+  constexpr double kOneSurface = 1e-4;
+  // The table's 256 pupil points against the scatter's pupil mesh, at the centre ...
+  constexpr double kVignettingCentre = 0.02;
+  // ... and out to the corners, where the clear apertures clip the beams (6 % of even the axial beam here).
+  constexpr double kVignettingEdges = 0.05;
   const int w = 96, h = 64;
   CameraOptions co;
   co.focus_distance_m = 3.0;
@@ -188,8 +200,8 @@ TEST_CASE("EWA: a flat wall through a real lens stays flat to the frame's edges"
     }
     INFO("wall at " << z_m << " m: " << lo << " .. " << hi);
     // One surface everywhere: each pixel's fragment is renormalised by its weight (float sums).
-    CHECK(lo == Approx(0.5).epsilon(1e-4));
-    CHECK(hi == Approx(0.5).epsilon(1e-4));
+    CHECK(lo == Approx(0.5).epsilon(kOneSurface));
+    CHECK(hi == Approx(0.5).epsilon(kOneSurface));
     CHECK(stats.unfilled_pixels == 0);
     // With vignetting the frame darkens towards its edges as the lens's relative illumination
     // does (the table's throughput), as the scatter method integrates the same ray model's weights
@@ -201,11 +213,11 @@ TEST_CASE("EWA: a flat wall through a real lens stays flat to the frame's edges"
     bo.spectral = false;
     bo.threads = 2;
     const Image scatter = render_bokeh(image, DepthMap(w, h, static_cast<float>(z_m)), *model, Aperture::circular(), bo);
-    CHECK(lit.at(w / 2, h / 2, 1) == Approx(scatter.at(w / 2, h / 2, 1)).epsilon(0.02));
+    CHECK(lit.at(w / 2, h / 2, 1) == Approx(scatter.at(w / 2, h / 2, 1)).epsilon(kVignettingCentre));
     for (int x = 2; x < w / 2; x += 6) {
       const int y = x * h / w;
       INFO("(" << x << ", " << y << "): ewa " << lit.at(x, y, 1) << ", scatter " << scatter.at(x, y, 1));
-      CHECK(lit.at(x, y, 1) == Approx(scatter.at(x, y, 1)).epsilon(0.05));
+      CHECK(lit.at(x, y, 1) == Approx(scatter.at(x, y, 1)).epsilon(kVignettingEdges));
     }
     CHECK(lit.at(1, 1, 1) < 0.6 * lit.at(w / 2, h / 2, 1));
   }

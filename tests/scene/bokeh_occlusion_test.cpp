@@ -53,11 +53,13 @@ TEST_CASE("Where two blurred branches cross, the scatter method is as bright as 
   // The 8 x 6 px window on the near branch beside the crossing, where each layer behind claiming all
   // of the hidden area made the picture 17 % too bright (0.241 against 0.208); 3 %: the truth's
   // noise over 48 px at 256 samples is below 0.5 %, the rest is the guess's freedom.
+  // Above the truth's noise (under 0.5 %), the rest the guess's freedom; far below the 17 % of the failure it guards.
+  constexpr double kHiddenGuess = 0.03;
   for (const HiddenSurfaces hidden : {HiddenSurfaces::Extend, HiddenSurfaces::Stretch}) {
     bo.hidden = hidden;
     const Image out = render_bokeh(input.rgb, input.depth, *model, Aperture::circular(), bo);
     const double expected = patch_mean(truth.rgb, 150, 76, 8, 6), got = patch_mean(out, 150, 76, 8, 6);
     INFO("hidden " << to_string(hidden) << ": " << got << ", ground truth " << expected);
-    CHECK(got == Approx(expected).epsilon(0.03));
+    CHECK(got == Approx(expected).epsilon(kHiddenGuess));
   }
 }
