@@ -23,6 +23,7 @@ from . import _plots
 from ._record import Record, dataframe as _dataframe
 from ._lensmith import (  # noqa: F401  (the error types are part of the API)
     Error,
+    FileError,
     LensFileError,
     GlassError,
     PrescriptionError,
@@ -39,7 +40,7 @@ from ._lensmith import (  # noqa: F401  (the error types are part of the API)
 __version__ = _lensmith.__version__
 __all__ = [
     "Lens", "Surface", "Fit", "Record", "TraceResult", "lenses", "bokeh", "convert_colorspace", "read_image", "read_depth", "read_metadata", "write_image", "RAY_STATUS", "LensWarning",
-    "Error", "LensFileError", "GlassError", "PrescriptionError", "OptionsError", "UsageError", "ComputationError",
+    "Error", "FileError", "LensFileError", "GlassError", "PrescriptionError", "OptionsError", "UsageError", "ComputationError",
     "IoError", "ImageFileError", "FitError", "SceneError", "SceneFileError",
 ]
 

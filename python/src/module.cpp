@@ -16,14 +16,21 @@ std::string dump(const ojson& o) { return json_text(o); }
 namespace {
 
 // Raises `type` with the message, and, for errors about a place in a file, the attributes
-// `file`, `line` and `column` (0 when unknown) and `detail` (the message without the place).
-void raise(PyObject* type, const char* message, const SourceLocation* where = nullptr, const std::string* detail = nullptr) {
+// `file`, `line` and `column` (0 when unknown) and `detail` (the message without the place); for
+// errors about a part of a model, `surface` (1-based, 0: none), `field` and `index` (-1: none).
+void raise(PyObject* type, const char* message, const SourceLocation* where = nullptr, const std::string* detail = nullptr,
+           const ErrorSubject* subject = nullptr) {
   py::object exception = py::reinterpret_borrow<py::object>(type)(message);
   if (where) {
     exception.attr("file") = where->file;
     exception.attr("line") = where->line;
     exception.attr("column") = where->column;
     exception.attr("detail") = *detail;
+  }
+  if (subject) {
+    exception.attr("surface") = subject->surface;
+    exception.attr("field") = subject->field;
+    exception.attr("index") = subject->index;
   }
   PyErr_SetObject(type, exception.ptr());
 }
@@ -42,7 +49,10 @@ PYBIND11_MODULE(_lensmith, m) {
   // The hierarchy of errors.h: every lensmith error is a lensmith.Error; those about the caller's
   // values are also ValueError, those of the operating system also OSError.
   static py::exception<Error> error(m, "Error", PyExc_RuntimeError);
-  static py::exception<LensFileError> lens_file_error(m, "LensFileError", error.ptr());
+  // One class for every unreadable file; LensFileError and SceneFileError, its earlier names, stay.
+  static py::exception<FileError> file_error(m, "FileError", error.ptr());
+  m.attr("LensFileError") = file_error;
+  m.attr("SceneFileError") = file_error;
   static py::exception<GlassError> glass_error(m, "GlassError", error.ptr());
   static py::exception<PrescriptionError> prescription_error(m, "PrescriptionError", error.ptr());
   static py::object options_error_type = py::reinterpret_steal<py::object>(
@@ -58,18 +68,15 @@ PYBIND11_MODULE(_lensmith, m) {
   static py::exception<ImageFileError> image_file_error(m, "ImageFileError", error.ptr());
   static py::exception<FitError> fit_error(m, "FitError", error.ptr());
   static py::exception<SceneError> scene_error(m, "SceneError", error.ptr());
-  static py::exception<SceneFileError> scene_file_error(m, "SceneFileError", error.ptr());
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
-    } catch (const LensFileError& e) {
-      raise(lens_file_error.ptr(), e.what(), &e.where(), &e.what_without_location());
-    } catch (const SceneFileError& e) {
-      raise(scene_file_error.ptr(), e.what(), &e.where(), &e.what_without_location());
+    } catch (const FileError& e) {
+      raise(file_error.ptr(), e.what(), &e.where(), &e.what_without_location());
     } catch (const GlassError& e) {
-      raise(glass_error.ptr(), e.what());
+      raise(glass_error.ptr(), e.what(), nullptr, nullptr, &e.subject());
     } catch (const PrescriptionError& e) {
-      raise(prescription_error.ptr(), e.what());
+      raise(prescription_error.ptr(), e.what(), nullptr, nullptr, &e.subject());
     } catch (const UsageError& e) {
       raise(usage_error_type.ptr(), e.what());
     } catch (const OptionsError& e) {
@@ -83,7 +90,7 @@ PYBIND11_MODULE(_lensmith, m) {
     } catch (const FitError& e) {
       raise(fit_error.ptr(), e.what());
     } catch (const SceneError& e) {
-      raise(scene_error.ptr(), e.what());
+      raise(scene_error.ptr(), e.what(), nullptr, nullptr, &e.subject());
     } catch (const Error& e) {
       raise(error.ptr(), e.what());
     }

@@ -4,7 +4,7 @@
 #include "lensmith/core/located_json.h"
 
 using lensmith::JsonObjectReader;
-using lensmith::LensFileError;
+using lensmith::FileError;
 using lensmith::LocatedJson;
 
 TEST_CASE("located JSON: a value's position is the line and column where it starts", "[core]") {
@@ -24,7 +24,7 @@ TEST_CASE("located JSON: a syntax error names its line", "[core]") {
   try {
     LocatedJson::parse(text, "bad.json");
     FAIL("expected an error");
-  } catch (const LensFileError& e) {
+  } catch (const FileError& e) {
     CHECK(e.where().file == "bad.json");
     CHECK(e.where().line == 3);
   }

@@ -55,7 +55,7 @@ TEST_CASE("A wrong merit file is refused at the line and column of the mistake",
   const auto message = [](const std::string& text) {
     try {
       parse_merit_function(text, "m.json");
-    } catch (const LensFileError& e) {
+    } catch (const FileError& e) {
       return std::string(e.what());
     }
     return std::string("accepted");

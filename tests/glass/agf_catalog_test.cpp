@@ -12,7 +12,7 @@ using Catch::Matchers::Contains;
 using Catch::Matchers::WithinRel;
 using lensmith::Glass;
 using lensmith::GlassCatalog;
-using lensmith::LensFileError;
+using lensmith::FileError;
 
 namespace {
 
@@ -96,10 +96,10 @@ TEST_CASE("AGF: malformed records are errors at their line, saying what was expe
   const auto error_line = [](const std::string& text) {
     try {
       (void)GlassCatalog::from_agf(text, "bad.agf", "BAD");
-    } catch (const LensFileError& e) {
+    } catch (const FileError& e) {
       return e.where().line;
     }
-    FAIL("expected a LensFileError");
+    FAIL("expected a FileError");
     return -1;
   };
   CHECK(error_line("CC ok\nNM G 14 0 1.5 50 0 0 0\nCD 1\nLD 0.4 0.7\n") == 2);   // no formula 14

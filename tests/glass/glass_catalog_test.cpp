@@ -16,7 +16,7 @@ using Catch::Matchers::WithinAbs;
 using lensmith::Glass;
 using lensmith::GlassCatalog;
 using lensmith::GlassError;
-using lensmith::LensFileError;
+using lensmith::FileError;
 
 namespace {
 
@@ -245,8 +245,8 @@ TEST_CASE("malformed catalogue JSON: a syntax error names its line", "[glass][ca
   const std::string text = lab_catalogue(kLabCrown + ",\n{\"name\": \"CROWN-2\", \"formula\": 2,, }");
   try {
     GlassCatalog::from_json(text, "broken.json");
-    FAIL("expected a LensFileError");
-  } catch (const LensFileError& e) {
+    FAIL("expected a FileError");
+  } catch (const FileError& e) {
     CHECK(e.where().file == "broken.json");
     CHECK(e.where().line == 4);
   }
@@ -274,7 +274,7 @@ TEST_CASE("malformed catalogue JSON: values of the wrong type or range name the 
   auto error_for = [](const std::string& glass) {
     try {
       GlassCatalog::from_json(lab_catalogue(glass), "t.json");
-    } catch (const LensFileError& e) {
+    } catch (const FileError& e) {
       return std::string(e.what());
     }
     return std::string("no error");
@@ -307,7 +307,7 @@ TEST_CASE("malformed catalogue JSON: the format name and version are checked", "
   CHECK_THROWS_WITH(
       GlassCatalog::from_json(R"({"format": "lensmith-glass-catalog", "version": 2, "vendor": "V", "glasses": []})", "v.json"),
       Catch::Contains("version: version 2 is not supported"));
-  CHECK_THROWS_AS(GlassCatalog::from_json("[]", "a.json"), LensFileError);
+  CHECK_THROWS_AS(GlassCatalog::from_json("[]", "a.json"), FileError);
 }
 
 TEST_CASE("merge appends vendors after the existing ones and refuses duplicates", "[glass][catalog]") {

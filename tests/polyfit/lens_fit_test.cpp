@@ -170,7 +170,7 @@ TEST_CASE("malformed fit files are refused with the file, line and what was expe
   const std::string good = triplet_fit().to_json();
   auto fails_with = [&](std::string text, const std::string& what) {
     INFO(what);
-    CHECK_THROWS_AS(LensFit::parse(text, "bad.json"), LensFileError);
+    CHECK_THROWS_AS(LensFit::parse(text, "bad.json"), FileError);
     CHECK_THROWS_WITH(LensFit::parse(text, "bad.json"), Contains("bad.json:") && Contains(what));
   };
   std::string wrong_format = good;

@@ -63,13 +63,13 @@ std::string mini_seq(const std::string& system_extra = "", const std::string& le
 }
 // clang-format on
 
-LensFileError codev_error(const std::string& text) {
+FileError codev_error(const std::string& text) {
   try {
     read_codev(text, "t.seq");
-  } catch (const LensFileError& e) {
+  } catch (const FileError& e) {
     return e;
   }
-  FAIL("expected a LensFileError");
+  FAIL("expected a FileError");
   throw std::logic_error("unreachable");
 }
 
@@ -200,7 +200,7 @@ TEST_CASE("CODE V: DIM I converts lengths, curvatures, aspheric terms, EPD and h
 
 TEST_CASE("CODE V: an unknown DIM is an error naming it", "[prescription][codev]") {
   const std::string text = replaced(mini_seq(), "DIM M", "DIM FURLONG");
-  const LensFileError e = codev_error(text);
+  const FileError e = codev_error(text);
   CHECK(e.where().line == line_of(text, "DIM"));
   CHECK_THAT(e.what(), Contains("FURLONG"));
 }
@@ -229,7 +229,7 @@ TEST_CASE("CODE V: CON with K alone gives a conic; SPH drops conic and aspheric 
 TEST_CASE("CODE V: the r^18 and r^20 terms (H, J) are refused unless zero", "[prescription][codev]") {
   CHECK_NOTHROW(read_codev(mini_seq("", "  ASP\n  H 0; J 0\n"), "t.seq"));
   const std::string text = mini_seq("", "  ASP\n  H 1e-25\n");
-  const LensFileError e = codev_error(text);
+  const FileError e = codev_error(text);
   CHECK(e.where().line == line_of(text, "H 1e-25"));
   CHECK_THAT(e.what(), Contains("r^18"));
 }
@@ -286,7 +286,7 @@ TEST_CASE("CODE V: decentres and tilts are accepted when zero and refused otherw
   for (const char* line : {"  YDE 2.5\n", "  ADE 45\n", "  CDE -1\n"}) {
     const std::string text = mini_seq("", line);
     INFO(line);
-    const LensFileError e = codev_error(text);
+    const FileError e = codev_error(text);
     CHECK(e.where().line == line_of(text, line));
     CHECK(e.where().column == 7);
     CHECK_THAT(e.what(), Contains("decentres and tilts"));
@@ -307,7 +307,7 @@ TEST_CASE("CODE V: commands that change the optics beyond lensmith's model are r
     const bool system = line.front() != ' ';
     const std::string text = system ? mini_seq(line) : mini_seq("", line);
     INFO(line);
-    const LensFileError e = codev_error(text);
+    const FileError e = codev_error(text);
     CHECK(e.where().line == line_of(text, line));
     CHECK_THAT(e.what(), Contains(c.feature));
   }
@@ -474,7 +474,7 @@ TEST_CASE("CODE V: an obsolete SCHOTT name reads as its N- successor with a warn
 
 TEST_CASE("CODE V: an unknown glass is an error naming it, its line and the closest catalogue names", "[prescription][codev]") {
   const std::string text = replaced(mini_seq(), "NBK7_SCHOTT", "UNOBTAINIUM7_SCHOTT");
-  const LensFileError e = codev_error(text);
+  const FileError e = codev_error(text);
   CHECK(e.where().line == line_of(text, "UNOBTAINIUM"));
   CHECK(e.where().column == 8);
   CHECK_THAT(e.what(), Contains("UNOBTAINIUM7_SCHOTT") && Contains("closest catalogue names"));
@@ -556,7 +556,7 @@ TEST_CASE("CODE V: numbers such as nan, inf and 1e999 are errors naming their li
   for (const char* bad : {"nan", "inf", "1e999", "1.#INF", "4.2E"}) {
     const std::string text = replaced(mini_seq(), "S 50 5", std::string("S ") + bad + " 5");
     INFO(bad);
-    const LensFileError e = codev_error(text);
+    const FileError e = codev_error(text);
     CHECK(e.where().line == line_of(text, std::string("S ") + bad));
     CHECK(e.where().column == 3);
   }
@@ -572,11 +572,11 @@ TEST_CASE("CODE V: a file needs SO and a lens surface, in that order", "[prescri
 
 TEST_CASE("CODE V: binary garbage, empty files and a lone byte-order mark are errors, not crashes", "[prescription][codev]") {
   const std::string garbage("\x89PNG\r\n\x1a\n\0\0\0\rIHDR", 16);
-  CHECK_THROWS_AS(read_codev(garbage, "g.seq"), LensFileError);
-  CHECK_THROWS_AS(read_codev("", "e.seq"), LensFileError);
-  CHECK_THROWS_AS(read_codev("\xFF\xFE", "bom-only.seq"), LensFileError);
-  CHECK_THROWS_AS(read_codev(std::string(100000, 'A'), "long.seq"), LensFileError);
-  CHECK_THROWS_AS(read_codev(std::string(100000, '&'), "amp.seq"), LensFileError);
+  CHECK_THROWS_AS(read_codev(garbage, "g.seq"), FileError);
+  CHECK_THROWS_AS(read_codev("", "e.seq"), FileError);
+  CHECK_THROWS_AS(read_codev("\xFF\xFE", "bom-only.seq"), FileError);
+  CHECK_THROWS_AS(read_codev(std::string(100000, 'A'), "long.seq"), FileError);
+  CHECK_THROWS_AS(read_codev(std::string(100000, '&'), "amp.seq"), FileError);
 }
 
 TEST_CASE("CODE V: UTF-16LE with a byte-order mark reads like UTF-8", "[prescription][codev]") {
@@ -622,7 +622,7 @@ TEST_CASE("CODE V: NAO is an object-space NA aperture; with the object at infini
   const Prescription p = read_codev(replaced(mini_seq("NAO 0.05\n", "", "SO 0 400"), "EPD 10\n", ""), "t.seq").prescription;
   CHECK(p.aperture == ApertureSpec{ApertureSpec::Kind::ObjectSpaceNA, 0.05});
   const std::string at_infinity = replaced(mini_seq("NAO 0.05\n"), "EPD 10\n", "");
-  const LensFileError e = codev_error(at_infinity);
+  const FileError e = codev_error(at_infinity);
   CHECK(e.where().line == line_of(at_infinity, "NAO"));
   CHECK_THAT(e.what(), Contains("finite object"));
 }

@@ -28,13 +28,13 @@ std::string lens_with(const std::string& surface2, const std::string& extra_top 
          "}\n";
 }
 
-LensFileError read_error(const std::string& text) {
+FileError read_error(const std::string& text) {
   try {
     read_lens_json(text, "t.json");
-  } catch (const LensFileError& e) {
+  } catch (const FileError& e) {
     return e;
   }
-  FAIL("expected a LensFileError");
+  FAIL("expected a FileError");
   throw;  // unreachable
 }
 

@@ -28,13 +28,13 @@ const std::string& database() {
 
 LensReadResult read_entry(const std::string& id) { return read_lentil(database(), database_path(), id); }
 
-LensFileError lentil_error(const std::string& text, const std::string& id) {
+FileError lentil_error(const std::string& text, const std::string& id) {
   try {
     read_lentil(text, "t.json", id);
-  } catch (const LensFileError& e) {
+  } catch (const FileError& e) {
     return e;
   }
-  FAIL("expected a LensFileError");
+  FAIL("expected a FileError");
   throw std::logic_error("unreachable");
 }
 
@@ -158,8 +158,8 @@ TEST_CASE("lentil: cylindrical elements read as biconics, cyl-y curved in x and 
 TEST_CASE("lentil: an unknown id is an error listing the available ids", "[prescription][lentil]") {
   try {
     read_entry("0042");
-    FAIL("expected a LensFileError");
-  } catch (const LensFileError& e) {
+    FAIL("expected a FileError");
+  } catch (const FileError& e) {
     CHECK_THAT(e.what(), Contains("0042") && Contains("0001, 0002") && Contains("9994"));
   }
 }
@@ -173,7 +173,7 @@ TEST_CASE("lentil: every supported entry reads and validates", "[prescription][l
       ++supported;
       CHECK_NOTHROW(read_entry(e.id));
     } else {
-      CHECK_THROWS_AS(read_entry(e.id), LensFileError);  // "supported" means exactly "readable"
+      CHECK_THROWS_AS(read_entry(e.id), FileError);  // "supported" means exactly "readable"
     }
   }
   CHECK(supported == 21);  // all but the three without an iris (2002, 9991, 9994)
@@ -201,13 +201,13 @@ TEST_CASE("lentil: the entry list gives ids, makers and what lensmith can read",
 TEST_CASE("lentil: a zoom thickness list is an error naming the element", "[prescription][lentil]") {
   std::string element = glass_element("abbe", "1.6", "40");
   element.replace(element.find("\"thickness\": 4"), 14, "\"thickness\": [4, 5, 6]");
-  const LensFileError e = lentil_error(tiny_database(element), "0100");
+  const FileError e = lentil_error(tiny_database(element), "0100");
   CHECK_THAT(e.what(), Contains("optical-elements-patent[0].thickness") && Contains("zoom"));
   CHECK(e.where().line == 6);
 }
 
 TEST_CASE("lentil: a glass in no catalogue without an ior is an error listing close names", "[prescription][lentil]") {
-  const LensFileError e = lentil_error(tiny_database(glass_element("NBK8", "null", "null")), "0100");
+  const FileError e = lentil_error(tiny_database(glass_element("NBK8", "null", "null")), "0100");
   CHECK_THAT(e.what(), Contains("NBK8") && Contains("closest catalogue names") && Contains("N-BK7"));
   CHECK(e.where().line == 6);
 }
@@ -228,14 +228,14 @@ TEST_CASE("lentil: OHARA names written without their dash (SLAH64) find the cata
 }
 
 TEST_CASE("lentil: an element key lensmith does not know is an error", "[prescription][lentil]") {
-  const LensFileError e =
+  const FileError e =
       lentil_error(tiny_database(glass_element("abbe", "1.6", "40", ", \"housing_radius\": 9")), "0100");
   CHECK_THAT(e.what(), Contains("housing_radius") && Contains("unknown key"));
 }
 
 TEST_CASE("lentil: a second iris is an error", "[prescription][lentil]") {
   std::string element = glass_element("iris", "null", "null");
-  const LensFileError e = lentil_error(tiny_database(element), "0100");
+  const FileError e = lentil_error(tiny_database(element), "0100");
   CHECK_THAT(e.what(), Contains("second iris"));
 }
 
@@ -251,10 +251,10 @@ TEST_CASE("lentil: aspherical terms on a spherical element, or a wrong count, ar
 
 TEST_CASE("lentil: malformed JSON and a non-object root are errors with positions", "[prescription][lentil]") {
   CHECK(lentil_error("{\"0001\": [}", "0001").where().line == 1);
-  CHECK_THROWS_AS(read_lentil("[1, 2]", "t.json", "0001"), LensFileError);
-  CHECK_THROWS_AS(list_lentil_entries("\"text\"", "t.json"), LensFileError);
-  CHECK_THROWS_AS(read_lentil(std::string(100000, '['), "deep.json", "0001"), LensFileError);
-  CHECK_THROWS_AS(read_lentil(tiny_database(glass_element("abbe", "1e999", "40")), "t.json", "0100"), LensFileError);
+  CHECK_THROWS_AS(read_lentil("[1, 2]", "t.json", "0001"), FileError);
+  CHECK_THROWS_AS(list_lentil_entries("\"text\"", "t.json"), FileError);
+  CHECK_THROWS_AS(read_lentil(std::string(100000, '['), "deep.json", "0001"), FileError);
+  CHECK_THROWS_AS(read_lentil(tiny_database(glass_element("abbe", "1e999", "40")), "t.json", "0100"), FileError);
 }
 
 TEST_CASE("lentil: a housing radius wider than the sphere is limited to |radius|, with a warning",

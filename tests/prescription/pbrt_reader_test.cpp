@@ -27,13 +27,13 @@ LensReadResult read_data(const std::string& name, PbrtConvention convention = Pb
   return read_pbrt(read_file_bytes(path), path, convention);
 }
 
-LensFileError pbrt_error(const std::string& text, PbrtConvention convention = PbrtConvention::Auto) {
+FileError pbrt_error(const std::string& text, PbrtConvention convention = PbrtConvention::Auto) {
   try {
     read_pbrt(text, "t.dat", convention);
-  } catch (const LensFileError& e) {
+  } catch (const FileError& e) {
     return e;
   }
-  FAIL("expected a LensFileError");
+  FAIL("expected a FileError");
   throw std::logic_error("unreachable");
 }
 
@@ -150,13 +150,13 @@ TEST_CASE("pbrt: an explicit convention overrides the Auto rule and reads a diff
 }
 
 TEST_CASE("pbrt: separation-from-previous needs 0 in the first row", "[prescription][pbrt]") {
-  const LensFileError e = pbrt_error(kSmallLens, PbrtConvention::SeparationFromPrevious);
+  const FileError e = pbrt_error(kSmallLens, PbrtConvention::SeparationFromPrevious);
   CHECK(e.where().line == 2);
   CHECK(e.where().column == 6);
 }
 
 TEST_CASE("pbrt: a row without exactly 4 columns is an error naming its line", "[prescription][pbrt]") {
-  const LensFileError three = pbrt_error("# X\n50 5 1.6 20\n0 3 0\n-80 0 1 20\n");
+  const FileError three = pbrt_error("# X\n50 5 1.6 20\n0 3 0\n-80 0 1 20\n");
   CHECK(three.where().line == 3);
   CHECK_THAT(three.what(), Contains("4 columns"));
   CHECK(pbrt_error("50 5 1.6 20 7\n0 3 0 16\n-80 0 1 20\n").where().line == 1);
@@ -165,7 +165,7 @@ TEST_CASE("pbrt: a row without exactly 4 columns is an error naming its line", "
 TEST_CASE("pbrt: a value that is not a finite number is an error naming line and column", "[prescription][pbrt]") {
   for (const char* bad : {"abc", "nan", "inf", "1e999", "5,0", "0x1p3"}) {
     INFO(bad);
-    const LensFileError e = pbrt_error(std::string("50 5 1.6 20\n0 ") + bad + " 0 16\n-80 0 1 20\n");
+    const FileError e = pbrt_error(std::string("50 5 1.6 20\n0 ") + bad + " 0 16\n-80 0 1 20\n");
     CHECK(e.where().line == 2);
     CHECK(e.where().column == 3);
   }
@@ -174,7 +174,7 @@ TEST_CASE("pbrt: a value that is not a finite number is an error naming line and
 }
 
 TEST_CASE("pbrt: two stop rows are an error naming the second", "[prescription][pbrt]") {
-  const LensFileError e = pbrt_error("0 2 0 16\n50 5 1.6 20\n0 3 0 16\n-80 0 1 20\n");
+  const FileError e = pbrt_error("0 2 0 16\n50 5 1.6 20\n0 3 0 16\n-80 0 1 20\n");
   CHECK(e.where().line == 3);
   CHECK_THAT(e.what(), Contains("line 1"));
 }
@@ -194,13 +194,13 @@ TEST_CASE("pbrt: a negative thickness or a non-positive diameter is an error", "
 }
 
 TEST_CASE("pbrt: empty files, comment-only files and binary data are errors", "[prescription][pbrt]") {
-  CHECK_THROWS_AS(read_pbrt("", "e.dat"), LensFileError);
-  CHECK_THROWS_AS(read_pbrt("# only a comment\n\n", "c.dat"), LensFileError);
+  CHECK_THROWS_AS(read_pbrt("", "e.dat"), FileError);
+  CHECK_THROWS_AS(read_pbrt("# only a comment\n\n", "c.dat"), FileError);
   CHECK_THROWS_AS(read_pbrt(std::string("\x7f"
                                         "ELF\0\0\0",
                                         7),
                             "b.dat"),
-                  LensFileError);
+                  FileError);
 }
 
 TEST_CASE("pbrt: comments after the numbers and CRLF line ends are fine", "[prescription][pbrt]") {

@@ -20,6 +20,41 @@ TEST_CASE("prescription: a negative semi-diameter is rejected naming the surface
   CHECK_THROWS_WITH(p.validate(), Contains("surface 4: semi_diameter_mm = -2: must be finite and > 0"));
 }
 
+TEST_CASE("prescription: an error carries its subject (surface, field, list entry), so readers need not parse its text", "[prescription]") {
+  auto subject_of = [](const Prescription& p) {
+    try {
+      p.validate();
+    } catch (const PrescriptionError& e) {
+      return e.subject();
+    }
+    FAIL("validate() accepted the lens");
+    return ErrorSubject{};
+  };
+  Prescription p = sasian();
+  p.surfaces[3].semi_diameter_mm = -2.0;
+  const ErrorSubject rim = subject_of(p);
+  CHECK(rim.surface == 4);
+  CHECK(rim.field == "semi_diameter_mm");
+  CHECK(rim.to_string() == "surface 4, semi_diameter_mm");
+
+  Prescription q = sasian();
+  q.wavelengths_nm[1] = q.wavelengths_nm[0];
+  const ErrorSubject twice = subject_of(q);
+  CHECK(twice.surface == 0);
+  CHECK(twice.field == "wavelengths_nm");
+  CHECK(twice.index == 1);
+
+  Prescription r = sasian();
+  r.surfaces[2].material = MaterialSpec::catalog("NO-SUCH-GLASS");
+  try {
+    r.resolve_materials(GlassCatalog::builtin());
+    FAIL("an unknown glass was resolved");
+  } catch (const GlassError& e) {
+    CHECK(e.subject().surface == 3);
+    CHECK(e.subject().field == "material");
+  }
+}
+
 TEST_CASE("prescription: a non-finite thickness is rejected naming the surface", "[prescription]") {
   Prescription p = sasian();
   p.surfaces[1].thickness_mm = std::nan("");

@@ -80,13 +80,13 @@ std::string mini_zmx(const std::string& system_extra = "", const std::string& le
 }
 // clang-format on
 
-LensFileError zemax_error(const std::string& text) {
+FileError zemax_error(const std::string& text) {
   try {
     read_zemax(text, "t.zmx");
-  } catch (const LensFileError& e) {
+  } catch (const FileError& e) {
     return e;
   }
-  FAIL("expected a LensFileError");
+  FAIL("expected a FileError");
   throw std::logic_error("unreachable");
 }
 
@@ -239,7 +239,7 @@ TEST_CASE("Zemax: UNIT IN converts lengths, curvatures and aspheric coefficients
 
 TEST_CASE("Zemax: an unknown UNIT is an error naming it", "[prescription][zemax]") {
   const std::string text = mini_zmx("UNIT FURLONG\n");
-  const LensFileError e = zemax_error(text);
+  const FileError e = zemax_error(text);
   CHECK(e.where().line == line_of(text, "UNIT FURLONG"));
   CHECK_THAT(e.what(), Contains("FURLONG"));
 }
@@ -248,8 +248,8 @@ TEST_CASE("Zemax: a STOP on a coordinate break is an error naming its line", "[p
   const std::string path = data_file("coordbrk.zmx");
   try {
     read_zemax(read_file_bytes(path), path);
-    FAIL("expected a LensFileError");
-  } catch (const LensFileError& e) {
+    FAIL("expected a FileError");
+  } catch (const FileError& e) {
     CHECK(e.where().file == path);
     CHECK(e.where().line == 15);  // the STOP line of SURF 1, a COORDBRK
     CHECK_THAT(e.what(), Contains("coordinate break"));
@@ -260,7 +260,7 @@ TEST_CASE("Zemax: a surface type other than STANDARD, EVENASPH, TOROIDAL, BICONI
   for (const char* type : {"PARAXIAL", "GRID_SAG", "XOSPHERE", "BICONICZ"}) {
     std::string text = mini_zmx();
     text.replace(text.find("  TYPE STANDARD\n  CURV 0.02"), 15, std::string("  TYPE ") + type);
-    const LensFileError e = zemax_error(text);
+    const FileError e = zemax_error(text);
     CHECK(e.where().line == line_of(text, std::string("TYPE ") + type));
     CHECK_THAT(e.what(), Contains(type));
   }
@@ -315,7 +315,7 @@ TEST_CASE("Zemax: a glass in no catalogue and without nd on its line is an error
           "[prescription][zemax]") {
   std::string text = mini_zmx();
   text.replace(text.find("N-BK7 0 0 1.5 40 0 0 0 0 0 0"), 28, "NBK7");  // newer OpticStudio writes the name only
-  const LensFileError e = zemax_error(text);
+  const FileError e = zemax_error(text);
   CHECK(e.where().line == line_of(text, "GLAS NBK7"));
   CHECK_THAT(e.what(), Contains("NBK7") && Contains("closest catalogue names") && Contains("N-BK7"));
 }
@@ -324,7 +324,7 @@ TEST_CASE("Zemax: OpticStudio's placeholder nd 1.5 / Vd 40 never stands in for a
           "[prescription][zemax]") {
   std::string text = mini_zmx();
   text.replace(text.find("N-BK7 0 0 1.5 40"), 16, "ACME-42 0 0 1.5 40");
-  const LensFileError e = zemax_error(text);
+  const FileError e = zemax_error(text);
   CHECK(e.where().line == line_of(text, "GLAS ACME-42"));
   CHECK_THAT(e.what(), Contains("ACME-42") && Contains("placeholder"));
 }
@@ -391,7 +391,7 @@ TEST_CASE("Zemax: DISZ on SURF 0 is the object distance, INFINITY an object at i
 
 TEST_CASE("Zemax: a negative object distance is an error", "[prescription][zemax]") {
   const std::string text = mini_zmx("", "", "-50");
-  const LensFileError e = zemax_error(text);
+  const FileError e = zemax_error(text);
   CHECK(e.where().line == line_of(text, "DISZ -50"));
 }
 
@@ -408,7 +408,7 @@ TEST_CASE("Zemax: PWAV picks the primary wavelength, counting from 1", "[prescri
 TEST_CASE("Zemax: PWAV beyond the wavelengths in use is an error", "[prescription][zemax]") {
   std::string text = mini_zmx();
   text.replace(text.find("PWAV 1"), 6, "PWAV 2");  // FTYP says one wavelength is in use
-  const LensFileError e = zemax_error(text);
+  const FileError e = zemax_error(text);
   CHECK(e.where().line == line_of(text, "PWAV 2"));
 }
 
@@ -454,7 +454,7 @@ TEST_CASE("Zemax: FTYP 3 gives a real image-height field, in lens units", "[pres
 TEST_CASE("Zemax: FTYP's theodolite angle fields are refused on their line", "[prescription][zemax]") {
   std::string text = mini_zmx();
   text.replace(text.find("FTYP 0"), 6, "FTYP 4");
-  const LensFileError e = zemax_error(text);
+  const FileError e = zemax_error(text);
   CHECK(e.where().line == line_of(text, "FTYP 4"));
   CHECK_THAT(e.what(), Contains("theodolite"));
 }
@@ -470,7 +470,7 @@ TEST_CASE("Zemax: FTYP's telecentric flag makes the lens object-space telecentri
 TEST_CASE("Zemax: a telecentric lens with an entrance-pupil aperture is refused on a located line", "[prescription][zemax]") {
   std::string text = mini_zmx("", "", "400");
   text.replace(text.find("FTYP 0 0"), 8, "FTYP 1 1");
-  const LensFileError e = zemax_error(text);
+  const FileError e = zemax_error(text);
   CHECK_THAT(e.what(), Contains("telecentric"));
   CHECK(e.where().line == line_of(text, "ENPD"));
 }
@@ -523,7 +523,7 @@ TEST_CASE("Zemax: FNUM type 1 is a paraxial working F/#, OBNA an object-space NA
 TEST_CASE("Zemax: an object-space NA with the object at infinity is refused on the OBNA line", "[prescription][zemax]") {
   std::string na = mini_zmx();
   na.replace(na.find("ENPD 10"), 7, "OBNA 1.5E-1 0");
-  const LensFileError e = zemax_error(na);
+  const FileError e = zemax_error(na);
   CHECK(e.where().line == line_of(na, "OBNA"));
   CHECK_THAT(e.what(), Contains("finite object"));
 }
@@ -574,7 +574,7 @@ TEST_CASE("Zemax: annular, rectangular and elliptical apertures and obscurations
 
 TEST_CASE("Zemax: two apertures on one surface are refused on the second's line", "[prescription][zemax]") {
   const std::string text = mini_zmx("", "  CLAP 0 6 0\n  OBSC 0 1 0\n");
-  const LensFileError e = zemax_error(text);
+  const FileError e = zemax_error(text);
   CHECK(e.where().line == line_of(text, "OBSC"));
   CHECK_THAT(e.what(), Contains("CLAP"));
 }
@@ -583,7 +583,7 @@ TEST_CASE("Zemax: spiders and user-defined apertures are refused, naming the key
   for (const char* line : {"  SPID 1 4 0\n", "  UDAD 0 0 0\n"}) {
     const std::string text = mini_zmx("", line);
     INFO(line);
-    const LensFileError e = zemax_error(text);
+    const FileError e = zemax_error(text);
     CHECK(e.where().line == line_of(text, line));
     CHECK_THAT(e.what(), Contains(std::string(line).substr(2, 4)));
   }
@@ -625,7 +625,7 @@ TEST_CASE("Zemax: a surface tilt before the surface (SCBD 1) is a coordinate bre
 
 TEST_CASE("Zemax: PARM with a non-zero value on a STANDARD surface is an error", "[prescription][zemax]") {
   const std::string text = mini_zmx("", "  PARM 2 1.0E-6\n");
-  const LensFileError e = zemax_error(text);
+  const FileError e = zemax_error(text);
   CHECK(e.where().line == line_of(text, "PARM 2"));
   CHECK_THAT(e.what(), Contains("EVENASPH"));
   CHECK_NOTHROW(read_zemax(mini_zmx("", "  PARM 2 0\n"), "t.zmx"));
@@ -663,7 +663,7 @@ TEST_CASE("Zemax: numbers such as 1.#INF, nan and 1e999 are errors naming their 
     std::string text = mini_zmx();
     text.replace(text.find("CURV 0.02"), 9, std::string("CURV ") + bad);
     INFO(bad);
-    const LensFileError e = zemax_error(text);
+    const FileError e = zemax_error(text);
     CHECK(e.where().line == line_of(text, std::string("CURV ") + bad));
     CHECK(e.where().column == 8);
   }
@@ -692,8 +692,8 @@ TEST_CASE("Zemax: a truncated file is an error", "[prescription][zemax]") {
   const std::string path = data_file("truncated.zmx");
   try {
     read_zemax(read_file_bytes(path), path);
-    FAIL("expected a LensFileError");
-  } catch (const LensFileError& e) {
+    FAIL("expected a FileError");
+  } catch (const FileError& e) {
     CHECK_THAT(e.what(), Contains("truncated"));
     CHECK(e.where().line > 0);
   }
@@ -701,10 +701,10 @@ TEST_CASE("Zemax: a truncated file is an error", "[prescription][zemax]") {
 
 TEST_CASE("Zemax: binary garbage and empty files are errors, not crashes", "[prescription][zemax]") {
   const std::string garbage("\x89PNG\r\n\x1a\n\0\0\0\rIHDR", 16);
-  CHECK_THROWS_AS(read_zemax(garbage, "g.zmx"), LensFileError);
-  CHECK_THROWS_AS(read_zemax("", "e.zmx"), LensFileError);
-  CHECK_THROWS_AS(read_zemax("\xFF\xFE", "bom-only.zmx"), LensFileError);
-  CHECK_THROWS_AS(read_zemax(std::string(100000, 'A'), "long.zmx"), LensFileError);
+  CHECK_THROWS_AS(read_zemax(garbage, "g.zmx"), FileError);
+  CHECK_THROWS_AS(read_zemax("", "e.zmx"), FileError);
+  CHECK_THROWS_AS(read_zemax("\xFF\xFE", "bom-only.zmx"), FileError);
+  CHECK_THROWS_AS(read_zemax(std::string(100000, 'A'), "long.zmx"), FileError);
 }
 
 TEST_CASE("Zemax: a file needs an object, a lens surface and an image surface", "[prescription][zemax]") {
@@ -715,7 +715,7 @@ TEST_CASE("Zemax: a wavelength used twice is an error naming its WAVM line", "[p
   std::string text = mini_zmx();
   text.replace(text.find("FTYP 0 0 2 1"), 12, "FTYP 0 0 2 2");
   text.replace(text.find("WAVM 2 0.55 1"), 13, "WAVM 2 0.5875618 1");
-  const LensFileError e = zemax_error(text);
+  const FileError e = zemax_error(text);
   CHECK(e.where().line == line_of(text, "WAVM 2"));
   CHECK_THAT(e.what(), Contains("twice"));
 }

@@ -46,14 +46,14 @@ std::string with_object(const std::string& object) {
          " ]}\n";
 }
 
-// Reads `text` as "scene.json" and returns the SceneFileError it must raise.
-SceneFileError read_error(const std::string& text) {
+// Reads `text` as "scene.json" and returns the FileError it must raise.
+FileError read_error(const std::string& text) {
   try {
     read_scene_json(text, "scene.json");
-  } catch (const SceneFileError& e) {
+  } catch (const FileError& e) {
     return e;
   }
-  FAIL("no SceneFileError for:\n" << text);
+  FAIL("no FileError for:\n" << text);
   throw std::logic_error("unreachable");
 }
 
@@ -120,7 +120,7 @@ TEST_CASE("a scene file with no camera, ambient or background gets the documente
 }
 
 TEST_CASE("an unknown key is an error at its line naming the allowed keys", "[scene][json]") {
-  const SceneFileError e = read_error(with_object(
+  const FileError e = read_error(with_object(
       R"(  {"type": "sphere", "centre_m": [0, 0, 3], "radius_m": 1, "colour": [1, 0, 0], "material": {"albedo": 0.5}})"));
   CHECK(e.where().file == "scene.json");
   CHECK(e.where().line == 4);
@@ -130,58 +130,58 @@ TEST_CASE("an unknown key is an error at its line naming the allowed keys", "[sc
 }
 
 TEST_CASE("an unknown key in a nested texture is an error at its line", "[scene][json]") {
-  const SceneFileError e = read_error(with_object(
+  const FileError e = read_error(with_object(
       R"(  {"type": "sphere", "centre_m": [0, 0, 3], "radius_m": 1, "material": {"texture": {"type": "checker", "size_m": 1, "colours": [0, 1], "scale_m": 2}}})"));
   CHECK(e.where().line == 4);
   CHECK_THAT(e.what(), Contains("objects[0].material.texture.scale_m: unknown key"));
 }
 
 TEST_CASE("a value of the wrong type is an error at its line saying what was expected", "[scene][json]") {
-  const SceneFileError e = read_error(with_object(R"(  {"type": "sphere", "centre_m": [0, 0, 3], "radius_m": "1", "material": {"albedo": 0.5}})"));
+  const FileError e = read_error(with_object(R"(  {"type": "sphere", "centre_m": [0, 0, 3], "radius_m": "1", "material": {"albedo": 0.5}})"));
   CHECK(e.where().line == 4);
   CHECK(e.where().column == 57);
   CHECK_THAT(e.what(), Contains("scene.json:4:57: objects[0].radius_m: expected a number, got a string"));
 }
 
 TEST_CASE("a vector of the wrong length is an error naming the expected form", "[scene][json]") {
-  const SceneFileError e = read_error(with_object(R"(  {"type": "sphere", "centre_m": [0, 3], "radius_m": 1, "material": {"albedo": 0.5}})"));
+  const FileError e = read_error(with_object(R"(  {"type": "sphere", "centre_m": [0, 3], "radius_m": 1, "material": {"albedo": 0.5}})"));
   CHECK(e.where().line == 4);
   CHECK_THAT(e.what(), Contains("objects[0].centre_m: expected a point in metres [x, y, z] (3 numbers), got an array of 2"));
 }
 
 TEST_CASE("a missing required key is named with the line of its object", "[scene][json]") {
-  const SceneFileError e = read_error(with_object(R"(  {"type": "sphere", "centre_m": [0, 0, 3], "material": {"albedo": 0.5}})"));
+  const FileError e = read_error(with_object(R"(  {"type": "sphere", "centre_m": [0, 0, 3], "material": {"albedo": 0.5}})"));
   CHECK(e.where().line == 4);
   CHECK(e.where().column == 3);
   CHECK_THAT(e.what(), Contains("objects[0]: missing key \"radius_m\""));
 }
 
 TEST_CASE("a missing material is named with the line of its object", "[scene][json]") {
-  const SceneFileError e = read_error(with_object(R"(  {"type": "sphere", "centre_m": [0, 0, 3], "radius_m": 1})"));
+  const FileError e = read_error(with_object(R"(  {"type": "sphere", "centre_m": [0, 0, 3], "radius_m": 1})"));
   CHECK(e.where().line == 4);
   CHECK_THAT(e.what(), Contains("objects[0]: missing key \"material\""));
 }
 
 TEST_CASE("a missing objects array is named at the top of the file", "[scene][json]") {
-  const SceneFileError e = read_error("{\"format\": \"lensmith-scene\",\n \"version\": 1}");
+  const FileError e = read_error("{\"format\": \"lensmith-scene\",\n \"version\": 1}");
   CHECK(e.where().line == 1);
   CHECK_THAT(e.what(), Contains("missing key \"objects\""));
 }
 
 TEST_CASE("a negative radius is an error at its line", "[scene][json]") {
-  const SceneFileError e = read_error(with_object(R"(  {"type": "disc", "centre_m": [0, 0, 3], "normal": [0, 0, 1], "radius_m": -0.5, "material": {"albedo": 0.5}})"));
+  const FileError e = read_error(with_object(R"(  {"type": "disc", "centre_m": [0, 0, 3], "normal": [0, 0, 1], "radius_m": -0.5, "material": {"albedo": 0.5}})"));
   CHECK(e.where().line == 4);
   CHECK_THAT(e.what(), Contains("objects[0].radius_m: must be finite and > 0, got -0.5"));
 }
 
 TEST_CASE("a normal that cannot be normalised is an error at its line", "[scene][json]") {
-  const SceneFileError e = read_error(with_object(R"(  {"type": "plane", "point_m": [0, 0, 3], "normal": [0, 0, 0], "material": {"albedo": 0.5}})"));
+  const FileError e = read_error(with_object(R"(  {"type": "plane", "point_m": [0, 0, 3], "normal": [0, 0, 0], "material": {"albedo": 0.5}})"));
   CHECK(e.where().line == 4);
   CHECK_THAT(e.what(), Contains("objects[0].normal: [0, 0, 0] cannot be normalised"));
 }
 
 TEST_CASE("a u_axis along the normal is an error at the u_axis", "[scene][json]") {
-  const SceneFileError e = read_error(with_object(
+  const FileError e = read_error(with_object(
       R"(  {"type": "plane", "point_m": [0, 0, 3], "normal": [0, 0, -1], "u_axis": [0, 0, 2], "material": {"albedo": 0.5}})"));
   CHECK(e.where().line == 4);
   CHECK(e.where().column == 75);
@@ -189,7 +189,7 @@ TEST_CASE("a u_axis along the normal is an error at the u_axis", "[scene][json]"
 }
 
 TEST_CASE("rectangle half-edges that are not perpendicular are an error naming both", "[scene][json]") {
-  const SceneFileError e = read_error(with_object(
+  const FileError e = read_error(with_object(
       R"(  {"type": "rectangle", "centre_m": [0, 0, 3], "half_u_m": [1, 0, 0], "half_v_m": [0.1, 1, 0], "material": {"albedo": 0.5}})"));
   CHECK(e.where().line == 4);
   CHECK_THAT(e.what(), Contains("must be perpendicular"));
@@ -197,44 +197,44 @@ TEST_CASE("rectangle half-edges that are not perpendicular are an error naming b
 }
 
 TEST_CASE("an unknown object type is an error listing the known ones", "[scene][json]") {
-  const SceneFileError e = read_error(with_object(R"(  {"type": "cube", "centre_m": [0, 0, 3], "material": {"albedo": 0.5}})"));
+  const FileError e = read_error(with_object(R"(  {"type": "cube", "centre_m": [0, 0, 3], "material": {"albedo": 0.5}})"));
   CHECK(e.where().line == 4);
   CHECK_THAT(e.what(), Contains("unknown object type \"cube\"; expected \"plane\", \"rectangle\", \"disc\" or \"sphere\""));
 }
 
 TEST_CASE("an unknown texture type is an error listing the known ones", "[scene][json]") {
-  const SceneFileError e = read_error(with_object(
+  const FileError e = read_error(with_object(
       R"(  {"type": "sphere", "centre_m": [0, 0, 3], "radius_m": 1, "material": {"texture": {"type": "marble"}}})"));
   CHECK(e.where().line == 4);
   CHECK_THAT(e.what(), Contains("objects[0].material.texture.type: unknown texture type \"marble\""));
 }
 
 TEST_CASE("a material with both albedo and texture is an error", "[scene][json]") {
-  const SceneFileError e = read_error(with_object(
+  const FileError e = read_error(with_object(
       R"(  {"type": "sphere", "centre_m": [0, 0, 3], "radius_m": 1, "material": {"albedo": 0.5, "texture": {"type": "constant", "colour": 1}}})"));
   CHECK_THAT(e.what(), Contains("objects[0].material.texture: give albedo (a colour) or texture, not both"));
 }
 
 TEST_CASE("an empty material is an error naming what it needs", "[scene][json]") {
-  const SceneFileError e = read_error(with_object(R"(  {"type": "sphere", "centre_m": [0, 0, 3], "radius_m": 1, "material": {}})"));
+  const FileError e = read_error(with_object(R"(  {"type": "sphere", "centre_m": [0, 0, 3], "radius_m": 1, "material": {}})"));
   CHECK_THAT(e.what(), Contains("objects[0].material: a material needs at least one of emission, albedo, texture"));
 }
 
 TEST_CASE("a negative colour channel is an error at the colour", "[scene][json]") {
-  const SceneFileError e = read_error(with_object(
+  const FileError e = read_error(with_object(
       R"(  {"type": "sphere", "centre_m": [0, 0, 3], "radius_m": 1, "material": {"emission": [1, -2, 3]}})"));
   CHECK(e.where().line == 4);
   CHECK_THAT(e.what(), Contains("objects[0].material.emission: each channel must be >= 0"));
 }
 
 TEST_CASE("a noise texture's octaves must be an integer in 1 to 16", "[scene][json]") {
-  const SceneFileError e = read_error(with_object(
+  const FileError e = read_error(with_object(
       R"(  {"type": "sphere", "centre_m": [0, 0, 3], "radius_m": 1, "material": {"texture": {"type": "noise", "scale_m": 1, "octaves": 2.5, "colours": [0, 1]}}})"));
   CHECK_THAT(e.what(), Contains("objects[0].material.texture.octaves: must be an integer in 1..16, got 2.5"));
 }
 
 TEST_CASE("a checker needs exactly two colours", "[scene][json]") {
-  const SceneFileError e = read_error(with_object(
+  const FileError e = read_error(with_object(
       R"(  {"type": "sphere", "centre_m": [0, 0, 3], "radius_m": 1, "material": {"texture": {"type": "checker", "size_m": 1, "colours": [0, 1, 0.5]}}})"));
   CHECK_THAT(e.what(), Contains("objects[0].material.texture.colours: expected two colours"));
 }
@@ -247,33 +247,33 @@ TEST_CASE("the format name and version are checked", "[scene][json]") {
 }
 
 TEST_CASE("a JSON syntax error names its line", "[scene][json]") {
-  const SceneFileError e = read_error("{\"format\": \"lensmith-scene\",\n \"version\": 1,\n \"objects\": [,]}");
+  const FileError e = read_error("{\"format\": \"lensmith-scene\",\n \"version\": 1,\n \"objects\": [,]}");
   CHECK(e.where().line == 3);
 }
 
 TEST_CASE("a camera whose up vector is along its look direction is an error at up", "[scene][json]") {
-  const SceneFileError e = read_error(
+  const FileError e = read_error(
       "{\"format\": \"lensmith-scene\", \"version\": 1,\n \"camera\": {\"look_at_m\": [0, 0, 5],\n \"up\": [0, 0, 1]},\n \"objects\": []}");
   CHECK(e.where().line == 3);
   CHECK_THAT(e.what(), Contains("camera.up: up [0, 0, 1] is parallel to the look direction"));
 }
 
 TEST_CASE("a camera looking at its own position is an error at look_at_m", "[scene][json]") {
-  const SceneFileError e = read_error(
+  const FileError e = read_error(
       "{\"format\": \"lensmith-scene\", \"version\": 1,\n \"camera\": {\"position_m\": [1, 1, 1], \"look_at_m\": [1, 1, 1]},\n \"objects\": []}");
   CHECK(e.where().line == 2);
   CHECK_THAT(e.what(), Contains("camera.look_at_m: must differ from position_m"));
 }
 
 TEST_CASE("an image texture that cannot be read is an error at its file key quoting the path", "[scene][json]") {
-  const SceneFileError e = read_error(with_object(
+  const FileError e = read_error(with_object(
       R"(  {"type": "rectangle", "centre_m": [0, 0, 3], "half_u_m": [1, 0, 0], "half_v_m": [0, 1, 0], "material": {"texture": {"type": "image", "file": "no-such-picture.exr"}}})"));
   CHECK(e.where().line == 4);
   CHECK_THAT(e.what(), Contains("objects[0].material.texture.file: cannot use the picture no-such-picture.exr"));
 }
 
 TEST_CASE("an image texture on a sphere needs an explicit size", "[scene][json]") {
-  const SceneFileError e = read_error(with_object(
+  const FileError e = read_error(with_object(
       R"(  {"type": "sphere", "centre_m": [0, 0, 3], "radius_m": 1, "material": {"texture": {"type": "image", "file": "x.exr"}}})"));
   CHECK_THAT(e.what(), Contains("objects[0].material.texture: missing key \"size_m\""));
 }

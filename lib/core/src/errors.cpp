@@ -11,7 +11,22 @@ std::string SourceLocation::to_string() const {
   return s;
 }
 
-LensFileError::LensFileError(SourceLocation where, const std::string& what)
+std::string ErrorSubject::to_string() const {
+  std::string s;
+  if (surface > 0) s = "surface " + std::to_string(surface);
+  if (!field.empty()) {
+    if (!s.empty()) s += ", ";
+    s += field;
+    if (index >= 0) {
+      s += '[';
+      s += std::to_string(index);
+      s += ']';
+    }
+  }
+  return s.empty() ? std::string("(none)") : s;
+}
+
+FileError::FileError(SourceLocation where, const std::string& what)
     : Error(where.to_string() + ": " + what), where_(std::move(where)), detail_(what) {}
 
 }  // namespace lensmith

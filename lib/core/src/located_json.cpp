@@ -139,7 +139,7 @@ class LocatedJsonBuilder {
     return fail_at(offset, what);
   }
 
-  [[noreturn]] void throw_error() const { throw LensFileError(error_where_, error_message_); }
+  [[noreturn]] void throw_error() const { throw FileError(error_where_, error_message_); }
   bool failed() const { return !error_message_.empty(); }
 
  private:
@@ -210,7 +210,7 @@ LocatedJson LocatedJson::parse(std::string_view text, const std::string& file_na
   const bool ok = nlohmann::json::sax_parse(first, last, &builder, nlohmann::json::input_format_t::json, true, false);
   if (!ok || builder.failed()) {
     if (builder.failed()) builder.throw_error();
-    throw LensFileError({file_name, 0, 0}, "not valid JSON");
+    throw FileError({file_name, 0, 0}, "not valid JSON");
   }
   return doc;
 }
@@ -249,7 +249,7 @@ JsonObjectReader::JsonObjectReader(const LocatedJson& doc, std::string pointer, 
     : doc_(doc), pointer_(std::move(pointer)), path_(std::move(display_path)) {
   object_ = &doc.root().at(nlohmann::json::json_pointer(pointer_));
   if (!object_->is_object()) {
-    throw LensFileError(doc_.where(pointer_),
+    throw FileError(doc_.where(pointer_),
                         (path_.empty() ? std::string("the file") : path_) + ": expected an object, got " + json_type_phrase(*object_));
   }
 }
@@ -273,7 +273,7 @@ SourceLocation JsonObjectReader::where(const std::string& key) const {
 
 void JsonObjectReader::fail(const std::string& key, const std::string& message) const {
   const std::string path = key.empty() ? path_ : child_path(key);
-  throw LensFileError(where(key), (path.empty() ? std::string() : path + ": ") + message);
+  throw FileError(where(key), (path.empty() ? std::string() : path + ": ") + message);
 }
 
 double JsonObjectReader::get_number(const std::string& key) {

@@ -46,7 +46,7 @@ void append_utf8(std::string& out, char32_t cp) {
 
 std::string decode_utf16(std::string_view bytes, bool little_endian, const std::string& file_name) {
   if (bytes.size() % 2 != 0) {
-    throw LensFileError({file_name, 0, 0}, "UTF-16 text has an odd number of bytes (truncated file?)");
+    throw FileError({file_name, 0, 0}, "UTF-16 text has an odd number of bytes (truncated file?)");
   }
   std::string out;
   out.reserve(bytes.size() / 2);
@@ -60,13 +60,13 @@ std::string decode_utf16(std::string_view bytes, bool little_endian, const std::
     char16_t u = unit_at(i);
     char32_t cp = u;
     if (u >= 0xD800 && u <= 0xDBFF) {
-      if (i + 3 >= bytes.size()) throw LensFileError({file_name, line, 0}, "UTF-16 surrogate pair cut off at end of file");
+      if (i + 3 >= bytes.size()) throw FileError({file_name, line, 0}, "UTF-16 surrogate pair cut off at end of file");
       char16_t lo = unit_at(i + 2);
-      if (lo < 0xDC00 || lo > 0xDFFF) throw LensFileError({file_name, line, 0}, "malformed UTF-16 surrogate pair");
+      if (lo < 0xDC00 || lo > 0xDFFF) throw FileError({file_name, line, 0}, "malformed UTF-16 surrogate pair");
       cp = 0x10000 + ((static_cast<char32_t>(u) - 0xD800) << 10) + (lo - 0xDC00);
       i += 2;
     } else if (u >= 0xDC00 && u <= 0xDFFF) {
-      throw LensFileError({file_name, line, 0}, "malformed UTF-16: lone low surrogate");
+      throw FileError({file_name, line, 0}, "malformed UTF-16: lone low surrogate");
     }
     if (cp == U'\n') ++line;
     append_utf8(out, cp);
@@ -109,13 +109,6 @@ std::optional<bool> utf16_without_bom(std::string_view bytes) {
 
 }  // namespace
 
-std::string ascii_upper(std::string_view text) {
-  std::string out(text);
-  for (char& c : out) {
-    if (c >= 'a' && c <= 'z') c = static_cast<char>(c - 'a' + 'A');
-  }
-  return out;
-}
 
 std::string shown_text(std::string_view text, std::size_t max_length) {
   if (text.size() <= max_length) return std::string(text);

@@ -338,7 +338,7 @@ class MeritReader {
       const std::string pointer = r.child_pointer(key) + "/" + std::to_string(i);
       const nlohmann::json& v = doc_.root().at(nlohmann::json::json_pointer(pointer));
       if (!v.is_number() || !std::isfinite(v.get<double>())) {
-        throw LensFileError(doc_.where(pointer), r.child_path(key) + "[" + std::to_string(i) + "]: expected a finite number, got " + json_type_phrase(v));
+        throw FileError(doc_.where(pointer), r.child_path(key) + "[" + std::to_string(i) + "]: expected a finite number, got " + json_type_phrase(v));
       }
       values.push_back(v.get<double>());
     }
@@ -479,7 +479,7 @@ class MeritReader {
 
 MeritFunction parse_merit_function(std::string_view text, const std::string& file_name) {
   const LocatedJson doc = LocatedJson::parse(text, file_name);
-  if (!doc.root().is_object()) throw LensFileError(doc.where(""), "expected a merit function object {\"variables\": [...], \"operands\": [...]}");
+  if (!doc.root().is_object()) throw FileError(doc.where(""), "expected a merit function object {\"variables\": [...], \"operands\": [...]}");
   return MeritReader(doc).read();
 }
 

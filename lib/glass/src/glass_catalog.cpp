@@ -1,6 +1,7 @@
 // Glass catalogues: reading lensmith's compact JSON (docs/glass.md, written by
 // tools/convert_glass_catalogs.py from the refractiveindex.info database) and looking glasses up
 // by name. A name that is not found is an error listing the closest names; nothing is guessed.
+#include "lensmith/core/ascii_text.h"
 #include "lensmith/glass/glass_catalog.h"
 
 #include <algorithm>
@@ -34,20 +35,12 @@ constexpr int kFormatVersion = 1;
 constexpr std::string_view kDefaultVendorOrder[] = {"SCHOTT", "OHARA", "HOYA", "CDGM", "HIKARI", "SUMITA"};
 constexpr std::size_t kDefaultSuggestions = 5;
 
-std::string upper(std::string_view text) {
-  std::string out(text);
-  for (char& c : out) {
-    if (c >= 'a' && c <= 'z') c = static_cast<char>(c - 'a' + 'A');
-  }
-  return out;
-}
-
 // The form in which names are compared for suggestions: "n-bk7", "N BK7" and "NBK7" all become
 // "NBK7", because lens files and patents write separators inconsistently.
 std::string normalise(std::string_view name) {
   std::string out;
   out.reserve(name.size());
-  for (char c : upper(name)) {
+  for (char c : to_upper_ascii(name)) {
     if (c != '-' && c != ' ' && c != '_') out += c;
   }
   return out;
@@ -99,7 +92,7 @@ std::vector<double> read_numbers(JsonObjectReader& reader, const std::string& ke
   for (std::size_t i = 0; i < size; ++i) {
     const nlohmann::json& item = array[i];
     if (!item.is_number()) {
-      throw LensFileError(reader.document().where(reader.child_pointer(key) + "/" + std::to_string(i)),
+      throw FileError(reader.document().where(reader.child_pointer(key) + "/" + std::to_string(i)),
                           reader.child_path(key) + "[" + std::to_string(i) + "]: expected a number, got " +
                               json_type_phrase(item));
     }
@@ -215,8 +208,8 @@ GlassCatalog GlassCatalog::from_agf(std::string_view text, const std::string& fi
     if (!pending) return;
     const Pending& g = *pending;
     const SourceLocation at{file_name, g.line, 1};
-    if (!g.has_coefficients) throw LensFileError(at, "glass " + g.name + " has no CD line (its dispersion coefficients)");
-    if (!g.range_um) throw LensFileError(at, "glass " + g.name + " has no LD line (the wavelength range of its formula, micrometres)");
+    if (!g.has_coefficients) throw FileError(at, "glass " + g.name + " has no CD line (its dispersion coefficients)");
+    if (!g.range_um) throw FileError(at, "glass " + g.name + " has no LD line (the wavelength range of its formula, micrometres)");
     const auto [formula, coefficients] = agf_formula(g.formula, g.coefficients);
     try {
       Glass glass = Glass::from_formula(g.name, vendor, formula, coefficients,
@@ -225,7 +218,7 @@ GlassCatalog GlassCatalog::from_agf(std::string_view text, const std::string& fi
       glass.set_catalog_status(g.status);
       catalog.add(std::move(glass));
     } catch (const GlassError& e) {
-      throw LensFileError(at, e.what());
+      throw FileError(at, e.what());
     }
     pending.reset();
   };
@@ -247,7 +240,7 @@ GlassCatalog GlassCatalog::from_agf(std::string_view text, const std::string& fi
     const SourceLocation at{file_name, line_number, 1};
     const auto number = [&](std::size_t i, const char* what) {
       const std::optional<double> v = i < words.size() ? parse_finite_number(words[i]) : std::nullopt;
-      if (!v) throw LensFileError(at, std::string(words[0]) + ": expected " + what + " as field " + std::to_string(i) + ", got " +
+      if (!v) throw FileError(at, std::string(words[0]) + ": expected " + what + " as field " + std::to_string(i) + ", got " +
                                           (i < words.size() ? "\"" + std::string(words[i]) + "\"" : std::string("nothing")));
       return *v;
     };
@@ -256,11 +249,11 @@ GlassCatalog GlassCatalog::from_agf(std::string_view text, const std::string& fi
       finish();
       Pending g;
       g.line = line_number;
-      if (words.size() < 2) throw LensFileError(at, "NM: expected the glass name");
+      if (words.size() < 2) throw FileError(at, "NM: expected the glass name");
       g.name = std::string(words[1]);
       const double formula = number(2, "the dispersion formula number (1-13)");
       if (formula != std::floor(formula) || formula < 1 || formula > 13) {
-        throw LensFileError(at, "NM " + g.name + ": dispersion formula " + format_number(formula) + " is not one of AGF's 1-13");
+        throw FileError(at, "NM " + g.name + ": dispersion formula " + format_number(formula) + " is not one of AGF's 1-13");
       }
       g.formula = static_cast<int>(formula);
       g.nd = words.size() > 4 ? number(4, "nd") : std::numeric_limits<double>::quiet_NaN();
@@ -272,33 +265,32 @@ GlassCatalog GlassCatalog::from_agf(std::string_view text, const std::string& fi
       }
       pending = std::move(g);
     } else if (key == "CD") {
-      if (!pending) throw LensFileError(at, "CD before any NM line (coefficients of no glass)");
-      if (words.size() > 11) throw LensFileError(at, "CD: at most 10 coefficients, got " + std::to_string(words.size() - 1));
+      if (!pending) throw FileError(at, "CD before any NM line (coefficients of no glass)");
+      if (words.size() > 11) throw FileError(at, "CD: at most 10 coefficients, got " + std::to_string(words.size() - 1));
       for (std::size_t i = 1; i < words.size(); ++i) pending->coefficients[i - 1] = number(i, "a coefficient");
       pending->has_coefficients = true;
     } else if (key == "LD") {
-      if (!pending) throw LensFileError(at, "LD before any NM line");
+      if (!pending) throw FileError(at, "LD before any NM line");
       const double lo = number(1, "the shortest wavelength (um)"), hi = number(2, "the longest wavelength (um)");
-      if (!(lo > 0.0) || !(hi > lo)) throw LensFileError(at, "LD " + format_number(lo) + " " + format_number(hi) + ": expected 0 < min < max micrometres");
+      if (!(lo > 0.0) || !(hi > lo)) throw FileError(at, "LD " + format_number(lo) + " " + format_number(hi) + ": expected 0 < min < max micrometres");
       pending->range_um = std::make_pair(lo, hi);
     } else if (key == "CC" || key == "GC" || key == "ED" || key == "TD" || key == "OD" || key == "IT" || key == "BD") {
       // Comments, thermal, other and transmission data: not used by lensmith.
     } else {
-      throw LensFileError(at, "unknown AGF record \"" + std::string(key.substr(0, 16)) +
+      throw FileError(at, "unknown AGF record \"" + std::string(key.substr(0, 16)) +
                                   "\" (expected NM, CD, LD, or CC, GC, ED, TD, OD, IT, BD)");
     }
   }
   finish();
-  if (catalog.size() == 0) throw LensFileError({file_name, 0, 0}, "no glass (NM line) in this AGF catalogue");
+  if (catalog.size() == 0) throw FileError({file_name, 0, 0}, "no glass (NM line) in this AGF catalogue");
   return catalog;
 }
 
 GlassCatalog GlassCatalog::read_file(const std::string& path) {
   const std::filesystem::path p(path);
-  std::string extension = p.extension().string();
-  for (char& ch : extension) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  const std::string extension = to_lower_ascii(p.extension().string());
   const std::string text = decode_text(read_file_bytes(path), path);
-  if (extension == ".agf") return from_agf(text, path, upper(p.stem().string()));
+  if (extension == ".agf") return from_agf(text, path, to_upper_ascii(p.stem().string()));
   if (extension == ".json") return from_json(text, path);
   throw GlassError(path + ": a glass catalogue is a Zemax .agf or a lensmith .json file");
 }
@@ -313,9 +305,7 @@ void append_catalog_files(GlassCatalog& all, const std::vector<std::string>& pat
     std::error_code ec;
     if (std::filesystem::is_directory(path, ec)) {
       for (const auto& entry : std::filesystem::directory_iterator(path, ec)) {
-        std::string ext = entry.path().extension().string();
-        for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-        if (ext == ".agf") files.push_back(entry.path().string());
+        if (to_lower_ascii(entry.path().extension().string()) == ".agf") files.push_back(entry.path().string());
       }
       std::sort(files.begin(), files.end());
       if (files.empty()) throw GlassError(origin + path + ": a folder without .agf glass catalogues");
@@ -385,7 +375,7 @@ GlassCatalog GlassCatalog::from_json(std::string_view json_text, const std::stri
     root.fail("version", "version " + number_text(version) + " is not supported; this lensmith reads version " +
                              std::to_string(kFormatVersion));
   }
-  const std::string vendor = upper(root.get_string("vendor"));
+  const std::string vendor = to_upper_ascii(root.get_string("vendor"));
   if (vendor.empty()) root.fail("vendor", "must not be empty");
   // Provenance, for people reading the file; lensmith does not interpret it.
   root.get_optional_string("source");
@@ -425,7 +415,7 @@ void GlassCatalog::merge(const GlassCatalog& other) {
 
 void GlassCatalog::add(Glass glass) {
   if (vendor_rank(glass.vendor()) == vendors_.size()) vendors_.push_back(glass.vendor());
-  by_name_[upper(glass.name())].push_back(glasses_.size());
+  by_name_[to_upper_ascii(glass.name())].push_back(glasses_.size());
   normalised_names_.push_back(normalise(glass.name()));
   glasses_.push_back(std::move(glass));
 }
@@ -436,7 +426,7 @@ std::size_t GlassCatalog::vendor_rank(std::string_view vendor_upper) const {
 
 const Glass* GlassCatalog::find(std::string_view name, std::string_view vendor,
                                 std::span<const std::string> vendor_order) const {
-  const auto it = by_name_.find(upper(name));
+  const auto it = by_name_.find(to_upper_ascii(name));
   if (it == by_name_.end()) return nullptr;
   const std::vector<std::size_t>& candidates = it->second;
   auto at_vendor = [&](std::string_view vendor_upper) -> const Glass* {
@@ -445,9 +435,9 @@ const Glass* GlassCatalog::find(std::string_view name, std::string_view vendor,
     }
     return nullptr;
   };
-  if (!vendor.empty()) return at_vendor(upper(vendor));
+  if (!vendor.empty()) return at_vendor(to_upper_ascii(vendor));
   for (const std::string& preferred : vendor_order) {
-    if (const Glass* glass = at_vendor(upper(preferred))) return glass;
+    if (const Glass* glass = at_vendor(to_upper_ascii(preferred))) return glass;
   }
   // Default order: the candidate whose vendor comes first in vendors_.
   const auto best = std::min_element(candidates.begin(), candidates.end(), [&](std::size_t a, std::size_t b) {
@@ -465,10 +455,10 @@ const Glass& GlassCatalog::get(std::string_view name, std::string_view vendor,
     throw GlassError("unknown glass " + quoted +
                      (closest.empty() ? "; the glass catalogue is empty" : "; closest catalogue names: " + join(closest)));
   }
-  const std::string vendor_upper = upper(vendor);
+  const std::string vendor_upper = to_upper_ascii(vendor);
   // The name may exist at another vendor (SF5 is SCHOTT and HIKARI, not HOYA): say where.
   std::vector<std::string> elsewhere;
-  if (const auto it = by_name_.find(upper(name)); it != by_name_.end()) {
+  if (const auto it = by_name_.find(to_upper_ascii(name)); it != by_name_.end()) {
     for (std::size_t index : it->second) elsewhere.push_back(glasses_[index].name() + " (" + glasses_[index].vendor() + ")");
   }
   const std::string where_else = elsewhere.empty() ? "" : "; the name exists only as " + join(elsewhere);
@@ -483,7 +473,7 @@ const Glass& GlassCatalog::get(std::string_view name, std::string_view vendor,
 
 const Glass* GlassCatalog::successor(std::string_view obsolete_name) const {
   if (obsolete_name.empty() || find(obsolete_name) != nullptr) return nullptr;
-  const std::string base = "N-" + upper(obsolete_name);
+  const std::string base = "N-" + to_upper_ascii(obsolete_name);
   for (const std::string& candidate : {base, base + "A"}) {
     if (const Glass* glass = find(candidate, "SCHOTT")) return glass;
   }
@@ -515,7 +505,7 @@ std::vector<std::string> GlassCatalog::closest_names_at(std::string_view name, s
   for (std::size_t i = 0; i < glasses_.size(); ++i) {
     if (!vendor_upper.empty() && glasses_[i].vendor() != vendor_upper) continue;
     // An exact match after normalising has distance 0 and so ranks first.
-    candidates.push_back({levenshtein(query, normalised_names_[i]), upper(glasses_[i].name()),
+    candidates.push_back({levenshtein(query, normalised_names_[i]), to_upper_ascii(glasses_[i].name()),
                           vendor_rank(glasses_[i].vendor()), i});
   }
   const std::size_t kept = std::min(count, candidates.size());

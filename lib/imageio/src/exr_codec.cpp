@@ -34,6 +34,7 @@
 #include <thread>
 
 #include "codecs.h"
+#include "lensmith/core/ascii_text.h"
 #include "lensmith/imageio/deep_raster.h"
 #include "lensmith/core/number_parsing.h"
 #include "lensmith/core/text_file.h"
@@ -117,12 +118,6 @@ SampleType sample_type(Imf::PixelType type) {
   }
 }
 
-std::string lower(std::string_view text) {
-  std::string out(text);
-  std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return out;
-}
-
 // Rank of a channel's suffix within its layer, as OpenImageIO orders them (colour, then alpha,
 // then depth); layers holding X with Y or Z are positions or normals and keep X, Y, Z together.
 int suffix_rank(std::string_view suffix, bool xyz_layer) {
@@ -130,7 +125,7 @@ int suffix_rank(std::string_view suffix, bool xyz_layer) {
                                                            "alpha", "ar", "ra", "ag", "ga", "ab", "ba", "z", "depth", "zback"};
   static constexpr std::array<std::string_view, 21> kXyz{"r", "red", "g", "green", "b", "blue", "x", "y", "z", "real", "imag",
                                                          "a", "alpha", "ar", "ra", "ag", "ga", "ab", "ba", "depth", "zback"};
-  const std::string s = lower(suffix);
+  const std::string s = to_lower_ascii(suffix);
   if (xyz_layer) {
     for (std::size_t i = 0; i < kXyz.size(); ++i) {
       if (kXyz[i] == s) return static_cast<int>(i);
@@ -165,7 +160,7 @@ std::vector<std::string> canonical_order(const Imf::ChannelList& list) {
     std::size_t end = begin;
     bool has_x = false, has_yz = false;
     while (end < names.size() && names[end].layer == names[begin].layer) {
-      const std::string s = lower(names[end].suffix);
+      const std::string s = to_lower_ascii(names[end].suffix);
       has_x |= s == "x";
       has_yz |= s == "y" || s == "z";
       ++end;

@@ -50,7 +50,7 @@ class FitReader {
   explicit FitReader(const LocatedJson& doc) : doc_(doc) {}
 
   [[noreturn]] void fail(const std::string& pointer, const std::string& path, const std::string& message) const {
-    throw LensFileError(doc_.where(pointer), path + ": " + message);
+    throw FileError(doc_.where(pointer), path + ": " + message);
   }
   const json& at(const std::string& pointer) const { return doc_.root().at(json::json_pointer(pointer)); }
   double number(const std::string& pointer, const std::string& path) const {

@@ -6,6 +6,7 @@
 // on the surface last entered, or on the one an S k / SO / SI qualifier names. Lengths are in the unit
 // of DIM, wavelengths in nanometres. The keyword table (read, ignored, refused) is in
 // docs/lens-formats-foreign.md, section "CODE V".
+#include "lensmith/core/ascii_text.h"
 #include "lensmith/prescription/codev_reader.h"
 
 #include <algorithm>
@@ -92,19 +93,17 @@ bool contains(const std::array<std::string_view, N>& sorted, std::string_view ke
   return std::binary_search(sorted.begin(), sorted.end(), key);
 }
 
-bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
 bool is_digit(char c) { return c >= '0' && c <= '9'; }
 bool is_letter(char c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z'); }
 bool is_quote(char c) { return c == '\'' || c == '"'; }
 
-std::string to_upper(std::string_view s) { return ascii_upper(s); }
 std::string shown(std::string_view s, std::size_t max_length = kMaxShownLength) { return shown_text(s, max_length); }
 
 // A glass name as CODE V writes Schott's, Ohara's and CDGM's (N-BK7 as NBK7, S-LAL8 as SLAL8):
 // upper case without '-' and blanks.
 std::string normalised_glass_name(std::string_view name) {
   std::string out;
-  for (char c : to_upper(name)) {
+  for (char c : to_upper_ascii(name)) {
     if (c != '-' && c != ' ') out += c;
   }
   return out;
@@ -201,10 +200,10 @@ class CodeVParser {
   // ---- errors ----------------------------------------------------------------------------------
 
   [[noreturn]] void fail(int line, int column, const std::string& message) const {
-    throw LensFileError(SourceLocation{file_, line, column}, message);
+    throw FileError(SourceLocation{file_, line, column}, message);
   }
   [[noreturn]] void fail_at(const Command& c, const Token& t, const std::string& message) const {
-    fail(t.line, t.column, shown(to_upper(c.keyword.text)) + ": " + message);
+    fail(t.line, t.column, shown(to_upper_ascii(c.keyword.text)) + ": " + message);
   }
   [[noreturn]] void fail_keyword(const Command& c, const std::string& message) const {
     fail_at(c, c.keyword, message);
@@ -334,7 +333,7 @@ class CodeVParser {
     c.end_line = command_end.line;
     c.end_column = command_end.column;
     if (!c.keyword.quoted) {
-      c.name = to_upper(c.keyword.text);
+      c.name = to_upper_ascii(c.keyword.text);
       if (c.name.size() > 3 && std::all_of(c.name.begin(), c.name.end(), is_letter)) c.name.resize(3);
     }
     commands_.push_back(std::move(c));
@@ -343,7 +342,7 @@ class CodeVParser {
   // ---- arguments ---------------------------------------------------------------------------------
 
   const Token& required_arg(const Command& c, std::size_t i, const std::string& what) const {
-    if (i >= c.args.size()) fail(c.end_line, c.end_column, shown(to_upper(c.keyword.text)) + ": missing " + what);
+    if (i >= c.args.size()) fail(c.end_line, c.end_column, shown(to_upper_ascii(c.keyword.text)) + ": missing " + what);
     return c.args[i];
   }
   double number(const Command& c, std::size_t i, const std::string& what) const {
@@ -366,7 +365,7 @@ class CodeVParser {
       }
       out.push_back(located_number(c, i, what));
     }
-    if (out.empty()) fail(c.end_line, c.end_column, shown(to_upper(c.keyword.text)) + ": missing " + what);
+    if (out.empty()) fail(c.end_line, c.end_column, shown(to_upper_ascii(c.keyword.text)) + ": missing " + what);
     return out;
   }
   void no_more_args(const Command& c, std::size_t used) const {
@@ -379,7 +378,7 @@ class CodeVParser {
     std::optional<std::size_t> index = current_;
     while (i < c.args.size() && !c.args[i].quoted) {
       const Token& t = c.args[i];
-      const std::string q = to_upper(t.text);
+      const std::string q = to_upper_ascii(t.text);
       if (q == "SO") {
         if (surfaces_.empty()) fail_at(c, t, "SO qualifier before the SO line");
         index = 0;
@@ -626,7 +625,7 @@ class CodeVParser {
 
   // REFL in the glass field makes a mirror (the medium before it continues), as RMD REFL does.
   void set_glass(const Command& c, CvSurface& s, const Token& t) {
-    const std::string upper = to_upper(t.text);
+    const std::string upper = to_upper_ascii(t.text);
     if (!t.quoted && upper == "REFL") {
       s.mirror = true;
       s.mirror_line = c.keyword.line;
@@ -637,7 +636,7 @@ class CodeVParser {
   }
 
   void set_refract_mode(const Command& c, const Token& t, CvSurface& s) const {
-    const std::string mode = to_upper(t.text);
+    const std::string mode = to_upper_ascii(t.text);
     if (mode == "TIR") fail_at(c, t, "total-internal-reflection surfaces are not supported");
     if (mode != "REFR" && mode != "REFL") fail_at(c, t, "unknown refract mode \"" + shown(t.text) + "\" (expected REFR or REFL)");
     s.mirror = mode == "REFL";
@@ -650,7 +649,7 @@ class CodeVParser {
       radius_mode_ = true;
       return;
     }
-    const std::string v = to_upper(c.args[0].text);
+    const std::string v = to_upper_ascii(c.args[0].text);
     if (v == "Y" || v == "YES") {
       radius_mode_ = true;
     } else if (v == "N" || v == "NO") {
@@ -664,7 +663,7 @@ class CodeVParser {
   void handle_dim(const Command& c) {
     const Token& t = required_arg(c, 0, "the lens unit");
     no_more_args(c, 1);
-    const std::string u = to_upper(t.text);
+    const std::string u = to_upper_ascii(t.text);
     if (u == "M" || u == "MM") {
       mm_per_unit_ = 1.0;
     } else if (u == "C" || u == "CM") {
@@ -719,7 +718,7 @@ class CodeVParser {
     CvSurface& s = surfaces_[index];
     ApertureRole role = kClear;
     for (; i < c.args.size() && !c.args[i].quoted; ++i) {
-      const std::string q = to_upper(c.args[i].text);
+      const std::string q = to_upper_ascii(c.args[i].text);
       if (q == "OBS") {
         role = kObscuration;
       } else if (q == "EDG") {
@@ -788,7 +787,7 @@ class CodeVParser {
     g.line = c.keyword.line;
     if (!c.args.empty() && !c.args[0].quoted && !c.args[0].text.empty() && is_letter(c.args[0].text[0])) {
       g.formula = shown(c.args[0].text);
-      private_glasses_[to_upper(g.name)] = std::move(g);
+      private_glasses_[to_upper_ascii(g.name)] = std::move(g);
       return true;
     }
     for (const Located& n : numbers_from(c, 0, "an index", kMaxWavelengths)) {
@@ -802,11 +801,11 @@ class CodeVParser {
                           " PWL wavelengths");
     }
     for (const Located& w : private_wavelengths_) g.wavelengths_nm.push_back(w.value);
-    private_glasses_[to_upper(g.name)] = std::move(g);
+    private_glasses_[to_upper_ascii(g.name)] = std::move(g);
     return true;
   }
 
-  void record_unknown(const Command& c) { unknown_.record(to_upper(shown(c.keyword.text)), c.keyword.line); }
+  void record_unknown(const Command& c) { unknown_.record(to_upper_ascii(shown(c.keyword.text)), c.keyword.line); }
 
   std::string surface_name(std::size_t index) const {
     if (index == 0) return "the object surface (SO)";
@@ -874,7 +873,7 @@ class CodeVParser {
   }
 
   MaterialSpec material_for(const GlassRef& g) {
-    const std::string key = (g.quoted ? "'" : "") + to_upper(g.name);
+    const std::string key = (g.quoted ? "'" : "") + to_upper_ascii(g.name);
     if (auto it = materials_.find(key); it != materials_.end()) return it->second;
     MaterialSpec m = resolve_glass(g);
     materials_.emplace(key, m);
@@ -882,7 +881,7 @@ class CodeVParser {
   }
 
   MaterialSpec resolve_glass(const GlassRef& g) {
-    const std::string upper = to_upper(g.name);
+    const std::string upper = to_upper_ascii(g.name);
     if (auto it = private_glasses_.find(upper); it != private_glasses_.end()) return private_material(it->second, g.line);
     if (upper == "AIR") return MaterialSpec::air();
     if (auto code = glass_code(g.name)) return fictitious_material(g, code->first, code->second);
@@ -892,7 +891,7 @@ class CodeVParser {
     std::string vendor;
     if (const auto underscore = g.name.rfind('_'); underscore != std::string::npos && underscore > 0) {
       base = g.name.substr(0, underscore);
-      vendor = to_upper(g.name.substr(underscore + 1));
+      vendor = to_upper_ascii(g.name.substr(underscore + 1));
     }
     const auto& vendors = catalogue_.vendors();
     const bool known_vendor = !vendor.empty() && std::find(vendors.begin(), vendors.end(), vendor) != vendors.end();
@@ -989,20 +988,16 @@ class CodeVParser {
 
   double mm(double lens_units) const { return lens_units * mm_per_unit_; }
 
-  // The line a PrescriptionError is about, from the "surface N: ..." form of its message.
-  int line_for_prescription_message(const std::string& message) const {
-    constexpr std::string_view kSurface = "surface ";
-    if (message.rfind(kSurface, 0) == 0) {
-      const std::size_t end = message.find_first_not_of("0123456789", kSurface.size());
-      auto n = parse_finite_number(std::string_view(message).substr(kSurface.size(), end - kSurface.size()));
-      if (n && *n >= 1.0 && *n + 1.0 < static_cast<double>(surfaces_.size())) return surfaces_[static_cast<std::size_t>(*n)].line;
-    }
-    if (message.rfind("wavelength", 0) == 0 || message.rfind("primary", 0) == 0) {
-      return message.rfind("primary", 0) == 0 && reference_ ? reference_->line : wavelength_line_;
-    }
-    if (message.rfind("aperture", 0) == 0 && aperture_) return aperture_->line;
-    if (message.rfind("field", 0) == 0) return std::max(x_field_.line, y_field_.line);
-    if (message.rfind("object", 0) == 0 && !surfaces_.empty()) return surfaces_.front().line;
+  // The line a GlassError or PrescriptionError is about, from its subject.
+  int line_for_subject(const ErrorSubject& subject) const {
+    const int n = subject.surface;
+    if (n >= 1 && n + 1 < static_cast<int>(surfaces_.size())) return surfaces_[static_cast<std::size_t>(n)].line;
+    const std::string_view field = subject.field;
+    if (field.starts_with("primary")) return reference_ ? reference_->line : wavelength_line_;
+    if (field.starts_with("wavelength")) return wavelength_line_;
+    if (field.starts_with("aperture") && aperture_) return aperture_->line;
+    if (field.starts_with("field")) return std::max(x_field_.line, y_field_.line);
+    if (field.starts_with("object") && !surfaces_.empty()) return surfaces_.front().line;
     return 0;
   }
 
@@ -1072,7 +1067,7 @@ class CodeVParser {
     set_wavelengths(p);
     p.ray_aiming = RayAiming::RealStop;
 
-    resolve_and_validate(p, catalogue_, file_, [this](const std::string& m) { return line_for_prescription_message(m); });
+    resolve_and_validate(p, catalogue_, file_, [this](const ErrorSubject& e) { return line_for_subject(e); });
     unknown_.report(diagnostics_, file_, "commands");
     result.diagnostics = std::move(diagnostics_);
     return result;

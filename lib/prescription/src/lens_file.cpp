@@ -1,3 +1,4 @@
+#include "lensmith/core/ascii_text.h"
 #include "lensmith/prescription/lens_file.h"
 
 #include <algorithm>
@@ -19,9 +20,7 @@ std::string lower_extension(const std::string& path) {
   const auto slash = path.find_last_of("/\\");
   const auto dot = path.find_last_of('.');
   if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return {};
-  std::string ext = path.substr(dot);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
+  return to_lower_ascii(path.substr(dot));
 }
 
 // A lentil database is a JSON object of entries, each holding "optical-elements-patent"; a native
@@ -34,14 +33,12 @@ bool looks_like_lentil(std::string_view text) {
 }  // namespace
 
 void resolve_and_validate(Prescription& lens, const GlassCatalog& catalogue, const std::string& file,
-                          const std::function<int(const std::string& message)>& line_of) {
+                          const std::function<int(const ErrorSubject& subject)>& line_of) {
   try {
     lens.resolve_materials(catalogue);
     lens.validate();
-  } catch (const GlassError& e) {
-    throw LensFileError(SourceLocation{file, line_of(e.what()), 0}, e.what());
-  } catch (const PrescriptionError& e) {
-    throw LensFileError(SourceLocation{file, line_of(e.what()), 0}, e.what());
+  } catch (const SubjectError& e) {  // GlassError, PrescriptionError
+    throw FileError(SourceLocation{file, line_of(e.subject()), 0}, e.what());
   }
 }
 
@@ -89,7 +86,7 @@ LensFormat lens_format_from_path(const std::string& path) {
   if (ext == ".zmx") return LensFormat::Zemax;
   if (ext == ".dat") return LensFormat::Pbrt;
   if (ext == ".seq") return LensFormat::CodeV;
-  throw LensFileError({path, 0, 0}, "unknown lens file type \"" + ext +
+  throw FileError({path, 0, 0}, "unknown lens file type \"" + ext +
                                         "\"; expected .json (lensmith or lentil), .zmx (Zemax), .seq (CODE V) or .dat (pbrt)");
 }
 
@@ -129,16 +126,16 @@ LensReadResult read_any(const std::string& path_with_id, const GlassCatalog& cat
       const std::string text = decode_text(bytes, path);
       if (looks_like_lentil(text)) {
         if (entry_id.empty()) {
-          throw LensFileError({path, 0, 0}, "this is a lentil lens database; name an entry after '#', e.g. " + path + "#0001 "
+          throw FileError({path, 0, 0}, "this is a lentil lens database; name an entry after '#', e.g. " + path + "#0001 "
                                             "(`lensmith lenses --lentil " + path + "` lists them)");
         }
         return read_lentil(text, path, entry_id, catalogue);
       }
-      if (!entry_id.empty()) throw LensFileError({path, 0, 0}, "'#" + entry_id + "' given, but this is not a lentil database");
+      if (!entry_id.empty()) throw FileError({path, 0, 0}, "'#" + entry_id + "' given, but this is not a lentil database");
       return read_lens_json(text, path, catalogue);
     }
   }
-  throw LensFileError({path, 0, 0}, "unsupported lens format");
+  throw FileError({path, 0, 0}, "unsupported lens format");
 }
 
 }  // namespace

@@ -1,8 +1,8 @@
 // Native lens format: reader and writer. Key-by-key reference: docs/lens-format.md.
+#include "lensmith/core/ascii_text.h"
 #include "lensmith/prescription/lens_json.h"
 
 #include <cmath>
-#include <cstdio>
 #include <utility>
 
 #include "lensmith/core/json_text.h"
@@ -32,14 +32,12 @@ MaterialSpec read_material(const LocatedJson& doc, const std::string& pointer, c
   const json& v = doc.root().at(json::json_pointer(pointer));
   if (v.is_string()) {
     const std::string name = v.get<std::string>();
-    if (name.empty()) throw LensFileError(doc.where(pointer), path + ": empty glass name");
-    std::string lower;
-    for (char c : name) lower += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (lower == "air") return MaterialSpec::air();
+    if (name.empty()) throw FileError(doc.where(pointer), path + ": empty glass name");
+    if (to_lower_ascii(name) == "air") return MaterialSpec::air();
     return MaterialSpec::catalog(name);
   }
   if (!v.is_object()) {
-    throw LensFileError(doc.where(pointer), path + ": expected \"air\", a glass name, {\"glass\": ...} or {\"nd\": ..., \"vd\": ...}, got " +
+    throw FileError(doc.where(pointer), path + ": expected \"air\", a glass name, {\"glass\": ...} or {\"nd\": ..., \"vd\": ...}, got " +
                                                json_type_phrase(v));
   }
   JsonObjectReader r(doc, pointer, path);
@@ -77,7 +75,7 @@ std::vector<double> read_number_list(JsonObjectReader& r, const std::string& key
   for (std::size_t i = 0; i < v->size(); ++i) {
     const json& e = (*v)[i];
     if (!e.is_number()) {
-      throw LensFileError(r.document().where(pointer + "/" + std::to_string(i)),
+      throw FileError(r.document().where(pointer + "/" + std::to_string(i)),
                           r.child_path(key) + "[" + std::to_string(i) + "]: expected a number, got " + json_type_phrase(e));
     }
     out.push_back(e.get<double>());
@@ -404,16 +402,14 @@ LensReadResult read_lens_json(std::string_view text, const std::string& file_nam
   try {
     p.resolve_materials(catalogue);
     p.validate();
-  } catch (const Error& e) {
-    // Point at the surface the message names ("surface 3: ..."), else at the top of the file.
-    const std::string message = e.what();
+  } catch (const SubjectError& e) {
+    // Point at the surface the error is about, else at the top of the file.
     SourceLocation where{file_name, 1, 1};
-    int surface_number = 0;
-    if (std::sscanf(message.c_str(), "surface %d:", &surface_number) == 1 && surface_number >= 1 &&
-        static_cast<std::size_t>(surface_number) <= count) {
-      where = doc.where("/surfaces/" + std::to_string(surface_number - 1));
-    }
-    throw LensFileError(where, message);
+    const int n = e.subject().surface;
+    if (n >= 1 && static_cast<std::size_t>(n) <= count) where = doc.where("/surfaces/" + std::to_string(n - 1));
+    throw FileError(where, e.what());
+  } catch (const Error& e) {
+    throw FileError(SourceLocation{file_name, 1, 1}, e.what());
   }
   return result;
 }

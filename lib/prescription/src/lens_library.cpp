@@ -1,3 +1,4 @@
+#include "lensmith/core/ascii_text.h"
 #include "lensmith/prescription/lens_library.h"
 
 #include <algorithm>
@@ -75,7 +76,7 @@ LensReadResult LensLibrary::load(const std::string& id, const GlassCatalog& cata
   std::sort(ranked.begin(), ranked.end());
   std::string closest;
   for (std::size_t i = 0; i < ranked.size() && i < 3; ++i) closest += (i ? ", " : "") + ranked[i].second;
-  throw LensFileError({id, 0, 0}, "no such file, and no shipped lens of that name; closest shipped lenses: " + closest +
+  throw FileError({id, 0, 0}, "no such file, and no shipped lens of that name; closest shipped lenses: " + closest +
                                       " (`lensmith lenses` lists them all)");
 }
 
@@ -88,8 +89,7 @@ LensReadResult LensLibrary::load_path_or_name(const std::string& path_or_id, con
   // What names a file (a folder in it, or a lens file's extension) and is not there is a missing
   // file; anything else may be a shipped lens's name.
   const std::filesystem::path file(file_part);
-  std::string extension = file.extension().string();
-  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string extension = to_lower_ascii(file.extension().string());
   if (!find_embedded(path_or_id) &&
       (file_part.find('/') != std::string::npos || extension == ".json" || extension == ".zmx" || extension == ".dat" || extension == ".seq")) {
     throw IoError(file_part + ": no such file");

@@ -3,6 +3,7 @@
 // to rear in "optical-elements-patent". How each key is read, including lentil's aspheric terms
 // (z = c r^2 / (1 + sqrt(1 - c^2 r^2)) + a4 r^4 + a6 r^6 + a8 r^8 + a10 r^10, from lentil's
 // raytrace.h), is in docs/lens-formats-foreign.md, section "lentil".
+#include "lensmith/core/ascii_text.h"
 #include "lensmith/prescription/lentil_reader.h"
 
 #include <cmath>
@@ -34,12 +35,6 @@ constexpr std::size_t kAsphericTerms = 4;  // a4, a6, a8, a10
 
 const std::vector<std::string> kElementKeys = {"radius", "thickness",      "material",      "ior",
                                                "abbe",   "housing-radius", "lens-geometry", "aspherical-equation"};
-
-std::string to_lower(std::string_view s) {
-  std::string out(s);
-  for (char& c : out) c = (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c;
-  return out;
-}
 
 // Glass names compared the way lentil writes them: "SLAH64" for OHARA's S-LAH64.
 std::string normalized_glass_name(std::string_view s) {
@@ -95,7 +90,7 @@ std::string year_text(double year) {
 
 const json& entries_object(const LocatedJson& doc) {
   if (!doc.root().is_object()) {
-    throw LensFileError(doc.where(""),
+    throw FileError(doc.where(""),
                         "expected a JSON object of lens entries keyed by id, got " + json_type_phrase(doc.root()));
   }
   return doc.root();
@@ -117,7 +112,7 @@ bool entry_supported(const json& entry) {
     auto thickness = e.find("thickness");
     if (thickness == e.end() || !thickness->is_number()) return false;
     auto material = e.find("material");
-    if (material != e.end() && material->is_string() && to_lower(material->get<std::string>()) == "iris") ++irises;
+    if (material != e.end() && material->is_string() && to_lower_ascii(material->get<std::string>()) == "iris") ++irises;
   }
   return irises == 1;
 }
@@ -153,12 +148,12 @@ class LentilEntryReader {
     try {
       p.resolve_materials(catalogue_);
     } catch (const GlassError& e) {
-      throw LensFileError(location_for_message(e.what()), e.what());
+      throw FileError(location_for(e.subject()), e.what());
     }
     try {
       p.validate();
     } catch (const PrescriptionError& e) {
-      throw LensFileError(location_for_message(e.what()), e.what());
+      throw FileError(location_for(e.subject()), e.what());
     }
     result.diagnostics = std::move(diagnostics_);
     return result;
@@ -206,7 +201,7 @@ class LentilEntryReader {
     const double radius = finite_number(e, "radius");
     if (radius == 0.0) e.fail("radius", "radius 0: lentil writes planes as 99999 or larger");
     const std::string material = e.get_string("material");
-    const std::string kind = to_lower(material);
+    const std::string kind = to_lower_ascii(material);
     const bool iris = kind == "iris";
     // An iris is a plane whatever radius lentil gives it (entry 0015 writes 9999).
     s.curvature_per_mm = iris || std::abs(radius) >= kFlatRadiusMm ? 0.0 : 1.0 / radius;
@@ -347,19 +342,10 @@ class LentilEntryReader {
   }
 
   // Where a PrescriptionError "surface N: ..." points: element N - 1.
-  SourceLocation location_for_message(const std::string& message) const {
-    constexpr std::string_view kSurface = "surface ";
-    if (message.rfind(kSurface, 0) == 0) {
-      std::size_t n = 0;
-      std::size_t i = kSurface.size();
-      bool any = false;
-      while (i < message.size() && message[i] >= '0' && message[i] <= '9' && n <= kMaxElements) {
-        n = n * 10 + static_cast<std::size_t>(message[i] - '0');
-        ++i;
-        any = true;
-      }
-      if (any && n >= 1 && n <= element_pointers_.size()) return doc_.where(element_pointers_[n - 1]);
-    }
+  // Where a GlassError or PrescriptionError is about: its subject's element, else the entry.
+  SourceLocation location_for(const ErrorSubject& subject) const {
+    const int n = subject.surface;
+    if (n >= 1 && n <= static_cast<int>(element_pointers_.size())) return doc_.where(element_pointers_[static_cast<std::size_t>(n - 1)]);
     return doc_.where(entry_.pointer());
   }
 
@@ -408,7 +394,7 @@ LensReadResult read_lentil(std::string_view text, const std::string& file_name, 
       ids += (ids.empty() ? "" : ", ") + it.key();
     }
     if (root.size() > kMaxListedIds) ids += ", ... (" + std::to_string(root.size()) + " in all)";
-    throw LensFileError(doc.where(""),
+    throw FileError(doc.where(""),
                         "no lentil entry \"" + id + "\"; available ids: " + (ids.empty() ? "(none)" : ids));
   }
   LentilEntryReader reader(doc, id, catalogue);

@@ -2,6 +2,7 @@
 // index and aperture DIAMETER in millimetres, '#' comments. The files come from W. J. Smith,
 // Modern Lens Design, via pbrt-v4-scenes; the two column conventions and how the header comments
 // are read are in docs/lens-formats-foreign.md, section "pbrt".
+#include "lensmith/core/ascii_text.h"
 #include "lensmith/prescription/pbrt_reader.h"
 
 #include <array>
@@ -24,22 +25,6 @@ constexpr double kMaxPlausibleIndex = 5.0;
 // A field-of-view hint in the header is believed only for a half angle in (0, 90) degrees.
 constexpr double kMaxHalfFieldDeg = 90.0;
 
-bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
-
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && is_blank(s.front())) s.remove_prefix(1);
-  while (!s.empty() && is_blank(s.back())) s.remove_suffix(1);
-  return s;
-}
-
-char lower(char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; }
-
-std::string to_lower(std::string_view s) {
-  std::string out(s);
-  for (char& c : out) c = lower(c);
-  return out;
-}
-
 std::string shown(std::string_view s) {
   constexpr std::size_t kMax = 32;
   return s.size() <= kMax ? std::string(s) : std::string(s.substr(0, kMax)) + "...";
@@ -55,25 +40,25 @@ struct Row {
 // A header comment line as written, without '#', surrounding blanks, and the stray unbalanced '"'
 // that spreadsheet exports left at the end of several pbrt-v4-scenes headers.
 std::string clean_comment(std::string_view text) {
-  std::string_view t = trim(text);
+  std::string_view t = trim_blanks(text);
   std::size_t quotes = 0;
   for (char c : t) quotes += c == '"' ? 1 : 0;
-  if (quotes % 2 == 1 && !t.empty() && t.back() == '"') t = trim(t.substr(0, t.size() - 1));
+  if (quotes % 2 == 1 && !t.empty() && t.back() == '"') t = trim_blanks(t.substr(0, t.size() - 1));
   return std::string(t);
 }
 
 // The "radius axpos N aperture" line that names the columns.
 bool is_column_header(std::string_view comment) {
-  const std::string l = to_lower(comment);
+  const std::string l = to_lower_ascii(comment);
   return l.rfind("radius", 0) == 0;
 }
 
 // A number written just before position `end` in `s` ("22deg", "155.9", "22 deg"), or nullopt.
 std::optional<double> number_before(std::string_view s, std::size_t end) {
-  std::string_view head = trim(s.substr(0, end));
+  std::string_view head = trim_blanks(s.substr(0, end));
   for (std::string_view unit : {"degrees", "degree", "deg"}) {
-    if (head.size() >= unit.size() && to_lower(head.substr(head.size() - unit.size())) == unit) {
-      head = trim(head.substr(0, head.size() - unit.size()));
+    if (head.size() >= unit.size() && to_lower_ascii(head.substr(head.size() - unit.size())) == unit) {
+      head = trim_blanks(head.substr(0, head.size() - unit.size()));
       break;
     }
   }
@@ -86,7 +71,7 @@ std::optional<double> number_before(std::string_view s, std::size_t end) {
 // Half field angle (degrees) from a header such as "D-GAUSS F/2 22deg HFOV" (half field) or
 // "Muller 16mm/f4 155.9FOV fisheye lens" (full field).
 std::optional<double> half_field_from_header(std::string_view header) {
-  const std::string l = to_lower(header);
+  const std::string l = to_lower_ascii(header);
   for (std::size_t pos = l.find("fov"); pos != std::string::npos; pos = l.find("fov", pos + 1)) {
     const bool half = pos > 0 && l[pos - 1] == 'h';
     const std::size_t number_end = half ? pos - 1 : pos;
@@ -121,7 +106,7 @@ class PbrtParser {
 
  private:
   [[noreturn]] void fail(int line, int column, const std::string& message) const {
-    throw LensFileError(SourceLocation{file_, line, column}, message);
+    throw FileError(SourceLocation{file_, line, column}, message);
   }
 
   void handle_line(std::string_view line, int number) {
@@ -140,7 +125,7 @@ class PbrtParser {
       }
       data = line.substr(0, hash);
     }
-    if (trim(data).empty()) return;
+    if (trim_blanks(data).empty()) return;
 
     Row row;
     row.line = number;
@@ -251,7 +236,7 @@ class PbrtParser {
 
     // Only air and model glasses occur, so no catalogue is needed (or loaded).
     const GlassCatalog no_catalogue{};
-    resolve_and_validate(p, no_catalogue, file_, [this](const std::string& m) { return line_for_message(m); });
+    resolve_and_validate(p, no_catalogue, file_, [this](const ErrorSubject& e) { return line_for_subject(e); });
     return result;
   }
 
@@ -266,7 +251,7 @@ class PbrtParser {
     }
     p.name = header_.front();
     for (std::size_t i = 1; i < header_.size(); ++i) {
-      std::string& target = to_lower(header_[i]).find("scaled") != std::string::npos ? p.notes : p.source;
+      std::string& target = to_lower_ascii(header_[i]).find("scaled") != std::string::npos ? p.notes : p.source;
       if (!target.empty()) target += "; ";
       target += header_[i];
     }
@@ -281,19 +266,10 @@ class PbrtParser {
     }
   }
 
-  // The row a PrescriptionError "surface N: ..." is about.
-  int line_for_message(const std::string& message) const {
-    constexpr std::string_view kSurface = "surface ";
-    if (message.rfind(kSurface, 0) != 0) return 0;
-    std::size_t n = 0;
-    std::size_t i = kSurface.size();
-    bool any = false;
-    while (i < message.size() && message[i] >= '0' && message[i] <= '9' && n < kMaxRows + 1) {
-      n = n * 10 + static_cast<std::size_t>(message[i] - '0');
-      ++i;
-      any = true;
-    }
-    return any && n >= 1 && n <= rows_.size() ? rows_[n - 1].line : 0;
+  // The row a GlassError or PrescriptionError is about: its subject's surface.
+  int line_for_subject(const ErrorSubject& subject) const {
+    const int n = subject.surface;
+    return n >= 1 && n <= static_cast<int>(rows_.size()) ? rows_[static_cast<std::size_t>(n - 1)].line : 0;
   }
 
   const std::string& file_;

@@ -13,18 +13,21 @@ namespace lensmith {
 
 namespace {
 
-std::string number(double v) {
-  char buffer[48];
-  std::snprintf(buffer, sizeof buffer, "%.10g", v);
-  return buffer;
+// The subject of an error about surface `index` (0-based).
+ErrorSubject surface_subject(std::size_t index, std::string field = {}) {
+  return ErrorSubject{static_cast<int>(index) + 1, std::move(field), -1};
 }
 
 [[noreturn]] void reject_surface(std::size_t index, const std::string& field, double value, const std::string& rule) {
-  throw PrescriptionError("surface " + std::to_string(index + 1) + ": " + field + " = " + number(value) + ": " + rule);
+  throw PrescriptionError(surface_subject(index, field),
+                          "surface " + std::to_string(index + 1) + ": " + field + " = " + format_number(value) + ": " + rule);
 }
 
-[[noreturn]] void reject_system(const std::string& field, double value, const std::string& rule) {
-  throw PrescriptionError(field + " = " + number(value) + ": " + rule);
+// `shown` names the value in the message ("wavelengths_nm[2]"); `subject` is what a reader points at
+// (the field `shown` without its index, when not given).
+[[noreturn]] void reject_system(const std::string& shown, double value, const std::string& rule, ErrorSubject subject = {}) {
+  if (subject.empty()) subject.field = shown;
+  throw PrescriptionError(std::move(subject), shown + " = " + format_number(value) + ": " + rule);
 }
 
 // Wavelengths that optical glass catalogues can be meaningful for, nm.
@@ -35,12 +38,12 @@ constexpr double kMaxWavelength_nm = 20000.0;
 
 std::string ApertureSpec::to_string() const {
   switch (kind) {
-    case Kind::EntrancePupilDiameter: return "entrance-pupil diameter " + number(value) + " mm";
-    case Kind::ImageSpaceFNumber: return "image-space f/" + number(value);
+    case Kind::EntrancePupilDiameter: return "entrance-pupil diameter " + format_number(value) + " mm";
+    case Kind::ImageSpaceFNumber: return "image-space f/" + format_number(value);
     case Kind::FloatByStop: return "float by stop size";
-    case Kind::ParaxialWorkingFNumber: return "paraxial working f/" + number(value);
-    case Kind::ObjectSpaceNA: return "object-space NA " + number(value);
-    case Kind::ObjectConeAngleDeg: return "object cone angle " + number(value) + " deg";
+    case Kind::ParaxialWorkingFNumber: return "paraxial working f/" + format_number(value);
+    case Kind::ObjectSpaceNA: return "object-space NA " + format_number(value);
+    case Kind::ObjectConeAngleDeg: return "object cone angle " + format_number(value) + " deg";
   }
   return "?";
 }
@@ -77,7 +80,7 @@ std::string FieldSpec::to_string() const {
                      : kind == Kind::ImageHeightMm  ? " mm (paraxial image height)"
                                                     : " mm (real image height)";
   std::string s;
-  for (double v : values) s += (s.empty() ? "" : ", ") + number(v);
+  for (double v : values) s += (s.empty() ? "" : ", ") + format_number(v);
   return s + unit;
 }
 
@@ -177,7 +180,7 @@ Diagnostics Prescription::geometry_warnings() const {
 }
 
 void Prescription::validate() const {
-  if (surfaces.empty()) throw PrescriptionError("surfaces: a lens needs at least one surface");
+  if (surfaces.empty()) throw PrescriptionError(ErrorSubject{0, "surfaces", -1}, "surfaces: a lens needs at least one surface");
   int stops = 0;
   for (std::size_t i = 0; i < surfaces.size(); ++i) {
     const Surface& s = surfaces[i];
@@ -194,7 +197,7 @@ void Prescription::validate() const {
       const double widest = s.max_semi_diameter_mm();
       if (*s.semi_diameter_mm > widest * (1.0 + 1e-12)) {
         reject_surface(i, "semi_diameter_mm", *s.semi_diameter_mm,
-                       "larger than the surface allows (" + number(widest) + " mm for this radius and conic)");
+                       "larger than the surface allows (" + format_number(widest) + " mm for this radius and conic)");
       }
     }
     if (s.aperture) {
@@ -210,7 +213,7 @@ void Prescription::validate() const {
         reject_surface(i, "aperture.min_radius_mm", a.min_radius_mm, "must be >= 0, and only on a circular aperture that is not an obscuration");
       }
       if (circle && a.min_radius_mm >= a.half_x_mm) {
-        reject_surface(i, "aperture.min_radius_mm", a.min_radius_mm, "must be smaller than the radius " + number(a.half_x_mm) + " mm");
+        reject_surface(i, "aperture.min_radius_mm", a.min_radius_mm, "must be smaller than the radius " + format_number(a.half_x_mm) + " mm");
       }
       if (!std::isfinite(a.decenter_x_mm)) reject_surface(i, "aperture.decenter_x_mm", a.decenter_x_mm, "must be finite");
       if (!std::isfinite(a.decenter_y_mm)) reject_surface(i, "aperture.decenter_y_mm", a.decenter_y_mm, "must be finite");
@@ -231,15 +234,15 @@ void Prescription::validate() const {
     if (!std::isfinite(s.curvature_x_per_mm)) reject_surface(i, "curvature_x_per_mm", s.curvature_x_per_mm, "must be finite (0: flat in x)");
     if (!std::isfinite(s.conic_x)) reject_surface(i, "conic_x", s.conic_x, "must be finite");
     if (s.kind == SurfaceKind::Biconic && s.has_asphere()) {
-      throw PrescriptionError("surface " + std::to_string(i + 1) + ": a biconic surface takes no even-asphere terms (use a toroidal "
+      throw PrescriptionError(surface_subject(i), "surface " + std::to_string(i + 1) + ": a biconic surface takes no even-asphere terms (use a toroidal "
                               "surface for a polynomial y profile)");
     }
     if (s.kind != SurfaceKind::Toroidal && s.kind != SurfaceKind::Biconic && (s.curvature_x_per_mm != 0.0 || s.conic_x != 0.0)) {
-      throw PrescriptionError("surface " + std::to_string(i + 1) + ": curvature_x_per_mm and conic_x belong to toroidal and biconic "
+      throw PrescriptionError(surface_subject(i), "surface " + std::to_string(i + 1) + ": curvature_x_per_mm and conic_x belong to toroidal and biconic "
                               "surfaces, not to a " + std::string(lensmith::to_string(s.kind)) + " surface");
     }
     if (s.kind == SurfaceKind::Toroidal && s.conic_x != 0.0) {
-      throw PrescriptionError("surface " + std::to_string(i + 1) + ": a toroidal surface has no x conic (its x section is the circle "
+      throw PrescriptionError(surface_subject(i), "surface " + std::to_string(i + 1) + ": a toroidal surface has no x conic (its x section is the circle "
                               "of its radius of rotation); use a biconic surface");
     }
     if (s.is_coordinate_break()) {
@@ -250,40 +253,40 @@ void Prescription::validate() const {
                                        std::pair{"tilt_z_deg", b.tilt_z_deg}}) {
         if (!std::isfinite(value)) reject_surface(i, at + key, value, "must be finite");
       }
-      if (s.mirror) throw PrescriptionError("surface " + std::to_string(i + 1) + ": a coordinate break cannot be a mirror (it has no shape)");
-      if (s.is_stop) throw PrescriptionError("surface " + std::to_string(i + 1) + ": a coordinate break cannot be the stop (it has no aperture)");
+      if (s.mirror) throw PrescriptionError(surface_subject(i), "surface " + std::to_string(i + 1) + ": a coordinate break cannot be a mirror (it has no shape)");
+      if (s.is_stop) throw PrescriptionError(surface_subject(i), "surface " + std::to_string(i + 1) + ": a coordinate break cannot be the stop (it has no aperture)");
       if (s.curvature_per_mm != 0.0 || s.conic != 0.0 || s.has_asphere()) {
-        throw PrescriptionError("surface " + std::to_string(i + 1) + ": a coordinate break has no shape (curvature, conic and "
+        throw PrescriptionError(surface_subject(i), "surface " + std::to_string(i + 1) + ": a coordinate break has no shape (curvature, conic and "
                                 "asphere terms must be 0)");
       }
       if (s.material.kind != MaterialSpec::Kind::Air) {
-        throw PrescriptionError("surface " + std::to_string(i + 1) + ": a coordinate break has no material of its own (the medium "
+        throw PrescriptionError(surface_subject(i), "surface " + std::to_string(i + 1) + ": a coordinate break has no material of its own (the medium "
                                 "before it continues); give it none");
       }
     } else if (!s.coordinate_break.is_identity()) {
-      throw PrescriptionError("surface " + std::to_string(i + 1) + ": decentres and tilts belong to a coordinate break surface");
+      throw PrescriptionError(surface_subject(i), "surface " + std::to_string(i + 1) + ": decentres and tilts belong to a coordinate break surface");
     }
     if (s.mirror && s.material.kind != MaterialSpec::Kind::Air) {
-      throw PrescriptionError("surface " + std::to_string(i + 1) + ": a mirror has no material of its own (the medium before it "
+      throw PrescriptionError(surface_subject(i), "surface " + std::to_string(i + 1) + ": a mirror has no material of its own (the medium before it "
                               "continues after the reflection); give it none");
     }
   }
-  if (stops > 1) throw PrescriptionError("surfaces: " + std::to_string(stops) + " surfaces are flagged as the stop; at most one may be");
+  if (stops > 1) throw PrescriptionError(ErrorSubject{0, "surfaces", -1}, "surfaces: " + std::to_string(stops) + " surfaces are flagged as the stop; at most one may be");
 
   if (!(object_distance_mm > 0.0)) reject_system("object_distance_mm", object_distance_mm, "must be > 0 (or infinity)");
 
-  if (wavelengths_nm.empty()) throw PrescriptionError("wavelengths_nm: at least one wavelength is needed");
+  if (wavelengths_nm.empty()) throw PrescriptionError(ErrorSubject{0, "wavelengths_nm", -1}, "wavelengths_nm: at least one wavelength is needed");
   for (std::size_t i = 0; i < wavelengths_nm.size(); ++i) {
     const double w = wavelengths_nm[i];
     if (!(w > kMinWavelength_nm && w < kMaxWavelength_nm)) {
-      reject_system("wavelengths_nm[" + std::to_string(i) + "]", w, "must lie in (100, 20000) nm");
+      reject_system("wavelengths_nm[" + std::to_string(i) + "]", w, "must lie in (100, 20000) nm", {0, "wavelengths_nm", static_cast<int>(i)});
     }
     for (std::size_t j = 0; j < i; ++j) {
-      if (wavelengths_nm[j] == w) reject_system("wavelengths_nm[" + std::to_string(i) + "]", w, "appears twice");
+      if (wavelengths_nm[j] == w) reject_system("wavelengths_nm[" + std::to_string(i) + "]", w, "appears twice", {0, "wavelengths_nm", static_cast<int>(i)});
     }
   }
   if (primary_wavelength_index >= wavelengths_nm.size()) {
-    throw PrescriptionError("primary wavelength index " + std::to_string(primary_wavelength_index + 1) + " is beyond the " +
+    throw PrescriptionError(ErrorSubject{0, "primary", -1}, "primary wavelength index " + std::to_string(primary_wavelength_index + 1) + " is beyond the " +
                             std::to_string(wavelengths_nm.size()) + " wavelengths given");
   }
 
@@ -309,20 +312,20 @@ void Prescription::validate() const {
       if (!std::isfinite(aperture.value) || aperture.value <= 0.0) reject_system(key, aperture.value, "must be finite and > 0");
       if (!na && aperture.value >= 90.0) reject_system(key, aperture.value, "must be below 90 degrees");
       if (na && aperture.value >= object_medium.index(primary_wavelength_nm())) {
-        reject_system(key, aperture.value, "must be below the object-space index " + number(object_medium.index(primary_wavelength_nm())));
+        reject_system(key, aperture.value, "must be below the object-space index " + format_number(object_medium.index(primary_wavelength_nm())));
       }
       break;
     }
     case ApertureSpec::Kind::FloatByStop: {
       auto stop = flagged_stop_index();
       if (stop && !surfaces[*stop].semi_diameter_mm) {
-        throw PrescriptionError("aperture: floats by stop size, but the stop (surface " + std::to_string(*stop + 1) +
+        throw PrescriptionError(ErrorSubject{0, "aperture", -1}, "aperture: floats by stop size, but the stop (surface " + std::to_string(*stop + 1) +
                                 ") has no semi_diameter_mm");
       }
       if (!stop) {
         bool any = false;
         for (const auto& s : surfaces) any = any || s.semi_diameter_mm.has_value();
-        if (!any) throw PrescriptionError("aperture: floats by stop size, but no surface is flagged as stop and none has a semi_diameter_mm");
+        if (!any) throw PrescriptionError(ErrorSubject{0, "aperture", -1}, "aperture: floats by stop size, but no surface is flagged as stop and none has a semi_diameter_mm");
       }
       break;
     }
@@ -330,42 +333,44 @@ void Prescription::validate() const {
 
   if (object_space_telecentric) {
     if (std::isinf(object_distance_mm)) {
-      throw PrescriptionError("object_space_telecentric: needs a finite object distance (the object is at infinity)");
+      throw PrescriptionError(ErrorSubject{0, "object_space_telecentric", -1}, "object_space_telecentric: needs a finite object distance (the object is at infinity)");
     }
     if (aperture.kind != ApertureSpec::Kind::ObjectSpaceNA && aperture.kind != ApertureSpec::Kind::ObjectConeAngleDeg) {
-      throw PrescriptionError("aperture: an object-space telecentric lens has its entrance pupil at infinity; give its "
+      throw PrescriptionError(ErrorSubject{0, "aperture", -1}, "aperture: an object-space telecentric lens has its entrance pupil at infinity; give its "
                               "aperture as an object-space NA or cone angle, not " + aperture.to_string());
     }
     if (field && field->kind == FieldSpec::Kind::AngleDeg) {
-      throw PrescriptionError("field: an object-space telecentric lens has every chief ray parallel to the axis; give "
+      throw PrescriptionError(ErrorSubject{0, "field", -1}, "field: an object-space telecentric lens has every chief ray parallel to the axis; give "
                               "its field as object or image heights, not angles");
     }
   }
   if (field) {
-    if (field->values.empty()) throw PrescriptionError("field: at least one field point is needed");
+    if (field->values.empty()) throw PrescriptionError(ErrorSubject{0, "field", -1}, "field: at least one field point is needed");
     for (std::size_t i = 0; i < field->values.size(); ++i) {
       const double v = field->values[i];
-      if (!std::isfinite(v)) reject_system("field.values[" + std::to_string(i) + "]", v, "must be finite");
+      if (!std::isfinite(v)) reject_system("field.values[" + std::to_string(i) + "]", v, "must be finite", {0, "field.values", static_cast<int>(i)});
       if (field->kind == FieldSpec::Kind::AngleDeg && std::abs(v) >= 90.0) {
         reject_system("field.max_angle_deg", v, "must lie in (-90, 90) degrees");
       }
     }
     if (!field->vignetting.empty() && field->vignetting.size() != field->values.size()) {
-      throw PrescriptionError("field.vignetting: " + std::to_string(field->vignetting.size()) + " sets of vignetting factors for " +
+      throw PrescriptionError(ErrorSubject{0, "field.vignetting", -1}, "field.vignetting: " + std::to_string(field->vignetting.size()) + " sets of vignetting factors for " +
                               std::to_string(field->values.size()) + " field points; give one per point");
     }
     for (std::size_t i = 0; i < field->vignetting.size(); ++i) {
       const VignettingFactors& v = field->vignetting[i];
       const std::string at = "field.vignetting[" + std::to_string(i) + "].";
       for (const auto& [key, value] : {std::pair{"vdx", v.vdx}, std::pair{"vdy", v.vdy}, std::pair{"van_deg", v.van_deg}}) {
-        if (!std::isfinite(value)) reject_system(at + key, value, "must be finite");
+        if (!std::isfinite(value)) reject_system(at + key, value, "must be finite", {0, "field.vignetting", static_cast<int>(i)});
       }
       for (const auto& [key, value] : {std::pair{"vcx", v.vcx}, std::pair{"vcy", v.vcy}}) {
-        if (!(value < 1.0) || !std::isfinite(value)) reject_system(at + key, value, "must be finite and below 1 (1 closes the pupil)");
+        if (!(value < 1.0) || !std::isfinite(value)) {
+          reject_system(at + key, value, "must be finite and below 1 (1 closes the pupil)", {0, "field.vignetting", static_cast<int>(i)});
+        }
       }
     }
     if (field->kind == FieldSpec::Kind::ObjectHeightMm && std::isinf(object_distance_mm)) {
-      throw PrescriptionError("field: an object-height field needs a finite object distance (the object is at infinity)");
+      throw PrescriptionError(ErrorSubject{0, "field", -1}, "field: an object-height field needs a finite object distance (the object is at infinity)");
     }
   }
 }
@@ -374,7 +379,7 @@ void Prescription::resolve_materials(const GlassCatalog& catalogue) {
   try {
     object_medium = object_material.resolve(catalogue);
   } catch (const GlassError& e) {
-    throw GlassError(std::string("object space: ") + e.what());
+    throw GlassError(ErrorSubject{0, "object", -1}, std::string("object space: ") + e.what());
   }
   for (std::size_t i = 0; i < surfaces.size(); ++i) {
     if (surfaces[i].mirror || surfaces[i].is_coordinate_break()) {
@@ -385,7 +390,7 @@ void Prescription::resolve_materials(const GlassCatalog& catalogue) {
     try {
       surfaces[i].medium = surfaces[i].material.resolve(catalogue);
     } catch (const GlassError& e) {
-      throw GlassError("surface " + std::to_string(i + 1) + ": " + e.what());
+      throw GlassError(surface_subject(i, "material"), "surface " + std::to_string(i + 1) + ": " + e.what());
     }
   }
 }
@@ -423,11 +428,11 @@ Prescription Prescription::scaled(double factor) const {
 std::string Prescription::to_string() const {
   std::ostringstream os;
   os << (name.empty() ? std::string("(unnamed lens)") : name) << "\n";
-  os << "  object distance: " << (std::isinf(object_distance_mm) ? std::string("infinity") : number(object_distance_mm) + " mm")
+  os << "  object distance: " << (std::isinf(object_distance_mm) ? std::string("infinity") : format_number(object_distance_mm) + " mm")
      << ", aperture: " << aperture.to_string() << ", field: " << (field ? field->to_string() : std::string("none")) << "\n";
   os << "  wavelengths (nm):";
   for (std::size_t i = 0; i < wavelengths_nm.size(); ++i) {
-    os << ' ' << number(wavelengths_nm[i]) << (i == primary_wavelength_index ? "*" : "");
+    os << ' ' << format_number(wavelengths_nm[i]) << (i == primary_wavelength_index ? "*" : "");
   }
   os << "\n";
   for (std::size_t i = 0; i < surfaces.size(); ++i) {

@@ -2,6 +2,7 @@
 // line: system data first, then one block per surface ("SURF n" followed by indented surface
 // keywords). Lengths are in the lens unit of the UNIT line, wavelengths in micrometres.
 // The keyword table (read, ignored, refused) is in docs/lens-formats-foreign.md, section "Zemax".
+#include "lensmith/core/ascii_text.h"
 #include "lensmith/prescription/zemax_reader.h"
 
 #include <algorithm>
@@ -63,14 +64,6 @@ static_assert(std::ranges::is_sorted(kIgnoredKeywords) && std::ranges::is_sorted
 template <std::size_t N>
 bool contains(const std::array<std::string_view, N>& sorted, std::string_view key) {
   return std::binary_search(sorted.begin(), sorted.end(), key);
-}
-
-bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
-
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && is_blank(s.front())) s.remove_prefix(1);
-  while (!s.empty() && is_blank(s.back())) s.remove_suffix(1);
-  return s;
 }
 
 // Trims blanks and line breaks (a note often ends with "NOTE 4" line breaks).
@@ -225,7 +218,7 @@ class ZemaxParser {
   // ---- errors and argument access --------------------------------------------------------------
 
   [[noreturn]] void fail(int line, int column, const std::string& message) const {
-    throw LensFileError(SourceLocation{file_, line, column}, message);
+    throw FileError(SourceLocation{file_, line, column}, message);
   }
   [[noreturn]] void fail_at(const ZmxLine& l, const Token& t, const std::string& message) const {
     fail(l.number, t.column, std::string(l.keyword.text) + ": " + message);
@@ -335,12 +328,12 @@ class ZemaxParser {
       return;
     }
     if (k == "COMM") {
-      current_surface(l).comment = std::string(trim(l.rest));
+      current_surface(l).comment = std::string(trim_blanks(l.rest));
       return;
     }
     if (k == "UNIT") return handle_unit(l);
     if (k == "NAME") {
-      std::string_view name = trim(l.rest);
+      std::string_view name = trim_blanks(l.rest);
       if (name.size() >= 2 && name.front() == '"' && name.back() == '"') name = name.substr(1, name.size() - 2);
       name_ = std::string(name);
       return;
@@ -490,7 +483,7 @@ class ZemaxParser {
     const Token& t = required_arg(l, 0, "the thickness");
     s.disz_line = l.number;
     s.disz_column = t.column;
-    if (ascii_upper(t.text) == "INFINITY") {
+    if (to_upper_ascii(t.text) == "INFINITY") {
       s.disz.reset();
       s.disz_infinite = true;
       return;
@@ -502,7 +495,7 @@ class ZemaxParser {
   void handle_glas(const ZmxLine& l) {
     ZmxSurface& s = current_surface(l);
     const Token& t = required_arg(l, 0, "the glass name");
-    if (ascii_upper(t.text) == "MIRROR") {
+    if (to_upper_ascii(t.text) == "MIRROR") {
       s.mirror = true;
       s.glass.reset();
       return;
@@ -609,7 +602,7 @@ class ZemaxParser {
 
   void handle_unit(const ZmxLine& l) {
     const Token& t = required_arg(l, 0, "the lens unit");
-    const std::string u = ascii_upper(t.text);
+    const std::string u = to_upper_ascii(t.text);
     if (u == "MM") {
       mm_per_unit_ = 1.0;
     } else if (u == "CM") {
@@ -644,7 +637,7 @@ class ZemaxParser {
     // Vendor catalogue names may carry a date suffix ("SUMITA_AUG2011"); other catalogues
     // (MISC, INFRARED, user catalogues) are not in lensmith and are skipped.
     for (const Token& t : l.args) {
-      const std::string token = ascii_upper(t.text);
+      const std::string token = to_upper_ascii(t.text);
       for (const std::string& vendor : catalogue_.vendors()) {
         if (token == vendor || (token.size() > vendor.size() && token.compare(0, vendor.size(), vendor) == 0 &&
                                 token[vendor.size()] == '_')) {
@@ -690,7 +683,7 @@ class ZemaxParser {
   double mm(double lens_units) const { return lens_units * mm_per_unit_; }
 
   MaterialSpec material_for(const GlassRef& g) {
-    const std::string upper = ascii_upper(g.name);
+    const std::string upper = to_upper_ascii(g.name);
     if (upper == "___BLANK") {
       // A model glass: nd and Vd are the glass (Vd 0 = no dispersion, as in OpticStudio).
       if (!g.nd || *g.nd < 1.0 || *g.nd > kMaxPlausibleIndex) {
@@ -748,29 +741,19 @@ class ZemaxParser {
              "; closest catalogue names: " + (names.empty() ? "(none)" : names));
   }
 
-  // The line a PrescriptionError is about, from the "surface N: ..." form of its message.
-  int line_for_prescription_message(const std::string& message) const {
-    constexpr std::string_view kSurface = "surface ";
-    if (message.rfind(kSurface, 0) == 0) {
-      auto end = message.find_first_not_of("0123456789", kSurface.size());
-      auto n = parse_integer(std::string_view(message).substr(kSurface.size(), end - kSurface.size()));
-      if (n && *n >= 1 && *n < static_cast<long long>(surfaces_.size())) {
-        return surfaces_[static_cast<std::size_t>(*n)].line;
-      }
+  // The line a GlassError or PrescriptionError is about, from its subject.
+  int line_for_subject(const ErrorSubject& subject) const {
+    const int n = subject.surface;
+    if (n >= 1 && n < static_cast<int>(surfaces_.size())) return surfaces_[static_cast<std::size_t>(n)].line;
+    const std::string_view field = subject.field;
+    if (field == "wavelengths_nm" && subject.index >= 0 && subject.index < static_cast<int>(wavelength_sources_.size())) {
+      return wavelength_sources_[static_cast<std::size_t>(subject.index)].line;
     }
-    constexpr std::string_view kWavelength = "wavelengths_nm[";
-    if (message.rfind(kWavelength, 0) == 0) {
-      auto end = message.find(']', kWavelength.size());
-      auto i = parse_integer(std::string_view(message).substr(kWavelength.size(), end - kWavelength.size()));
-      if (i && *i >= 0 && *i < static_cast<long long>(wavelength_sources_.size())) {
-        return wavelength_sources_[static_cast<std::size_t>(*i)].line;
-      }
-    }
-    if (message.rfind("primary", 0) == 0 && primary_) return primary_->line;
-    if (message.rfind("aperture", 0) == 0 && aperture_) return aperture_->line;
-    if (message.rfind("object_space_telecentric", 0) == 0 && field_type_) return field_type_->line;
-    if (message.rfind("field", 0) == 0 && field_type_) return field_type_->line;
-    if (message.rfind("object", 0) == 0) return surfaces_.front().disz_line;
+    if (field.starts_with("primary") && primary_) return primary_->line;
+    if (field.starts_with("aperture") && aperture_) return aperture_->line;
+    if (field.starts_with("object_space_telecentric") && field_type_) return field_type_->line;
+    if (field.starts_with("field") && field_type_) return field_type_->line;
+    if (field.starts_with("object")) return surfaces_.front().disz_line;
     return 0;
   }
 
@@ -859,7 +842,7 @@ class ZemaxParser {
       }
     }
 
-    resolve_and_validate(p, catalogue_, file_, [this](const std::string& m) { return line_for_prescription_message(m); });
+    resolve_and_validate(p, catalogue_, file_, [this](const ErrorSubject& e) { return line_for_subject(e); });
     unknown_.report(diagnostics_, file_, "lines");
     result.diagnostics = std::move(diagnostics_);
     return result;

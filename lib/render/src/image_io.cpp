@@ -1,5 +1,6 @@
 // Image and depth input/output for the bokeh renderer on top of lensmith::imageio's file codecs; the
 // sRGB curve of IEC 61966-2-1:1999 (5.2 encoding, 5.3 decoding).
+#include "lensmith/core/ascii_text.h"
 #include "lensmith/render/image_io.h"
 
 #include <algorithm>
@@ -19,12 +20,6 @@ namespace lensmith {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string lower(std::string text) {
-  std::transform(text.begin(), text.end(), text.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return text;
-}
 
 // The channels that hold the picture: R, G, B (and A) by those names, else of the first layer that
 // has all three, such as a Blender multilayer EXR's "ViewLayer.Combined.R" (OpenImageIO lists
@@ -54,7 +49,7 @@ int depth_channel(const RasterInfo& info) {
     if (const int c = info.channel_index(name); c >= 0) return c;
   }
   for (std::size_t c = 0; c < info.channels.size(); ++c) {
-    const std::string name = lower(info.channels[c].name);
+    const std::string name = to_lower_ascii(info.channels[c].name);
     if (name.size() > 8 && name.compare(name.size() - 8, 8, ".depth.z") == 0) return static_cast<int>(c);
   }
   return -1;
@@ -97,7 +92,7 @@ constexpr const char* kSupportedOutputs = ".exr, .hdr, .png, .jpg, .jpeg, .tif, 
 constexpr int kJpegQuality = 95;
 
 OutputFormat output_format(const fs::path& path) {
-  const std::string ext = lower(path.extension().string());
+  const std::string ext = to_lower_ascii(path.extension().string());
   if (ext == ".exr") return OutputFormat::Exr;
   if (ext == ".hdr") return OutputFormat::Hdr;
   if (ext == ".png") return OutputFormat::Png;
@@ -550,7 +545,7 @@ void write_output_image(const fs::path& path, const Image& linear_rgb, const Out
 }
 
 void write_float_exr(const fs::path& path, const Image& image, const std::vector<std::string>& channel_names) {
-  if (lower(path.extension().string()) != ".exr") {
+  if (to_lower_ascii(path.extension().string()) != ".exr") {
     throw OptionsError(path.string() + ": write_float_exr writes OpenEXR files only (extension .exr)");
   }
   if (image.channels < 1 || static_cast<std::size_t>(image.channels) != channel_names.size()) {

@@ -36,17 +36,17 @@ CameraPose CameraPose::looking_at(const Eigen::Vector3d& position_m, const Eigen
 }
 
 void CameraPose::validate() const {
-  if (!finite(position_m)) throw SceneError("camera.position_m = " + format_vector(position_m) + ": must be finite");
+  if (!finite(position_m)) throw SceneError(ErrorSubject{0, "camera.position_m", -1}, "camera.position_m = " + format_vector(position_m) + ": must be finite");
   if (!finite(look_direction) || !(look_direction.norm() > kMinDirectionLength)) {
-    throw SceneError("camera look direction " + format_vector(look_direction) +
+    throw SceneError(ErrorSubject{0, "camera.look_at_m", -1}, "camera look direction " + format_vector(look_direction) +
                      ": must be finite and non-zero (the look-at point must differ from the position)");
   }
   if (!finite(up) || !(up.norm() > kMinDirectionLength)) {
-    throw SceneError("camera.up = " + format_vector(up) + ": must be finite and non-zero");
+    throw SceneError(ErrorSubject{0, "camera.up", -1}, "camera.up = " + format_vector(up) + ": must be finite and non-zero");
   }
   const double sine = up.normalized().cross(look_direction.normalized()).norm();
   if (!(sine > kMinUpAngleRad)) {
-    throw SceneError("camera.up = " + format_vector(up) + ": is parallel to the look direction " +
+    throw SceneError(ErrorSubject{0, "camera.up", -1}, "camera.up = " + format_vector(up) + ": is parallel to the look direction " +
                      format_vector(look_direction) + "; give an up vector across it");
   }
 }

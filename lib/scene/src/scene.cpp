@@ -12,7 +12,7 @@ bool usable(double v) { return std::isfinite(v) && v >= 0.0; }
 
 void validate_colour(const Rgb& colour, const std::string& what) {
   if (!(usable(colour.r) && usable(colour.g) && usable(colour.b))) {
-    throw SceneError(what + " = " + colour.to_string() + ": each channel must be finite and >= 0");
+    throw SceneError(ErrorSubject{0, what, -1}, what + " = " + colour.to_string() + ": each channel must be finite and >= 0");
   }
 }
 
@@ -43,13 +43,13 @@ void Scene::validate() const {
     try {
       lensmith::validate(object.shape);
     } catch (const SceneError& e) {
-      throw SceneError(label + ": " + e.what());
+      throw SceneError(e.subject(), label + ": " + e.what());
     }
     try {
       validate_colour(object.material.emission, "emission");
       lensmith::validate(object.material.albedo);
     } catch (const SceneError& e) {
-      throw SceneError(label + ": material: " + e.what());
+      throw SceneError(e.subject(), label + ": material: " + e.what());
     }
   }
 }

@@ -48,7 +48,7 @@ std::string number_text(double v) {
 }
 
 [[noreturn]] void fail_at(const LocatedJson& doc, const std::string& pointer, const std::string& path, const std::string& message) {
-  throw LensFileError(doc.where(pointer), path + ": " + message);
+  throw FileError(doc.where(pointer), path + ": " + message);
 }
 
 // A finite number at `pointer`.
@@ -148,16 +148,15 @@ std::optional<double> read_optional_integer(JsonObjectReader& r, const std::stri
   return v;
 }
 
-// Runs a validate() of the model and reports its SceneError at the key its message starts with
-// ("u_axis = ...: ..."), or at the object when no key of the object is named.
+// Runs a validate() of the model and reports its SceneError at the key it is about (its subject's
+// field, without an index), or at the object when that is not one of the object's keys.
 template <class F>
 void validate_at(JsonObjectReader& r, F&& validate_fn) {
   try {
     validate_fn();
   } catch (const SceneError& e) {
-    const std::string message = e.what();
-    const std::string key = message.substr(0, message.find(' '));
-    throw LensFileError(r.where(r.has(key) ? key : std::string()), r.path() + "." + message);
+    const std::string key = e.subject().field_root();
+    throw FileError(r.where(r.has(key) ? key : std::string()), r.path() + "." + e.what());
   }
 }
 
@@ -190,7 +189,7 @@ class SceneReader {
     try {
       scene.validate();
     } catch (const SceneError& e) {  // every rule is checked at its key above; this is a backstop
-      throw LensFileError(doc_.where(""), e.what());
+      throw FileError(doc_.where(""), e.what());
     }
     return scene;
   }
@@ -360,25 +359,14 @@ class SceneReader {
 }  // namespace
 
 Scene read_scene_json(std::string_view text, const std::string& file_name, const std::filesystem::path& base_dir) {
-  try {
-    const LocatedJson doc = LocatedJson::parse(text, file_name);
-    return SceneReader(doc, base_dir).read();
-  } catch (const LensFileError& e) {
-    // The JSON helpers of core report in LensFileError; a scene file's errors are SceneFileError.
-    throw SceneFileError(e.where(), e.what_without_location());
-  }
+  const LocatedJson doc = LocatedJson::parse(text, file_name);
+  return SceneReader(doc, base_dir).read();
 }
 
 Scene load_scene(const std::filesystem::path& path) {
   const std::string name = path.string();
   const std::string bytes = read_file_bytes(name);
-  std::string text;
-  try {
-    text = decode_text(bytes, name);
-  } catch (const LensFileError& e) {
-    throw SceneFileError(e.where(), e.what_without_location());
-  }
-  return read_scene_json(text, name, path.parent_path());
+  return read_scene_json(decode_text(bytes, name), name, path.parent_path());
 }
 
 }  // namespace lensmith

@@ -1,3 +1,4 @@
+#include "lensmith/core/number_parsing.h"
 #include "lensmith/scene/shape.h"
 
 #include <algorithm>
@@ -30,26 +31,19 @@ Overloaded(Ts...) -> Overloaded<Ts...>;
 
 bool finite(const Eigen::Vector3d& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
 
-std::string number(double v) {
-  std::ostringstream os;
-  os.precision(6);
-  os << v;
-  return os.str();
-}
-
 void require_finite(const Eigen::Vector3d& v, const char* field) {
-  if (!finite(v)) throw SceneError(std::string(field) + " = " + format_vector(v) + ": must be finite");
+  if (!finite(v)) throw SceneError(ErrorSubject{0, field, -1}, std::string(field) + " = " + format_vector(v) + ": must be finite");
 }
 
 void require_direction(const Eigen::Vector3d& v, const char* field) {
   require_finite(v, field);
   if (!(v.norm() > kMinLength)) {
-    throw SceneError(std::string(field) + " = " + format_vector(v) + ": must have a non-zero length (it is normalised)");
+    throw SceneError(ErrorSubject{0, field, -1}, std::string(field) + " = " + format_vector(v) + ": must have a non-zero length (it is normalised)");
   }
 }
 
 void require_radius(double radius_m) {
-  if (!(std::isfinite(radius_m) && radius_m > 0.0)) throw SceneError("radius_m = " + number(radius_m) + ": must be finite and > 0");
+  if (!(std::isfinite(radius_m) && radius_m > 0.0)) throw SceneError(ErrorSubject{0, "radius_m", -1}, "radius_m = " + format_rounded(radius_m, 6) + ": must be finite and > 0");
 }
 
 void require_u_axis(const std::optional<Eigen::Vector3d>& u_axis, const Eigen::Vector3d& normal) {
@@ -58,7 +52,7 @@ void require_u_axis(const std::optional<Eigen::Vector3d>& u_axis, const Eigen::V
   const Eigen::Vector3d n = normal.normalized();
   const Eigen::Vector3d across = *u_axis - u_axis->dot(n) * n;
   if (!(across.norm() > kMinUAxisSine * u_axis->norm())) {
-    throw SceneError("u_axis = " + format_vector(*u_axis) + ": is parallel to the normal " + format_vector(normal) +
+    throw SceneError(ErrorSubject{0, "u_axis", -1}, "u_axis = " + format_vector(*u_axis) + ": is parallel to the normal " + format_vector(normal) +
                      "; give a direction in the surface");
   }
 }
@@ -115,8 +109,8 @@ void validate(const SceneShape& shape) {
                           require_direction(r.half_v_m, "half_v_m");
                           const double cosine = r.half_u_m.dot(r.half_v_m) / (r.half_u_m.norm() * r.half_v_m.norm());
                           if (!(std::abs(cosine) <= kMaxHalfEdgeCosine)) {
-                            throw SceneError("half_u_m = " + format_vector(r.half_u_m) + " and half_v_m = " +
-                                             format_vector(r.half_v_m) + ": must be perpendicular (cosine " + number(cosine) +
+                            throw SceneError(ErrorSubject{0, "half_u_m", -1}, "half_u_m = " + format_vector(r.half_u_m) + " and half_v_m = " +
+                                             format_vector(r.half_v_m) + ": must be perpendicular (cosine " + format_rounded(cosine, 6) +
                                              ", allowed 1e-6)");
                           }
                         },
@@ -221,12 +215,12 @@ std::string to_string(const SceneShape& shape) {
                                },
                                [](const Disc& d) {
                                  std::string s = "disc(centre " + format_vector(d.centre_m) + " m, normal " + format_vector(d.normal) +
-                                                 ", radius " + number(d.radius_m) + " m";
+                                                 ", radius " + format_rounded(d.radius_m, 6) + " m";
                                  if (d.u_axis) s += ", u_axis " + format_vector(*d.u_axis);
                                  return s + ")";
                                },
                                [](const Sphere& s) {
-                                 return "sphere(centre " + format_vector(s.centre_m) + " m, radius " + number(s.radius_m) + " m)";
+                                 return "sphere(centre " + format_vector(s.centre_m) + " m, radius " + format_rounded(s.radius_m, 6) + " m)";
                                }},
                     shape);
 }

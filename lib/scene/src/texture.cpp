@@ -1,3 +1,4 @@
+#include "lensmith/core/number_parsing.h"
 #include "lensmith/scene/texture.h"
 
 #include <algorithm>
@@ -23,15 +24,13 @@ struct Overloaded : Ts... {
 template <class... Ts>
 Overloaded(Ts...) -> Overloaded<Ts...>;
 
-std::string number(double v) {
-  std::ostringstream os;
-  os.precision(6);
-  os << v;
-  return os.str();
-}
-
-void require_size(double size_m, const char* field) {
-  if (!(std::isfinite(size_m) && size_m > 0.0)) throw SceneError(std::string(field) + " = " + number(size_m) + ": must be finite and > 0");
+// `shown` names the value in the message; the subject is its key (the part before any index), and
+// `index` the entry of a list.
+void require_size(double size_m, const char* shown, int index = -1) {
+  if (!(std::isfinite(size_m) && size_m > 0.0)) {
+    const std::string name(shown);
+    throw SceneError(ErrorSubject{0, name.substr(0, name.find_first_of("[ ")), index}, name + " = " + format_rounded(size_m, 6) + ": must be finite and > 0");
+  }
 }
 
 // SplitMix64's finaliser (Steele, Lea & Flood, "Fast splittable pseudorandom number generators",
@@ -119,19 +118,19 @@ void validate(const Texture& texture) {
                         [](const NoiseTexture& t) {
                           require_size(t.scale_m, "scale_m");
                           if (t.octaves < 1 || t.octaves > kMaxOctaves) {
-                            throw SceneError("octaves = " + std::to_string(t.octaves) + ": must be in 1..16");
+                            throw SceneError(ErrorSubject{0, "octaves", -1}, "octaves = " + std::to_string(t.octaves) + ": must be in 1..16");
                           }
                           validate_colour(t.colours[0], "colours[0]");
                           validate_colour(t.colours[1], "colours[1]");
                         },
                         [](const ImageTexture& t) {
-                          if (!t.image) throw SceneError("image texture " + t.file.string() + ": no picture loaded");
+                          if (!t.image) throw SceneError(ErrorSubject{0, "file", -1}, "image texture " + t.file.string() + ": no picture loaded");
                           if (t.image->channels != 3 || t.image->width < 1 || t.image->height < 1) {
-                            throw SceneError("image texture " + t.file.string() + ": needs a 3-channel picture, got " +
+                            throw SceneError(ErrorSubject{0, "file", -1}, "image texture " + t.file.string() + ": needs a 3-channel picture, got " +
                                              t.image->to_string());
                           }
-                          require_size(t.width_m, "size_m[0] (width)");
-                          require_size(t.height_m, "size_m[1] (height)");
+                          require_size(t.width_m, "size_m[0] (width)", 0);
+                          require_size(t.height_m, "size_m[1] (height)", 1);
                         }},
              texture);
 }
@@ -166,17 +165,17 @@ Rgb evaluate(const Texture& texture, const SurfaceCoordinates& at) {
 std::string to_string(const Texture& texture) {
   return std::visit(Overloaded{[](const ConstantTexture& t) { return "constant(" + t.colour.to_string() + ")"; },
                                [](const CheckerTexture& t) {
-                                 return "checker(size " + number(t.size_m) + " m, " + t.colours[0].to_string() + " / " +
+                                 return "checker(size " + format_rounded(t.size_m, 6) + " m, " + t.colours[0].to_string() + " / " +
                                         t.colours[1].to_string() + ")";
                                },
                                [](const NoiseTexture& t) {
-                                 return "noise(scale " + number(t.scale_m) + " m, " + std::to_string(t.octaves) + " octaves, seed " +
+                                 return "noise(scale " + format_rounded(t.scale_m, 6) + " m, " + std::to_string(t.octaves) + " octaves, seed " +
                                         std::to_string(t.seed) + ", " + t.colours[0].to_string() + " / " + t.colours[1].to_string() +
                                         ")";
                                },
                                [](const ImageTexture& t) {
                                  return "image(" + t.file.string() + ", " + (t.image ? t.image->to_string() : std::string("not loaded")) +
-                                        ", " + number(t.width_m) + " x " + number(t.height_m) + " m)";
+                                        ", " + format_rounded(t.width_m, 6) + " x " + format_rounded(t.height_m, 6) + " m)";
                                }},
                     texture);
 }

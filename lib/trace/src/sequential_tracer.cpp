@@ -4,6 +4,7 @@
 // Newton's method on the sag along the ray with a bracketed regula-falsi fallback; vector Snell refraction;
 // optical path n x length. Per-wavelength refractive indices come from a lock-free cache so that the per-ray
 // loop allocates nothing and throws nothing. docs/trace.md explains the choices made here.
+#include "lensmith/core/number_parsing.h"
 #include "lensmith/trace/sequential_tracer.h"
 
 #include <omp.h>
@@ -934,19 +935,12 @@ inline bool load(double x, double y, double z, double l, double m, double n, dou
   return true;
 }
 
-std::string number(double value) {
-  std::ostringstream os;
-  os.precision(17);
-  os << value;
-  return os.str();
-}
-
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
 void TracerOptions::validate() const {
   if (image_distance_mm && !std::isfinite(*image_distance_mm)) {
-    throw OptionsError("TracerOptions::image_distance_mm = " + number(*image_distance_mm) + ": must be finite");
+    throw OptionsError("TracerOptions::image_distance_mm = " + format_number(*image_distance_mm) + ": must be finite");
   }
 }
 

@@ -5,6 +5,7 @@
 #include <ostream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace lensmith {
 
@@ -27,11 +28,29 @@ class Error : public std::runtime_error {
   explicit Error(const std::string& message) : std::runtime_error(message) {}
 };
 
-// A lens file (native JSON, Zemax, pbrt, lentil) could not be read: the message is prefixed with
-// the location and says what was expected.
-class LensFileError : public Error {
+// What an error inside a model is about, so that a reader can point at the line that set it without
+// parsing the message: a surface (1-based; 0: none), a field ("semi_diameter_mm", "wavelengths_nm",
+// "aperture", "field.vignetting", "object", "primary", a scene object's key) and, for a list, the
+// entry's index (-1: none).
+struct ErrorSubject {
+  int surface = 0;
+  std::string field;
+  int index = -1;
+
+  bool empty() const { return surface == 0 && field.empty(); }
+  // The field's first dotted part: "aperture" for "aperture.f_number".
+  std::string field_root() const { return field.substr(0, field.find_first_of(".[")); }
+  // "surface 3, semi_diameter_mm", "wavelengths_nm[2]", "aperture", "(none)".
+  std::string to_string() const;
+  friend std::ostream& operator<<(std::ostream& os, const ErrorSubject& s) { return os << s.to_string(); }
+};
+
+// A user's file (a lens in any format, a glass catalogue, a fit, a scene) could not be read: the
+// message is prefixed with the location and says what was expected. One type for every file the
+// readers take, so callers and the Python module handle them alike.
+class FileError : public Error {
  public:
-  LensFileError(SourceLocation where, const std::string& what);
+  FileError(SourceLocation where, const std::string& what);
   const SourceLocation& where() const { return where_; }
   const std::string& what_without_location() const { return detail_; }
 
@@ -40,16 +59,27 @@ class LensFileError : public Error {
   std::string detail_;
 };
 
-// A glass could not be found or evaluated (unknown name, bad formula, wavelength out of range).
-class GlassError : public Error {
+// An error about one part of a model (a surface, a field), carrying that part as its subject.
+class SubjectError : public Error {
  public:
-  using Error::Error;
+  explicit SubjectError(const std::string& message) : Error(message) {}
+  SubjectError(ErrorSubject subject, const std::string& message) : Error(message), subject_(std::move(subject)) {}
+  const ErrorSubject& subject() const { return subject_; }
+
+ private:
+  ErrorSubject subject_;
+};
+
+// A glass could not be found or evaluated (unknown name, bad formula, wavelength out of range).
+class GlassError : public SubjectError {
+ public:
+  using SubjectError::SubjectError;
 };
 
 // A prescription is not a valid optical system ("surface 3: semi_diameter_mm = -2: must be > 0").
-class PrescriptionError : public Error {
+class PrescriptionError : public SubjectError {
  public:
-  using Error::Error;
+  using SubjectError::SubjectError;
 };
 
 // An options struct failed its own validation ("FitOptions::degree = 0: must be >= 1").

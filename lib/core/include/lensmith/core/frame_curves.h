@@ -22,7 +22,7 @@ namespace lensmith {
 class FrameCurves {
  public:
   // Reads a .json or .csv curve file (by extension; any case). Curve names must be among `allowed`.
-  // Throws IoError when the file cannot be read, LensFileError(file:line[:col]) for a malformed file:
+  // Throws IoError when the file cannot be read, FileError(file:line[:col]) for a malformed file:
   // an unknown curve (listing the allowed names), a value that is not a finite number, a frame that
   // is not a whole number, a frame keyed twice in one curve, a curve without keys.
   static FrameCurves read(const std::string& path, const std::vector<std::string>& allowed);

@@ -18,7 +18,7 @@ namespace lensmith {
 
 class LocatedJson {
  public:
-  // Parses `text`; throws LensFileError(file:line:col) on a syntax error, on nesting deeper than
+  // Parses `text`; throws FileError(file:line:col) on a syntax error, on nesting deeper than
   // `max_depth` levels, or on duplicate object keys.
   static LocatedJson parse(std::string_view text, const std::string& file_name, int max_depth = 64);
 
@@ -39,14 +39,14 @@ class LocatedJson {
 // Paths in messages use dotted form: surfaces[2].thickness_mm.
 class JsonObjectReader {
  public:
-  // Throws LensFileError unless the value at `pointer` is an object. `display_path` names it in
+  // Throws FileError unless the value at `pointer` is an object. `display_path` names it in
   // messages ("" for the root).
   JsonObjectReader(const LocatedJson& doc, std::string pointer, std::string display_path);
 
   bool has(const std::string& key) const;
   // The value of `key` if present; marks it consumed.
   const nlohmann::json* get(const std::string& key);
-  // Typed getters: throw LensFileError at the value's position when the type is wrong or, for the
+  // Typed getters: throw FileError at the value's position when the type is wrong or, for the
   // required forms, when the key is missing.
   double get_number(const std::string& key);
   std::optional<double> get_optional_number(const std::string& key);

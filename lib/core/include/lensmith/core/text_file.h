@@ -15,13 +15,10 @@ std::string read_file_bytes(const std::string& path);
 // Decodes text as Zemax and Windows tools write it, returned as valid UTF-8: UTF-16LE/BE with a BOM
 // (or without one, recognised by the zero byte in every pair of mostly-ASCII text), UTF-8 with or
 // without a BOM, and otherwise (bytes that are not UTF-8) "ANSI": Windows-1252, whose printable
-// characters include ISO-8859-1's (OpticStudio writes all three). Throws LensFileError(file) on a
+// characters include ISO-8859-1's (OpticStudio writes all three). Throws FileError(file) on a
 // malformed UTF-16 sequence.
 std::string decode_text(std::string_view bytes, const std::string& file_name);
 
-// `text` with its ASCII letters upper-cased and every other byte unchanged: keywords and glass names
-// in lens files, compared case-insensitively.
-std::string ascii_upper(std::string_view text);
 
 // A display form of user text for messages: at most `max_length` bytes, then "...", so that a
 // megabyte "keyword" from a garbage file does not become a megabyte error message.

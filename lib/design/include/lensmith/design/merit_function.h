@@ -118,7 +118,7 @@ struct MeritFunction {
   friend std::ostream& operator<<(std::ostream& os, const MeritFunction& m) { return os << m.to_string(); }
 };
 
-// Reads a merit file (docs/optimize.md). Throws LensFileError with file:line:column and what was
+// Reads a merit file (docs/optimize.md). Throws FileError with file:line:column and what was
 // expected, IoError when the file cannot be read.
 MeritFunction read_merit_function(const std::string& path);
 MeritFunction parse_merit_function(std::string_view text, const std::string& file_name);

@@ -20,16 +20,16 @@ class GlassCatalog {
   static const GlassCatalog& builtin();
 
   // Parses one catalogue in lensmith's compact JSON form (docs/glass.md). `source_name` is used in
-  // error messages. Throws GlassError (or LensFileError with a position) on malformed input.
+  // error messages. Throws GlassError (or FileError with a position) on malformed input.
   static GlassCatalog from_json(std::string_view json_text, const std::string& source_name);
 
   // Parses a Zemax glass catalogue (.agf: NM, CD and LD records; every AGF dispersion formula,
   // 1-13, docs/glass.md), its glasses under `vendor` (OpticStudio names a catalogue by its file
   // name). `text` is decoded text (text_file.h's decode_text: AGF files are UTF-16, UTF-8 or ANSI).
-  // Throws LensFileError at the line of a malformed record.
+  // Throws FileError at the line of a malformed record.
   static GlassCatalog from_agf(std::string_view text, const std::string& file_name, const std::string& vendor);
   // A catalogue file by its extension: .agf (vendor: the file name without extension, upper case)
-  // or lensmith's .json. Throws IoError, LensFileError or GlassError.
+  // or lensmith's .json. Throws IoError, FileError or GlassError.
   static GlassCatalog read_file(const std::string& path);
   // Adds a user's catalogue files to builtin(), searched after the shipped vendors (a lens file's
   // GCAT line names them first). LENSMITH_GLASS_CATALOGS (files or folders of .agf, separated by

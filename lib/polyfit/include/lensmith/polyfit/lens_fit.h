@@ -182,7 +182,7 @@ class LensFit {
   // and records it in timing(). One thread each; the process's OpenMP settings are not changed.
   void measure_speed(const Prescription& lens);
 
-  // Versioned JSON ("lensmith-fit", version 1). read() throws LensFileError with file:line:col for
+  // Versioned JSON ("lensmith-fit", version 1). read() throws FileError with file:line:col for
   // malformed files; write() goes through a temporary file and a rename.
   static LensFit parse(std::string_view text, const std::string& file_name);
   static LensFit read(const std::string& path);

@@ -14,7 +14,7 @@ namespace lensmith {
 // the object surface (its thickness the object distance, >= 1e10 lens units meaning infinity), the S
 // lines are the lens surfaces, SI the image surface (its thickness a defocus added to the last
 // surface's). Rays are aimed at the real stop (RayAiming::RealStop), as CODE V does.
-// Throws LensFileError naming file:line:col and the keyword for anything malformed or that would
+// Throws FileError naming file:line:col and the keyword for anything malformed or that would
 // change the optics and cannot be represented (mirrors, decentres and tilts, zoom, diffractive or
 // toroidal surfaces, object-space NA); a fictitious glass code or private glass becomes a model
 // glass with a warning; an unknown glass is an error naming the closest catalogue names.

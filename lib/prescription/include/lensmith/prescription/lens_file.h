@@ -23,18 +23,18 @@ struct LensReadResult {
 enum class LensFormat { Json, Zemax, Pbrt, Lentil, CodeV };
 
 // The format a path names, from its extension: .json -> Json (or Lentil when the file is a
-// lentil database; see read_lens_file), .zmx -> Zemax, .seq -> CodeV, .dat -> Pbrt. Throws LensFileError.
+// lentil database; see read_lens_file), .zmx -> Zemax, .seq -> CodeV, .dat -> Pbrt. Throws FileError.
 LensFormat lens_format_from_path(const std::string& path);
 
 // Reads any supported lens file. For a lentil database the path takes the entry id after a '#':
-// "lenses.json#0001". Throws IoError, LensFileError, GlassError or PrescriptionError.
+// "lenses.json#0001". Throws IoError, FileError, GlassError or PrescriptionError.
 LensReadResult read_lens_file(const std::string& path, const GlassCatalog& catalogue = GlassCatalog::builtin());
 
 // For readers: resolves the materials of `lens` against `catalogue` and validates it, turning a
-// GlassError or PrescriptionError into a LensFileError at `file`, on the line `line_of` finds for the
-// message (0 when unknown).
+// GlassError or PrescriptionError into a FileError at `file`, on the line `line_of` finds for the
+// error's subject (the surface or field it is about; 0 when unknown).
 void resolve_and_validate(Prescription& lens, const GlassCatalog& catalogue, const std::string& file,
-                          const std::function<int(const std::string& message)>& line_of);
+                          const std::function<int(const ErrorSubject& subject)>& line_of);
 
 // For readers: the name of a lens whose file gives none, the file name without folder and extension
 // ("lenses/US8427765.zmx" -> "US8427765").

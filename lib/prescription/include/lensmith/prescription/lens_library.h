@@ -20,7 +20,7 @@ class LensLibrary {
   static std::vector<ShippedLens> list();
   // True when `id` names a shipped lens.
   static bool contains(const std::string& id);
-  // Reads a shipped lens. Throws LensFileError naming the closest ids when `id` is unknown.
+  // Reads a shipped lens. Throws FileError naming the closest ids when `id` is unknown.
   static LensReadResult load(const std::string& id, const GlassCatalog& catalogue = GlassCatalog::builtin());
   // LENS as the CLI takes it: a path to an existing file, or else the id of a shipped lens.
   static LensReadResult load_path_or_name(const std::string& path_or_id,

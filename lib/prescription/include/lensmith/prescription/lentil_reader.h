@@ -28,7 +28,7 @@ std::vector<LentilEntrySummary> list_lentil_entries(std::string_view text, const
 // catalogues whose nd lies within 0.002 of the entry's "ior" is used as that catalogue glass;
 // otherwise a model glass from "ior" and "abbe" with a note. "iris" is the stop (its housing radius
 // sets the aperture, which floats by the stop). Cylindrical surfaces and zoom thickness lists are
-// errors naming the element. Throws LensFileError.
+// errors naming the element. Throws FileError.
 LensReadResult read_lentil(std::string_view text, const std::string& file_name, const std::string& id,
                            const GlassCatalog& catalogue = GlassCatalog::builtin());
 

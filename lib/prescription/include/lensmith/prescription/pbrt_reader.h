@@ -19,7 +19,7 @@ enum class PbrtConvention {
 
 // Parses a pbrt lens file. Indices become dispersion-free model glasses (pbrt gives no Abbe number),
 // the stop row a plane stop in air, the aperture floats by the stop, and the image plane is placed
-// at the paraxial focus (pbrt solves focus itself). Throws LensFileError with file:line.
+// at the paraxial focus (pbrt solves focus itself). Throws FileError with file:line.
 LensReadResult read_pbrt(std::string_view text, const std::string& file_name,
                          PbrtConvention convention = PbrtConvention::Auto);
 

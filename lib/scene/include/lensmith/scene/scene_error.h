@@ -1,4 +1,4 @@
-// Errors of the scene layer: an invalid scene built in code, and a scene file that cannot be read.
+// Errors of the scene layer: an invalid scene built in code.
 #pragma once
 
 #include <string>
@@ -8,24 +8,15 @@
 
 namespace lensmith {
 
-// A scene (built in code) is not valid: "objects[2] (sphere \"sun\"): radius_m = -1: must be > 0".
-class SceneError : public Error {
+// A scene (built in code) is not valid: "objects[2] (sphere \"sun\"): radius_m = -1: must be > 0";
+// its subject's field is the key the message starts with ("radius_m").
+class SceneError : public SubjectError {
  public:
-  using Error::Error;
+  using SubjectError::SubjectError;
 };
 
-// A scene file (docs/scene-format.md) could not be read: the message starts with file:line:col and
-// names the key and what was expected ("scene.json:12:17: objects[1].radius_m: must be > 0, got -1").
-class SceneFileError : public Error {
- public:
-  SceneFileError(SourceLocation where, const std::string& what)
-      : Error(where.to_string() + ": " + what), where_(std::move(where)), detail_(what) {}
-  const SourceLocation& where() const { return where_; }
-  const std::string& what_without_location() const { return detail_; }
-
- private:
-  SourceLocation where_;
-  std::string detail_;
-};
+// A scene file (docs/scene-format.md) that cannot be read throws FileError (lensmith/core/errors.h)
+// at file:line:col, naming the key and what was expected ("scene.json:12:17: objects[1].radius_m:
+// must be > 0, got -1").
 
 }  // namespace lensmith
