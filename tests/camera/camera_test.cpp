@@ -258,19 +258,30 @@ TEST_CASE("The exact model loses rays that a clear aperture blocks, and reports 
   CHECK(exact->unaimed_rays() == 0);
 }
 
-TEST_CASE("A stop point no ray can reach is counted as a failure of the exact model, not drawn as vignetting", "[camera]") {
+TEST_CASE("The exact model counts as failures only stop points it cannot aim: not vignetted rays, not points beyond the stop", "[camera]") {
   const Prescription lens = LensLibrary::load("pbrt-dgauss-50mm").prescription;
   const Camera cam = Camera::from_lens(lens, options(3.0, 2.0), 640, 480);
   const auto exact = make_ray_model(RayModelKind::Exact, cam);
   REQUIRE(exact->unaimed_rays() == 0);  // the model's own set-up rays are not counted
-  // Forty stop radii off the axis lies outside every element's sag domain: neither the beam's
-  // Broyden aim nor RayAimer's continuation finds a ray.
+  // Forty stop radii off the axis lies outside every element's sag domain and beyond the stop:
+  // no ray, and it is not counted (the stop blocks it anyway).
   const auto h = hits(*exact, {0.05, 0.0, 1.0 / 3000.0}, 587.56, {{0.0, 0.0}, {0.5, 0.0}, {40.0, 0.0}});
   CHECK(h[0].ok);
   CHECK(h[1].ok);
   CHECK_FALSE(h[2].ok);
   CHECK_FALSE(h[2].unclipped);
-  CHECK(exact->unaimed_rays() == 1);
+  CHECK(exact->unaimed_rays() == 0);
+  // A front surface bent to R = 12 mm ends (its sag has no value beyond r = 12 mm) inside the beam
+  // that fills the stop: stop points near the rim have no ray at all, and those are counted.
+  Prescription cut = lens;
+  cut.surfaces[0].curvature_per_mm = 1.0 / 12.0;
+  cut.surfaces[0].semi_diameter_mm = 11.9;
+  const Camera cut_camera = Camera::from_lens(cut, options(3.0, 2.0), 640, 480);
+  const auto cut_exact = make_ray_model(RayModelKind::Exact, cut_camera);
+  const auto rim = hits(*cut_exact, {0.0, 0.0, 1.0 / 3000.0}, 587.56, {{0.0, 0.0}, {0.995, 0.0}, {0.0, -0.995}});
+  CHECK(rim[0].ok);
+  for (std::size_t k = 1; k < rim.size(); ++k) CHECK_FALSE((rim[k].ok || rim[k].unclipped));
+  CHECK(cut_exact->unaimed_rays() == 2);
   // The first-order models need no aiming.
   CHECK(make_ray_model(RayModelKind::Paraxial, cam)->unaimed_rays() == 0);
 }

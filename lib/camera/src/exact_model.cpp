@@ -44,6 +44,9 @@ Ray ray_towards(const ScenePoint& p, double z_perspective_mm, double target_x, d
 
 // Two unit directions this close (rad) are one ray's: rounding of a trace is ~1e-14.
 constexpr double kSameDirection = 1e-9;
+// Pupil points within this radius (1: the stop's rim, with its edge tolerance) get RayAimer's
+// fallback aim.
+constexpr double kOnStop = 1.0 + kStopEdgeTolerance;
 
 }  // namespace
 
@@ -207,12 +210,16 @@ void ExactModel::map_raw(const ScenePoint& point, double wavelength_nm, std::spa
       r = {sx - want_x, sy - want_y};
       return true;
     };
-    // Where the beam's own aim fails (a rim ray of a strongly aberrated pupil, a beam the affine
-    // start misjudges), RayAimer's continuation; a ray neither can aim is counted as a failure.
+    // Where the beam's own aim fails for a point of the stop (a rim ray of a strongly aberrated
+    // pupil, a beam the affine start misjudges), RayAimer's continuation; a ray neither can aim is
+    // counted as a failure. Points beyond the stop's rim (a square grid's corners, a mask picture's)
+    // are not worth RayAimer's 20-120 us refusal: the stop blocks them, and no such ray may exist
+    // (validate's PSF grids took 40 % longer with it).
+    const bool on_stop = pupil[i].x * pupil[i].x + pupil[i].y * pupil[i].y <= kOnStop * kOnStop;
     if (!aim_solver.solve(miss, target, &beam_jacobian).converged() &&
-        !aim_by_ray_aimer(point, wavelength_nm, want_x, want_y, z_target, target[0], target[1])) {
+        !(on_stop && aim_by_ray_aimer(point, wavelength_nm, want_x, want_y, z_target, target[0], target[1]))) {
       hits[i] = {};
-      unaimed_.fetch_add(1, std::memory_order_relaxed);
+      if (on_stop) unaimed_.fetch_add(1, std::memory_order_relaxed);
       continue;
     }
     const double tx = target[0], ty = target[1];
