@@ -42,8 +42,6 @@ Ray ray_towards(const ScenePoint& p, double z_perspective_mm, double target_x, d
   return r;
 }
 
-// Two unit directions this close (rad) are one ray's: rounding of a trace is ~1e-14.
-constexpr double kSameDirection = 1e-9;
 // Pupil points within this radius (1: the stop's rim, with its edge tolerance) get RayAimer's
 // fallback aim.
 constexpr double kOnStop = 1.0 + kStopEdgeTolerance;
@@ -107,22 +105,10 @@ bool ExactModel::aim_by_ray_aimer(const ScenePoint& point, double wavelength_nm,
   const double r = aimer_->stop_radius_mm();
   const AimedRay aimed = aimer_->make_ray(field, PupilCoordinate{want_x_mm / r, want_y_mm / r}, wavelength_nm);
   if (!aimed.ok() || !(std::abs(aimed.ray.direction.z()) > 0.0)) return false;
-  // RayAimer aims on the stop in the global frame; this model's stop point is in the stop's own
-  // frame (a tilted lens): check where the ray really crosses it.
-  thread_local std::vector<SurfaceHit> path;
-  free_->trace_forward(aimed.ray, &path);
-  const std::size_t stop_index = static_cast<std::size_t>(stop_surface_ - 1);
-  if (path.size() <= stop_index) return false;
-  const Eigen::Vector3d on_stop = stop_frame_.to_local(path[stop_index].point_mm);
-  if (std::hypot(on_stop.x() - want_x_mm, on_stop.y() - want_y_mm) > kAimTolerance * stop_radius_mm_) return false;
   const double t = (z_target_mm - aimed.ray.position_mm.z()) / aimed.ray.direction.z();
   target_x_mm = aimed.ray.position_mm.x() + t * aimed.ray.direction.x();
   target_y_mm = aimed.ray.position_mm.y() + t * aimed.ray.direction.y();
-  if (!(std::isfinite(target_x_mm) && std::isfinite(target_y_mm))) return false;
-  // And that it is this scene point's ray (a lens file's finite object plane would turn an angle
-  // into a point on that plane): the same direction as the ray from the point to the target.
-  const Ray expected = ray_towards(point, z_persp, target_x_mm, target_y_mm, z_target_mm, wavelength_nm, z_target_mm);
-  return (expected.direction - aimed.ray.direction.normalized()).norm() <= kSameDirection;
+  return std::isfinite(target_x_mm) && std::isfinite(target_y_mm);
 }
 
 void ExactModel::map(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
@@ -216,8 +202,15 @@ void ExactModel::map_raw(const ScenePoint& point, double wavelength_nm, std::spa
     // are not worth RayAimer's 20-120 us refusal: the stop blocks them, and no such ray may exist
     // (validate's PSF grids took 40 % longer with it).
     const bool on_stop = pupil[i].x * pupil[i].x + pupil[i].y * pupil[i].y <= kOnStop * kOnStop;
-    if (!aim_solver.solve(miss, target, &beam_jacobian).converged() &&
-        !(on_stop && aim_by_ray_aimer(point, wavelength_nm, want_x, want_y, z_target, target[0], target[1]))) {
+    // RayAimer's ray is checked the way the beam's own are: traced from this point through its
+    // target, in the stop's own frame (which also refuses a ray of another beam, such as a lens
+    // file's finite object plane would give for an angle).
+    auto aimed_by_ray_aimer = [&]() {
+      Vector2 r;
+      return on_stop && aim_by_ray_aimer(point, wavelength_nm, want_x, want_y, z_target, target[0], target[1]) &&
+             miss(target, r, nullptr) && norm_2d(r) <= aim_options.tolerance;
+    };
+    if (!aim_solver.solve(miss, target, &beam_jacobian).converged() && !aimed_by_ray_aimer()) {
       hits[i] = {};
       if (on_stop) unaimed_.fetch_add(1, std::memory_order_relaxed);
       continue;

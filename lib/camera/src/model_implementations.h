@@ -286,8 +286,9 @@ class ExactModel final : public RayModel {
   // map() without the normalisation of the weights.
   void map_raw(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil, std::span<SensorHit> hits) const;
 
-  // The stop-plane target of the ray from `point` that RayAimer (the exact tracer's tested aiming,
-  // docs/trace.md) sends through stop point (x, y) mm, checked by tracing it; false when it fails.
+  // The entrance-pupil-plane target (z_target_mm) of the ray from `point` that RayAimer (the exact
+  // tracer's tested aiming, docs/trace.md) sends through stop point (x, y) mm; false when it fails.
+  // The caller checks it by tracing, as it checks its own aims.
   bool aim_by_ray_aimer(const ScenePoint& point, double wavelength_nm, double want_x_mm, double want_y_mm, double z_target_mm,
                         double& target_x_mm, double& target_y_mm) const;
 

@@ -78,12 +78,13 @@ void PolyModel::map_raw(const ScenePoint& point, double wavelength_nm, std::span
   // radiometric weights: the solid angle of that element of surface 1 seen from the point.
   const double outer_area = 1.0 / std::abs(det);
   const double z_persp = camera_.z_perspective_mm();
-  // The chord steps of one pupil point: at most 12 evaluations of the fit, full steps.
+  // The chord steps of one pupil point: at most kMaxChordEvaluations evaluations of the fit, full steps.
+  constexpr int kMaxChordEvaluations = 12;
   RootSolver2dOptions chord;
   chord.jacobian = JacobianSource::Fixed;
   chord.line_search = false;
   chord.tolerance = tolerance_mm;
-  chord.max_iterations = 11;
+  chord.max_iterations = kMaxChordEvaluations - 1;
   const RootSolver2d chord_solver(chord);
   for (std::size_t i = 0; i < pupil.size(); ++i) {
     const double sx = pupil[i].x * stop_radius_mm_, sy = pupil[i].y * stop_radius_mm_;

@@ -139,8 +139,6 @@ struct RayModelOptions {
 // made for a render covers what is rendered.
 LensFitOptions lens_fit_options_for(const Camera& camera);
 
-// The camera a model renders with: CameraSpec::camera (camera_spec.h).
-
 // Thin needs a thin-lens camera; the others a camera made from a prescription. Throws OptionsError
 // for a mismatch (poly: a fit of another lens, a stop wider than the fit's, a frame or wavelength
 // range beyond it) and what the Seidel analysis or the fit throws.
