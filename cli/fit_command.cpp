@@ -66,6 +66,9 @@ int run_fit(const FitCommandOptions& o, const GlobalOptions& global) {
             << "  degree " << options.degree << ", at most " << fit.term_budget() << " terms per output ("
             << fit.sensor_to_outer().size() << " sensor->outer, " << fit.outer_to_sensor().size()
             << " outer->sensor), " << options.training_rays << " training rays, 380-780 nm\n"
+            << (fit.symmetry() == LensSymmetry::kRotational
+                    ? "  form: rotation invariants (a rotationally symmetric lens)\n"
+                    : "  form: x and y components apart, the mirror symmetry of both sections kept (an anamorphic lens)\n")
             << "  clipping surfaces:";
   for (const ClipSurface& c : fit.clip_surfaces()) std::cout << " " << c.surface;
   std::cout << " (stop first)\n"

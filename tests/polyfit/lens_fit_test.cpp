@@ -177,8 +177,12 @@ TEST_CASE("malformed fit files are refused with the file, line and what was expe
   wrong_format.replace(wrong_format.find("lensmith-fit"), 12, "lensmith-lens");
   fails_with(wrong_format, "lensmith-fit");
   std::string wrong_version = good;
-  wrong_version.replace(wrong_version.find("\"version\": 1"), 12, "\"version\": 2");
+  wrong_version.replace(wrong_version.find("\"version\": 1"), 12, "\"version\": 3");
   fails_with(wrong_version, "version");
+  // Version 2 (anamorphic fits) needs what version 1 lacks.
+  std::string version_2 = good;
+  version_2.replace(version_2.find("\"version\": 1"), 12, "\"version\": 2");
+  fails_with(version_2, "symmetry");
   std::string extra = good;
   extra.insert(extra.find("\"version\""), "\"colour\": 3,\n ");
   fails_with(extra, "colour");

@@ -45,9 +45,9 @@ PolyModel::PolyModel(const Camera& camera, std::shared_ptr<const LensFit> fit) :
 }
 
 double PolyModel::outer_solid_angle(const ScenePoint& point, double z_perspective_mm, double x_mm, double y_mm) const {
-  double dz_dr2 = 0.0;
-  const double sag = fit_->front_sag(x_mm * x_mm + y_mm * y_mm, &dz_dr2).value_or(0.0);
-  return patch_solid_angle(point, z_perspective_mm, x_mm, y_mm, sag, 2.0 * x_mm * dz_dr2, 2.0 * y_mm * dz_dr2);
+  double dz_dx = 0.0, dz_dy = 0.0;
+  const double sag = fit_->front_sag(x_mm, y_mm, dz_dx, dz_dy).value_or(0.0);
+  return patch_solid_angle(point, z_perspective_mm, x_mm, y_mm, sag, dz_dx, dz_dy);
 }
 
 void PolyModel::map(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,

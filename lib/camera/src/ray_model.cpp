@@ -1,5 +1,6 @@
 #include "lensmith/camera/ray_model.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "lensmith/core/errors.h"
@@ -88,7 +89,17 @@ std::unique_ptr<RayModel> make_ray_model(RayModelKind kind, const Camera& camera
     throw OptionsError("the " + std::string(to_string(kind)) + " model needs a lens prescription, not a thin lens");
   }
   if (kind == RayModelKind::Exact) return std::make_unique<camera_detail::ExactModel>(camera);
-  if (camera.exact_model_only()) {
+  if (kind == RayModelKind::Poly) {
+    // A fit takes anamorphic lenses too (their maps in the component form); what it cannot fit is
+    // refused with its reason.
+    const Prescription& lens = *camera.lens();
+    if (const auto why = LensFit::why_not_fittable(lens)) {
+      throw OptionsError("the poly model cannot fit this lens: " + *why + ": use the exact model (--model exact)");
+    }
+    const bool obscured = std::any_of(lens.surfaces.begin(), lens.surfaces.end(),
+                                      [](const Surface& s) { return s.aperture && s.aperture->obscuration; });
+    if (obscured) throw OptionsError("the poly model does not clip at a central obscuration (not implemented): use the exact model (--model exact)");
+  } else if (camera.exact_model_only()) {
     throw OptionsError("the " + std::string(to_string(kind)) + " model assumes a rotationally symmetric refracting lens with a round "
                        "aperture, and this one is not (" + *camera.exact_model_only() + "): use the exact model (--model exact)");
   }

@@ -1,5 +1,6 @@
 // The two steps every fit of this library shares, on any family of basis functions: greedy
-// selection of columns (simultaneous orthogonal matching pursuit) and the coefficient solve by Ceres.
+// selection of columns (simultaneous orthogonal matching pursuit) and the coefficient solve (a
+// rank-revealing QR; Ceres for a robust loss).
 // Private to lib/polyfit.
 #pragma once
 
@@ -25,9 +26,16 @@ std::vector<std::size_t> select_columns(std::size_t pool_size, const ColumnFunct
                                         const std::vector<std::vector<double>>& targets, const FitOptions& options,
                                         std::vector<std::vector<double>>& selection_rms);
 
-// Least squares design * c ~ targets by Ceres (dense QR), design row-major (rows x num_terms), in place
-// from the current coefficients; with `loss` (e.g. Huber) one residual block per row. Returns the
-// iterations. Throws FitError when Ceres fails.
+// Least squares design * c ~ targets[o] for every target at once (design row-major, rows x num_terms), by
+// Eigen's column-pivoting Householder QR: rank-revealing, so nearly dependent columns (high-degree terms
+// of a dense fit) get no wild coefficients, and one factorisation serves every output. Throws FitError
+// when the solution is not finite.
+std::vector<std::vector<double>> solve_least_squares(const std::vector<double>& design, int num_terms,
+                                                     const std::vector<std::vector<double>>& targets);
+
+// Least squares design * c ~ targets: without `loss`, solve_least_squares (returns 1); with `loss` (e.g.
+// Huber) by Ceres (dense QR, one residual block per row), in place from the current coefficients,
+// returning its iterations. Throws FitError when Ceres fails.
 int solve_coefficients(const std::vector<double>& design, const std::vector<double>& targets, int num_terms,
                        ceres::LossFunction* loss, std::vector<double>& coefficients);
 

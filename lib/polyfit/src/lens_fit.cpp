@@ -26,11 +26,56 @@ namespace {
 // Samples the greedy term selection scores candidates on (the coefficients use every sample): 20000
 // random rays tell terms apart as well as all of them do, at a fraction of the time.
 constexpr int kSelectionSamples = 20000;
+// Terms of the component form per term of the invariant form in the automatic budget: measured on
+// lentil's Schneider anamorphic (docs/polyfit.md, "Anamorphic lenses").
+constexpr int kComponentTermsPerInvariant = 3;
 
 }  // namespace
 
-int LensFit::automatic_term_budget(std::size_t surfaces) {
-  return std::clamp(5 * static_cast<int>(surfaces) - 12, 12, 40);
+std::string_view to_string(LensSymmetry symmetry) {
+  switch (symmetry) {
+    case LensSymmetry::kRotational: return "rotational";
+    case LensSymmetry::kSectionMirrors: return "section mirrors";
+  }
+  return "unknown";
+}
+
+std::optional<std::string> LensFit::why_not_fittable(const Prescription& lens) {
+  if (const int mirrors = lens.mirror_count(); mirrors > 0) {
+    return "it has " + std::to_string(mirrors) + " mirror" + (mirrors == 1 ? "" : "s") +
+           " (a fit of a reflecting system is not implemented)";
+  }
+  if (!lens.is_coaxial()) {
+    return *lens.why_not_rotationally_symmetric() + " (a fit of tilted or decentred elements is not implemented)";
+  }
+  if (!lens.surfaces.empty() && lens.surfaces.front().is_coordinate_break()) {
+    return std::string("surface 1 is a coordinate break: the fit takes its outer pupil on the front surface");
+  }
+  return std::nullopt;
+}
+
+LensSymmetry LensFit::symmetry_of(const Prescription& lens) {
+  // Coaxial standard, toroidal and biconic surfaces: each is even in x and in y (Surface::sag_and_slope),
+  // so the lens keeps both section mirrors when it is not rotationally symmetric.
+  return lens.is_rotationally_symmetric() ? LensSymmetry::kRotational : LensSymmetry::kSectionMirrors;
+}
+
+void LensFit::set_front_surface(const FrontSurface& front) {
+  front_ = front;
+  front_shape_ = Surface{};
+  front_shape_.kind = front.kind;
+  front_shape_.curvature_per_mm = front.curvature_per_mm;
+  front_shape_.conic = front.conic;
+  front_shape_.even_asphere = front.even_asphere;
+  front_shape_.curvature_x_per_mm = front.curvature_x_per_mm;
+  front_shape_.conic_x = front.conic_x;
+}
+
+int LensFit::automatic_term_budget(std::size_t surfaces, LensSymmetry symmetry) {
+  const int rotational = std::clamp(5 * static_cast<int>(surfaces) - 12, 12, 40);
+  // The component form spends a term per monomial per component where one invariant term stood for
+  // several (x^3 and x y^2, the x and the y output): kComponentTermsPerInvariant times the budget.
+  return symmetry == LensSymmetry::kRotational ? rotational : kComponentTermsPerInvariant * rotational;
 }
 
 void LensFitOptions::validate() const {
@@ -110,6 +155,7 @@ std::string FitAim::to_string() const {
 LensFit LensFit::fit(const Prescription& lens, const LensFitOptions& options,
                      const std::function<void(double)>& progress) {
   options.validate();
+  if (const auto why = why_not_fittable(lens)) throw FitError("lens fit of '" + lens.name + "': " + *why);
   const auto start_time = std::chrono::steady_clock::now();
   const RaySampler sampler(lens, options);
   const ParaxialSystem& paraxial = sampler.paraxial();
@@ -126,8 +172,15 @@ LensFit LensFit::fit(const Prescription& lens, const LensFitOptions& options,
   fit.pupils_.entrance_per_stop = ep.magnification;
   fit.pupils_.z_exit_pupil_mm = xp.z_mm;
   fit.pupils_.exit_per_stop = xp.magnification;
+  fit.symmetry_ = symmetry_of(lens);
+  fit.pupils_x_ = fit.pupils_;
+  if (const ParaxialSystem* x = sampler.paraxial_x()) {
+    fit.pupils_x_ = Pupils{x->entrance_pupil().z_mm, x->entrance_pupil().magnification, x->exit_pupil().z_mm,
+                           x->exit_pupil().magnification};
+  }
   const Surface& front = lens.surfaces.front();
-  fit.front_ = FrontSurface{front.curvature_per_mm, front.conic, front.even_asphere};
+  fit.set_front_surface(FrontSurface{front.kind, front.curvature_per_mm, front.conic, front.even_asphere,
+                                     front.curvature_x_per_mm, front.conic_x});
 
   // Training rays: the sampled beam within the enlarged clear apertures. Test rays: another stream.
   const std::size_t n_train = static_cast<std::size_t>(options.training_rays);
@@ -158,8 +211,7 @@ LensFit LensFit::fit(const Prescription& lens, const LensFitOptions& options,
   s.wavelength_centre_nm = 0.5 * (options.min_wavelength_nm + options.max_wavelength_nm);
   s.wavelength_half_range_nm = 0.5 * (options.max_wavelength_nm - options.min_wavelength_nm);
 
-  // Each training ray counts twice: as itself for the x outputs and mirrored in x = y for the y
-  // outputs, which the same polynomial must give (lens_fit.h).
+  // Every training ray as the maps' inputs (normalised) and targets.
   const std::size_t clip_count = fit.clip_.size();
   std::vector<PolyPoint> sensor_in, outer_in;
   std::vector<std::vector<std::array<double, 2>>> to_outer(2), to_sensor(2), clip(clip_count);
@@ -180,20 +232,27 @@ LensFit LensFit::fit(const Prescription& lens, const LensFitOptions& options,
   }
   FitOptions fo;
   fo.max_degree = options.degree;
-  fit.term_budget_ = options.terms > 0 ? options.terms : automatic_term_budget(lens.surfaces.size());
+  fit.term_budget_ = options.terms > 0 ? options.terms : automatic_term_budget(lens.surfaces.size(), fit.symmetry_);
   fo.max_terms = fit.term_budget_;
   fo.max_selection_samples = kSelectionSamples;
-  const std::vector<InvariantTerm> pool = vector_invariant_terms(options.degree);
-  fit.sensor_to_outer_ = fit_rotational_map(sensor_in, to_outer, pool, fo).map;
+  // One fit of each map in the form the lens's symmetry calls for.
+  auto fit_vector = [&](const std::vector<PolyPoint>& in, const std::vector<std::vector<std::array<double, 2>>>& targets) {
+    if (fit.symmetry_ == LensSymmetry::kRotational) return FittedMap(fit_rotational_map(in, targets, vector_invariant_terms(options.degree), fo).map);
+    return FittedMap(fit_component_map(in, targets, vector_component_terms(options.degree), fo).map);
+  };
+  fit.sensor_to_outer_ = fit_vector(sensor_in, to_outer);
   if (progress) progress(0.5);
-  fit.outer_to_sensor_ = fit_rotational_map(outer_in, to_sensor, pool, fo).map;
+  fit.outer_to_sensor_ = fit_vector(outer_in, to_sensor);
   if (progress) progress(0.65);
-  fit.sensor_clip_ = fit_rotational_map(sensor_in, clip, pool, fo).map;
+  fit.sensor_clip_ = fit_vector(sensor_in, clip);
   if (progress) progress(0.8);
-  fit.outer_clip_ = fit_rotational_map(outer_in, clip, pool, fo).map;
+  fit.outer_clip_ = fit_vector(outer_in, clip);
   if (progress) progress(0.9);
-  fit.transmittance_ =
-      fit_rotational_scalar_map(sensor_in, transmittance_target, scalar_invariant_terms(options.degree), fo).map;
+  if (fit.symmetry_ == LensSymmetry::kRotational) {
+    fit.transmittance_ = fit_rotational_scalar_map(sensor_in, transmittance_target, scalar_invariant_terms(options.degree), fo).map;
+  } else {
+    fit.transmittance_ = fit_component_scalar_map(sensor_in, transmittance_target, scalar_component_terms(options.degree), fo).map;
+  }
   fit.timing_.fit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
 
   fit.errors_ = polyfit_detail::held_out_errors(fit, test, sampler.stop_surface());
@@ -201,7 +260,7 @@ LensFit LensFit::fit(const Prescription& lens, const LensFitOptions& options,
   return fit;
 }
 
-FitTrace LensFit::evaluate(const RotationalMap& map, const RotationalMap& clip, double position_scale,
+FitTrace LensFit::evaluate(const FittedMap& map, const FittedMap& clip, double position_scale,
                            double direction_scale, const PlaneRay& in, double wavelength_nm,
                            std::optional<double> stop_radius_mm) const {
   const double lambda = normalised_wavelength(wavelength_nm);
@@ -259,7 +318,7 @@ void LensFit::outer_rays(std::span<const double> x_mm, std::span<const double> y
 std::string LensFit::to_string() const {
   std::ostringstream os;
   os << "LensFit{lens=\"" << lens_name_ << "\", hash=" << lens_hash_ << ", degree=" << options_.degree
-     << ", terms=" << term_budget_ << ", sensor_to_outer=" << sensor_to_outer_ << ", outer_to_sensor="
+     << ", terms=" << term_budget_ << ", symmetry=" << lensmith::to_string(symmetry_) << ", sensor_to_outer=" << sensor_to_outer_ << ", outer_to_sensor="
      << outer_to_sensor_ << ", clip_surfaces=" << clip_.size() << ", " << errors_.to_string() << "}";
   return os.str();
 }

@@ -6,7 +6,6 @@
 #include "lens_fit_stages.h"
 #include "lensmith/core/number_parsing.h"
 #include "lensmith/core/root_solver_2d.h"
-#include "lensmith/prescription/conic_profile.h"
 
 namespace lensmith {
 
@@ -54,14 +53,17 @@ FitAim LensFit::aim_from_sensor(double x_mm, double y_mm, double stop_x_mm, doub
   options.validate();
   const double lambda = normalised_wavelength(wavelength_nm);
   const double ps = scales_.sensor_position_mm, ds = scales_.sensor_direction;
-  // First guess: toward the paraxial exit-pupil image of the stop point.
-  const double px = stop_x_mm * pupils_.exit_per_stop, py = stop_y_mm * pupils_.exit_per_stop;
-  double fx = x_mm - px, fy = y_mm - py, fz = sensor_z_mm_ - pupils_.z_exit_pupil_mm;
-  if (fz < 0.0) fx = -fx, fy = -fy, fz = -fz;
-  const double norm = std::sqrt(fx * fx + fy * fy + fz * fz);
+  // First guess: toward the paraxial exit-pupil image of the stop point, each section's in its own
+  // coordinate (the same pupil for a rotationally symmetric lens).
+  auto slope = [&](double at_mm, double stop_mm, const Pupils& p) {
+    const double dz = sensor_z_mm_ - p.z_exit_pupil_mm;
+    return dz == 0.0 ? 0.0 : (at_mm - stop_mm * p.exit_per_stop) / dz;
+  };
+  const double tx = slope(x_mm, stop_x_mm, pupils_x_), ty = slope(y_mm, stop_y_mm, pupils_);
+  const double norm = std::sqrt(tx * tx + ty * ty + 1.0);
   FitAim aim;
-  aim.ray = PlaneRay{x_mm, y_mm, fx / norm, fy / norm};
-  const RotationalMap& map = sensor_clip_;
+  aim.ray = PlaneRay{x_mm, y_mm, tx / norm, ty / norm};
+  const FittedMap& map = sensor_clip_;
   std::array<double, 2> at;
   std::array<double, 8> jac;
   auto residual = [&](const std::array<double, 2>& u, std::array<double, 2>& miss, std::array<double, 4>* j) {
@@ -84,11 +86,15 @@ FitAim LensFit::aim_from_sensor(double x_mm, double y_mm, double stop_x_mm, doub
 
 std::array<double, 2> LensFit::paraxial_outer_position(const ObjectPoint& o, double stop_x_mm, double stop_y_mm) const {
   const double w = o.inverse_depth_per_mm;
-  const double ex = stop_x_mm * pupils_.entrance_per_stop, ey = stop_y_mm * pupils_.entrance_per_stop;
-  const double ze = pupils_.z_entrance_pupil_mm;
-  // w times the vector from the object point to the entrance-pupil point (finite at w = 0).
-  const double ux = w * ex - o.tan_x, uy = w * ey - o.tan_y, uz = 1.0 + w * (ze - o.origin_z_mm);
-  return {ex - ux / uz * ze, ey - uy / uz * ze};
+  // Each section's coordinate through its own entrance pupil (an anamorphic front group puts the x
+  // section's far from the y section's; the same pupil for a rotationally symmetric lens).
+  auto at_vertex_plane = [&](double stop_mm, double tan, const Pupils& p) {
+    const double e = stop_mm * p.entrance_per_stop, ze = p.z_entrance_pupil_mm;
+    // w times the vector from the object point to the entrance-pupil point (finite at w = 0).
+    const double u = w * e - tan, uz = 1.0 + w * (ze - o.origin_z_mm);
+    return e - u / uz * ze;
+  };
+  return {at_vertex_plane(stop_x_mm, o.tan_x, pupils_x_), at_vertex_plane(stop_y_mm, o.tan_y, pupils_)};
 }
 
 FitAim LensFit::aim_from_object(const ObjectPoint& o, double stop_x_mm, double stop_y_mm, double wavelength_nm,
@@ -97,7 +103,7 @@ FitAim LensFit::aim_from_object(const ObjectPoint& o, double stop_x_mm, double s
   const double lambda = normalised_wavelength(wavelength_nm);
   const double ps = scales_.outer_position_mm, ds = scales_.outer_direction;
   const std::array<double, 2> start = guess ? *guess : paraxial_outer_position(o, stop_x_mm, stop_y_mm);
-  const RotationalMap& map = outer_clip_;
+  const FittedMap& map = outer_clip_;
   std::array<double, 2> at;
   std::array<double, 8> jac;
   auto residual = [&](const std::array<double, 2>& u, std::array<double, 2>& miss, std::array<double, 4>* j) {
@@ -131,19 +137,15 @@ FitAim LensFit::aim_from_object(const ObjectPoint& o, double stop_x_mm, double s
   return aim;
 }
 
-std::optional<double> LensFit::front_sag(double r2, double* dz_dr2) const {
-  double z = 0.0, slope = 0.0;
-  if (!conic_profile(front_.curvature_per_mm, 1.0 + front_.conic, front_.even_asphere.data(),
-                     static_cast<int>(front_.even_asphere.size()), r2, z, slope)) {
-    return std::nullopt;
-  }
-  if (dz_dr2) *dz_dr2 = slope;
+std::optional<double> LensFit::front_sag(double x_mm, double y_mm, double& dz_dx, double& dz_dy) const {
+  double z = 0.0;
+  if (!front_shape_.sag_and_slope(x_mm, y_mm, z, dz_dx, dz_dy)) return std::nullopt;
   return z;
 }
 
 std::optional<LensFit::OuterLine> LensFit::outer_line(const ObjectPoint& o, double x, double y) const {
-  double dz_ds = 0.0;
-  const std::optional<double> z = front_sag(x * x + y * y, &dz_ds);
+  double zx = 0.0, zy = 0.0;
+  const std::optional<double> z = front_sag(x, y, zx, zy);
   if (!z) return std::nullopt;
   // w times the vector from the object point to the surface point (finite at w = 0).
   const double w = o.inverse_depth_per_mm;
@@ -152,7 +154,6 @@ std::optional<LensFit::OuterLine> LensFit::outer_line(const ObjectPoint& o, doub
   const double len = std::sqrt(ux * ux + uy * uy + uz * uz);
   const double fx = ux / len, fy = uy / len, fz = uz / len;
   // d(w u) / dx = (w, 0, w dz/dx), d(w u) / dy = (0, w, w dz/dy); d f = (g - f (f.g)) / |w u|.
-  const double zx = 2.0 * x * dz_ds, zy = 2.0 * y * dz_ds;
   const double fgx = w * (fx + fz * zx), fgy = w * (fy + fz * zy);
   return OuterLine{PlaneRay{x, y, fx, fy}, (w - fx * fgx) / len, (0.0 - fy * fgx) / len, (0.0 - fx * fgy) / len,
                    (w - fy * fgy) / len};

@@ -19,22 +19,48 @@ namespace {
 using nlohmann::json;
 
 constexpr const char* kFormat = "lensmith-fit";
-constexpr int kVersion = 1;
+// Version 1: rotationally symmetric lenses (invariant terms). Version 2 adds the symmetry, the x
+// section's pupils, the front surface's kind and component terms (anamorphic lenses); a rotational fit
+// is still written as version 1, so that earlier lensmith reads it.
+constexpr int kVersionRotational = 1;
+constexpr int kVersionSections = 2;
 
 constexpr std::array<const char*, 3> kFactorNames{"p", "d", "1"};
+constexpr std::array<const char*, 3> kComponentNames{"x", "y", "1"};
 
-json map_to_json(const RotationalMap& map, const std::vector<std::string>& outputs) {
+json map_to_json(const FittedMap& fitted, const std::vector<std::string>& outputs) {
   json terms = json::array(), coefficients = json::array();
-  for (std::size_t t = 0; t < map.size(); ++t) {
-    json e = json::array();
-    for (const auto x : map.terms()[t].exponents) e.push_back(static_cast<int>(x));
-    e.push_back(kFactorNames[static_cast<std::size_t>(map.terms()[t].factor)]);
-    terms.push_back(e);
-    json c = json::array();
-    for (int k = 0; k < map.outputs(); ++k) c.push_back(map.coefficient(t, k));
-    coefficients.push_back(c);
+  auto add = [&](const auto& map, auto term_json) {
+    for (std::size_t t = 0; t < map.size(); ++t) {
+      terms.push_back(term_json(map.terms()[t]));
+      json c = json::array();
+      for (int k = 0; k < map.outputs(); ++k) c.push_back(map.coefficient(t, k));
+      coefficients.push_back(c);
+    }
+  };
+  if (fitted.is_rotational()) {
+    add(fitted.rotational(), [](const InvariantTerm& term) {
+      json e = json::array();
+      for (const auto x : term.exponents) e.push_back(static_cast<int>(x));
+      e.push_back(kFactorNames[static_cast<std::size_t>(term.factor)]);
+      return e;
+    });
+  } else {
+    add(fitted.component(), [](const ComponentTerm& term) {
+      json e = json::array();
+      for (const auto x : term.monomial.exponents) e.push_back(static_cast<int>(x));
+      e.push_back(kComponentNames[static_cast<std::size_t>(term.component)]);
+      return e;
+    });
   }
   return json{{"outputs", outputs}, {"terms", terms}, {"coefficients", coefficients}};
+}
+
+json pupils_to_json(const LensFit::Pupils& p) {
+  return {{"z_entrance_pupil_mm", p.z_entrance_pupil_mm},
+          {"entrance_per_stop", p.entrance_per_stop},
+          {"z_exit_pupil_mm", p.z_exit_pupil_mm},
+          {"exit_per_stop", p.exit_per_stop}};
 }
 
 std::vector<std::string> clip_names(const std::vector<ClipSurface>& clip) {
@@ -84,7 +110,9 @@ class FitReader {
     return JsonObjectReader(doc_, parent.child_pointer(key), parent.child_path(key));
   }
 
-  RotationalMap map(JsonObjectReader& parent, const std::string& key, int outputs, bool vector) const {
+  // A map's terms: invariant ([u, v, w, lambda exponents, factor]) for a rotational fit, component
+  // ([x, y, dx, dy, lambda exponents, component]) for a fit of section mirrors.
+  FittedMap map(JsonObjectReader& parent, const std::string& key, int outputs, bool vector, bool rotational) const {
     JsonObjectReader r = object(parent, key);
     const std::size_t names = r.get_array_size("outputs");
     if (names != static_cast<std::size_t>(outputs)) {
@@ -95,35 +123,57 @@ class FitReader {
     if (r.get_array_size("coefficients") != count) {
       r.fail("coefficients", "expected one row per term (" + std::to_string(count) + ")");
     }
-    std::vector<InvariantTerm> terms(count);
+    const std::size_t exponents = rotational ? 4 : kPolyVariables;
+    const std::string shape = rotational ? std::string("[u, v, w, lambda exponents, factor ") + (vector ? "\"p\" or \"d\"]" : "\"1\"]")
+                                         : std::string("[x, y, dx, dy, lambda exponents, component ") +
+                                               (vector ? "\"x\" or \"y\"]" : "\"1\"]");
+    std::vector<InvariantTerm> invariant_terms(rotational ? count : 0);
+    std::vector<ComponentTerm> component_terms(rotational ? 0 : count);
     std::vector<double> coefficients;
     for (std::size_t t = 0; t < count; ++t) {
       const std::string tp = r.child_pointer("terms") + "/" + std::to_string(t);
       const std::string tpath = r.child_path("terms") + "[" + std::to_string(t) + "]";
       const json& e = at(tp);
-      if (!e.is_array() || e.size() != 5) {
-        fail(tp, tpath, std::string("expected [u, v, w, lambda exponents, factor ") + (vector ? "\"p\" or \"d\"]" : "\"1\"]"));
-      }
+      if (!e.is_array() || e.size() != exponents + 1) fail(tp, tpath, "expected " + shape);
       int degree = 0;
-      for (int i = 0; i < 4; ++i) {
+      for (std::size_t i = 0; i < exponents; ++i) {
         const double v = number(tp + "/" + std::to_string(i), tpath + "[" + std::to_string(i) + "]");
         if (v != std::floor(v) || v < 0 || v > kMaxPolyDegree) {
           fail(tp + "/" + std::to_string(i), tpath, "an exponent must be a whole number in 0.." + std::to_string(kMaxPolyDegree));
         }
-        terms[t].exponents[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(v);
+        if (rotational) {
+          invariant_terms[t].exponents[i] = static_cast<std::uint8_t>(v);
+        } else {
+          component_terms[t].monomial.exponents[i] = static_cast<std::uint8_t>(v);
+        }
       }
-      const json& f = at(tp + "/4");
+      const std::string fp = tp + "/" + std::to_string(exponents);
+      const std::string fpath = tpath + "[" + std::to_string(exponents) + "]";
+      const json& f = at(fp);
       const std::string factor = f.is_string() ? f.get<std::string>() : std::string();
-      if (vector && factor == "p") {
-        terms[t].factor = RayFactor::kPosition;
-      } else if (vector && factor == "d") {
-        terms[t].factor = RayFactor::kDirection;
-      } else if (!vector && factor == "1") {
-        terms[t].factor = RayFactor::kOne;
+      if (rotational) {
+        if (vector && factor == "p") {
+          invariant_terms[t].factor = RayFactor::kPosition;
+        } else if (vector && factor == "d") {
+          invariant_terms[t].factor = RayFactor::kDirection;
+        } else if (!vector && factor == "1") {
+          invariant_terms[t].factor = RayFactor::kOne;
+        } else {
+          fail(fp, fpath, std::string("expected the factor ") + (vector ? "\"p\" or \"d\"" : "\"1\""));
+        }
+        degree = invariant_terms[t].total_degree();
       } else {
-        fail(tp + "/4", tpath + "[4]", std::string("expected the factor ") + (vector ? "\"p\" or \"d\"" : "\"1\""));
+        if (vector && factor == "x") {
+          component_terms[t].component = MapComponent::kX;
+        } else if (vector && factor == "y") {
+          component_terms[t].component = MapComponent::kY;
+        } else if (!vector && factor == "1") {
+          component_terms[t].component = MapComponent::kScalar;
+        } else {
+          fail(fp, fpath, std::string("expected the component ") + (vector ? "\"x\" or \"y\"" : "\"1\""));
+        }
+        degree = component_terms[t].total_degree();
       }
-      degree = terms[t].total_degree();
       if (degree > kMaxPolyDegree) fail(tp, tpath, "total degree above " + std::to_string(kMaxPolyDegree));
       const std::string cp = r.child_pointer("coefficients") + "/" + std::to_string(t);
       const std::string cpath = r.child_path("coefficients") + "[" + std::to_string(t) + "]";
@@ -137,10 +187,22 @@ class FitReader {
     }
     r.finish({"outputs", "terms", "coefficients"});
     try {
-      return RotationalMap(std::move(terms), outputs, std::move(coefficients));
+      if (rotational) return RotationalMap(std::move(invariant_terms), outputs, std::move(coefficients));
+      return ComponentMap(std::move(component_terms), outputs, std::move(coefficients));
     } catch (const FitError& e) {
       parent.fail(key, e.what());
     }
+  }
+
+  LensFit::Pupils pupils(JsonObjectReader& parent, const std::string& key) const {
+    JsonObjectReader p = object(parent, key);
+    LensFit::Pupils out;
+    out.z_entrance_pupil_mm = finite(p, "z_entrance_pupil_mm");
+    out.entrance_per_stop = finite(p, "entrance_per_stop");
+    out.z_exit_pupil_mm = finite(p, "z_exit_pupil_mm");
+    out.exit_per_stop = finite(p, "exit_per_stop");
+    p.finish({"z_entrance_pupil_mm", "entrance_per_stop", "z_exit_pupil_mm", "exit_per_stop"});
+    return out;
   }
 
  private:
@@ -151,8 +213,10 @@ class FitReader {
 
 std::string LensFit::to_json() const {
   json root;
+  const bool rotational = symmetry_ == LensSymmetry::kRotational;
   root["format"] = kFormat;
-  root["version"] = kVersion;
+  root["version"] = rotational ? kVersionRotational : kVersionSections;
+  if (!rotational) root["symmetry"] = std::string(lensmith::to_string(symmetry_));
   root["lens"] = {{"name", lens_name_}, {"prescription_hash", lens_hash_}};
   json options = {{"degree", options_.degree},
                   {"terms", options_.terms},
@@ -178,13 +242,16 @@ std::string LensFit::to_json() const {
                     {"outer_direction", scales_.outer_direction},
                     {"wavelength_centre_nm", scales_.wavelength_centre_nm},
                     {"wavelength_half_range_nm", scales_.wavelength_half_range_nm}};
-  root["pupils"] = {{"z_entrance_pupil_mm", pupils_.z_entrance_pupil_mm},
-                    {"entrance_per_stop", pupils_.entrance_per_stop},
-                    {"z_exit_pupil_mm", pupils_.z_exit_pupil_mm},
-                    {"exit_per_stop", pupils_.exit_per_stop}};
+  root["pupils"] = pupils_to_json(pupils_);
+  if (!rotational) root["pupils_x"] = pupils_to_json(pupils_x_);
   root["front_surface"] = {{"curvature_per_mm", front_.curvature_per_mm},
                            {"conic", front_.conic},
                            {"even_asphere", front_.even_asphere}};
+  if (!rotational) {
+    root["front_surface"]["kind"] = std::string(lensmith::to_string(front_.kind));
+    root["front_surface"]["curvature_x_per_mm"] = front_.curvature_x_per_mm;
+    root["front_surface"]["conic_x"] = front_.conic_x;
+  }
   root["maps"] = {
       {"sensor_to_outer", map_to_json(sensor_to_outer_, {"position on the outer plane, mm", "direction on the outer plane"})},
       {"sensor_to_clip", map_to_json(sensor_clip_, clip_names(clip_))},
@@ -220,10 +287,23 @@ LensFit LensFit::parse(std::string_view text, const std::string& file_name) {
   JsonObjectReader top(doc, "", "");
   if (top.get_string("format") != kFormat) top.fail("format", std::string("expected \"") + kFormat + "\"");
   const double version = top.get_number("version");
-  if (version != kVersion) {
-    top.fail("version", "this lensmith reads version " + std::to_string(kVersion) + " fit files");
+  if (version != kVersionRotational && version != kVersionSections) {
+    top.fail("version", "this lensmith reads version " + std::to_string(kVersionRotational) + " and " +
+                            std::to_string(kVersionSections) + " fit files");
   }
+  const bool sections = version == kVersionSections;
   LensFit fit;
+  if (sections) {
+    const std::string symmetry = top.get_string("symmetry");
+    if (symmetry == lensmith::to_string(LensSymmetry::kRotational)) {
+      fit.symmetry_ = LensSymmetry::kRotational;
+    } else if (symmetry == lensmith::to_string(LensSymmetry::kSectionMirrors)) {
+      fit.symmetry_ = LensSymmetry::kSectionMirrors;
+    } else {
+      top.fail("symmetry", "expected \"rotational\" or \"section mirrors\"");
+    }
+  }
+  const bool rotational = fit.symmetry_ == LensSymmetry::kRotational;
   {
     JsonObjectReader lens = in.object(top, "lens");
     fit.lens_name_ = lens.get_string("name");
@@ -280,34 +360,48 @@ LensFit LensFit::parse(std::string_view text, const std::string& file_name) {
     s.finish({"sensor_position_mm", "sensor_direction", "outer_position_mm", "outer_direction", "wavelength_centre_nm",
               "wavelength_half_range_nm"});
   }
-  {
-    JsonObjectReader p = in.object(top, "pupils");
-    fit.pupils_.z_entrance_pupil_mm = in.finite(p, "z_entrance_pupil_mm");
-    fit.pupils_.entrance_per_stop = in.finite(p, "entrance_per_stop");
-    fit.pupils_.z_exit_pupil_mm = in.finite(p, "z_exit_pupil_mm");
-    fit.pupils_.exit_per_stop = in.finite(p, "exit_per_stop");
-    p.finish({"z_entrance_pupil_mm", "entrance_per_stop", "z_exit_pupil_mm", "exit_per_stop"});
-  }
+  fit.pupils_ = in.pupils(top, "pupils");
+  fit.pupils_x_ = sections ? in.pupils(top, "pupils_x") : fit.pupils_;
   {
     JsonObjectReader f = in.object(top, "front_surface");
-    fit.front_.curvature_per_mm = in.finite(f, "curvature_per_mm");
-    fit.front_.conic = in.finite(f, "conic");
+    FrontSurface front;
+    front.curvature_per_mm = in.finite(f, "curvature_per_mm");
+    front.conic = in.finite(f, "conic");
     const std::size_t n = f.get_array_size("even_asphere");
-    if (n != fit.front_.even_asphere.size()) f.fail("even_asphere", "expected 8 coefficients (a2 .. a16)");
+    if (n != front.even_asphere.size()) f.fail("even_asphere", "expected 8 coefficients (a2 .. a16)");
     for (std::size_t i = 0; i < n; ++i) {
-      fit.front_.even_asphere[i] = in.number(f.child_pointer("even_asphere") + "/" + std::to_string(i),
-                                             f.child_path("even_asphere") + "[" + std::to_string(i) + "]");
+      front.even_asphere[i] = in.number(f.child_pointer("even_asphere") + "/" + std::to_string(i),
+                                        f.child_path("even_asphere") + "[" + std::to_string(i) + "]");
     }
-    f.finish({"curvature_per_mm", "conic", "even_asphere"});
+    if (sections) {
+      const std::string kind = f.get_string("kind");
+      if (kind == lensmith::to_string(SurfaceKind::Standard)) {
+        front.kind = SurfaceKind::Standard;
+      } else if (kind == lensmith::to_string(SurfaceKind::Toroidal)) {
+        front.kind = SurfaceKind::Toroidal;
+      } else if (kind == lensmith::to_string(SurfaceKind::Biconic)) {
+        front.kind = SurfaceKind::Biconic;
+      } else {
+        f.fail("kind", "expected \"standard\", \"toroidal\" or \"biconic\"");
+      }
+      front.curvature_x_per_mm = in.finite(f, "curvature_x_per_mm");
+      front.conic_x = in.finite(f, "conic_x");
+    }
+    if (sections) {
+      f.finish({"curvature_per_mm", "conic", "even_asphere", "kind", "curvature_x_per_mm", "conic_x"});
+    } else {
+      f.finish({"curvature_per_mm", "conic", "even_asphere"});
+    }
+    fit.set_front_surface(front);
   }
   {
     JsonObjectReader m = in.object(top, "maps");
     const int clip_outputs = static_cast<int>(clips);
-    fit.sensor_to_outer_ = in.map(m, "sensor_to_outer", 2, true);
-    fit.sensor_clip_ = in.map(m, "sensor_to_clip", clip_outputs, true);
-    fit.outer_to_sensor_ = in.map(m, "outer_to_sensor", 2, true);
-    fit.outer_clip_ = in.map(m, "outer_to_clip", clip_outputs, true);
-    fit.transmittance_ = in.map(m, "transmittance", 1, false);
+    fit.sensor_to_outer_ = in.map(m, "sensor_to_outer", 2, true, rotational);
+    fit.sensor_clip_ = in.map(m, "sensor_to_clip", clip_outputs, true, rotational);
+    fit.outer_to_sensor_ = in.map(m, "outer_to_sensor", 2, true, rotational);
+    fit.outer_clip_ = in.map(m, "outer_to_clip", clip_outputs, true, rotational);
+    fit.transmittance_ = in.map(m, "transmittance", 1, false, rotational);
     m.finish({"sensor_to_outer", "sensor_to_clip", "outer_to_sensor", "outer_to_clip", "transmittance"});
   }
   {
@@ -334,8 +428,10 @@ LensFit LensFit::parse(std::string_view text, const std::string& file_name) {
     fit.timing_.poly_ns_per_ray = in.finite(t, "poly_ns_per_ray");
     t.finish({"fit_seconds", "exact_ns_per_ray", "poly_ns_per_ray"});
   }
-  top.finish({"format", "version", "lens", "options", "sensor_plane_z_mm", "image_radius_mm", "clip_surfaces", "scales",
-              "pupils", "front_surface", "maps", "test_errors", "timing"});
+  std::vector<std::string> keys{"format", "version", "lens", "options", "sensor_plane_z_mm", "image_radius_mm", "clip_surfaces",
+                                "scales", "pupils", "front_surface", "maps", "test_errors", "timing"};
+  if (sections) keys.insert(keys.end(), {"symmetry", "pupils_x"});
+  top.finish(keys);
   return fit;
 }
 

@@ -27,6 +27,13 @@ std::string LensFit::prescription_hash(const Prescription& lens) {
     mix(s.conic);
     for (const double a : s.even_asphere) mix(a);
     mix(static_cast<int>(k + 1) == stop ? -1.0 : s.semi_diameter_mm.value_or(kInfinity));
+    // The other shapes' x section (not mixed for a standard surface: the hashes of fits made before
+    // toroids could be fitted stay valid).
+    if (s.kind != SurfaceKind::Standard) {
+      mix(static_cast<double>(static_cast<int>(s.kind)));
+      mix(s.curvature_x_per_mm);
+      mix(s.conic_x);
+    }
     for (const double nm : {380.0, kWavelengthD_nm, 780.0}) mix(s.medium.index(nm));
   }
   char text[17];

@@ -38,7 +38,19 @@ RaySampler::RaySampler(const Prescription& lens, const LensFitOptions& options)
   if (options.f_number) {
     stop_radius_mm_ = std::max(stop_radius_mm_, stop_opened_to_f_number(lens, *options.f_number).semi_diameter_mm);
   }
-  sampled_pupil_radius_mm_ = options.pupil_margin * std::abs(paraxial_.exit_pupil().magnification) * stop_radius_mm_;
+  double pupil_radius_mm = std::abs(paraxial_.exit_pupil().magnification) * stop_radius_mm_;
+  if (!lens.is_rotationally_symmetric()) {
+    // The x section's exit pupil may lie elsewhere and be another size (a rear anamorphic group): the
+    // sampled disc on the y section's pupil plane also covers the cone from the axial image point
+    // through the x section's pupil.
+    ParaxialOptions x_section;
+    x_section.section = Section::X;
+    paraxial_x_.emplace(lens, x_section);
+    const Pupil& px = paraxial_x_->exit_pupil();
+    const double to_x = sensor_z_mm() - px.z_mm, to_y = sensor_z_mm() - paraxial_.exit_pupil().z_mm;
+    if (to_x != 0.0) pupil_radius_mm = std::max(pupil_radius_mm, std::abs(px.magnification) * stop_radius_mm_ * std::abs(to_y / to_x));
+  }
+  sampled_pupil_radius_mm_ = options.pupil_margin * pupil_radius_mm;
   for (std::size_t k = 0; k < lens.surfaces.size(); ++k) {
     semi_diameter_.push_back(k == stop_index ? stop_radius_mm_ : lens.surfaces[k].semi_diameter_mm.value_or(kInfinity));
   }

@@ -15,6 +15,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -68,6 +69,8 @@ class RaySampler {
 
   const SequentialTracer& tracer() const { return tracer_; }
   const ParaxialSystem& paraxial() const { return paraxial_; }
+  // The x section's first-order data of a lens that is not rotationally symmetric; null otherwise.
+  const ParaxialSystem* paraxial_x() const { return paraxial_x_ ? &*paraxial_x_ : nullptr; }
   double sensor_z_mm() const { return tracer_.image_plane_z_mm(); }
   double image_radius_mm() const { return image_radius_mm_; }
   int stop_surface() const { return paraxial_.stop_surface(); }  // 1-based
@@ -111,6 +114,7 @@ class RaySampler {
   LensFitOptions options_;
   SequentialTracer tracer_;
   ParaxialSystem paraxial_;
+  std::optional<ParaxialSystem> paraxial_x_;
   double image_radius_mm_ = 0.0;
   double stop_radius_mm_ = 0.0;
   double sampled_pupil_radius_mm_ = 0.0;

@@ -8,6 +8,8 @@
 
 #include <ceres/ceres.h>
 
+#include <Eigen/QR>
+
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -48,6 +50,9 @@ class PowerTable {
   std::vector<double> values_;
 };
 
+// Candidate column values select_columns keeps in memory (256 MiB of doubles).
+constexpr std::size_t kCachedColumnValues = std::size_t{32} << 20;
+
 double dot(const std::vector<double>& a, const std::vector<double>& b) {
   double s = 0.0;
   for (std::size_t i = 0; i < a.size(); ++i) s += a[i] * b[i];
@@ -67,7 +72,15 @@ std::vector<std::size_t> select_columns(std::size_t p, const ColumnFunction& col
                                         std::vector<std::vector<double>>& selection_rms) {
   const std::size_t n = targets.front().size();
   const std::size_t outputs = targets.size();
+  // Candidate columns are kept when they fit in kCachedColumnValues doubles (formed once, not once per
+  // step: an anamorphic fit's 420 candidates took 10 s a map to re-form); else formed when scored.
+  const bool cached = p * n <= kCachedColumnValues;
+  std::vector<double> cache(cached ? p * n : 0);
   std::vector<double> norm2(p), outside2(p), gain(p);
+  // corr[j * outputs + k] = <column j, residual k>, updated as the residuals lose each chosen direction
+  // (r_k -= <q, r_k> q changes it by -<q, r_k> <column j, q>): one dot per candidate and step, whatever
+  // the number of outputs.
+  std::vector<double> corr(p * outputs);
   std::vector<char> candidate(p);
 #pragma omp parallel
   {
@@ -75,8 +88,10 @@ std::vector<std::size_t> select_columns(std::size_t p, const ColumnFunction& col
 #pragma omp for schedule(static)
     for (std::size_t j = 0; j < p; ++j) {
       column_of(j, column);
+      if (cached) std::copy(column.begin(), column.end(), cache.begin() + static_cast<std::ptrdiff_t>(j * n));
       norm2[j] = outside2[j] = dot(column, column);
       candidate[j] = norm2[j] > 0.0;
+      for (std::size_t k = 0; k < outputs; ++k) corr[j * outputs + k] = dot(column, targets[k]);
     }
   }
   std::vector<std::vector<double>> r = targets;
@@ -86,6 +101,7 @@ std::vector<std::size_t> select_columns(std::size_t p, const ColumnFunction& col
   std::vector<std::vector<double>> basis;
   std::vector<std::size_t> chosen;
   std::vector<double> weight(outputs);
+  std::vector<double> last_projection(outputs);  // <q, r_k> of the last chosen direction q, before r_k lost it
   while (chosen.size() < static_cast<std::size_t>(options.max_terms)) {
     bool explained = true;
     for (std::size_t k = 0; k < outputs; ++k) {
@@ -97,26 +113,27 @@ std::vector<std::size_t> select_columns(std::size_t p, const ColumnFunction& col
     if (explained) break;
 #pragma omp parallel
     {
-      std::vector<double> column(n);
+      std::vector<double> formed(cached ? 0 : n);
 #pragma omp for schedule(dynamic, 4)
       for (std::size_t j = 0; j < p; ++j) {
         gain[j] = 0.0;
         if (!candidate[j]) continue;
-        column_of(j, column);
+        double* cj = &corr[j * outputs];
         if (!basis.empty()) {
-          const double c = dot(column, basis.back());
+          const double* column = cached ? &cache[j * n] : formed.data();
+          if (!cached) column_of(j, formed);
+          const std::vector<double>& q = basis.back();
+          double c = 0.0;
+          for (std::size_t i = 0; i < n; ++i) c += column[i] * q[i];
           outside2[j] -= c * c;
+          for (std::size_t k = 0; k < outputs; ++k) cj[k] -= last_projection[k] * c;
           if (outside2[j] <= kDependentColumn * norm2[j]) {
             candidate[j] = false;
             continue;
           }
         }
         double g = 0.0;
-        for (std::size_t k = 0; k < outputs; ++k) {
-          if (weight[k] == 0.0) continue;
-          const double cr = dot(column, r[k]);
-          g += weight[k] * cr * cr;
-        }
+        for (std::size_t k = 0; k < outputs; ++k) g += weight[k] * cj[k] * cj[k];
         gain[j] = g / outside2[j];
       }
     }
@@ -132,7 +149,11 @@ std::vector<std::size_t> select_columns(std::size_t p, const ColumnFunction& col
     // Orthogonalise the chosen column twice against the basis (Gram-Schmidt, then once more for
     // the rounding of the first pass: "twice is enough", Giraud et al. 2005).
     std::vector<double> q(n);
-    column_of(best, q);
+    if (cached) {
+      std::copy(cache.begin() + static_cast<std::ptrdiff_t>(best * n), cache.begin() + static_cast<std::ptrdiff_t>((best + 1) * n), q.begin());
+    } else {
+      column_of(best, q);
+    }
     for (int pass = 0; pass < 2; ++pass) {
       for (const auto& b : basis) {
         const double c = dot(q, b);
@@ -143,6 +164,7 @@ std::vector<std::size_t> select_columns(std::size_t p, const ColumnFunction& col
     for (double& v : q) v /= qn;
     for (std::size_t k = 0; k < outputs; ++k) {
       const double cr = dot(q, r[k]);
+      last_projection[k] = cr;
       for (std::size_t i = 0; i < n; ++i) r[k][i] -= cr * q[i];
       selection_rms[k].push_back(std::sqrt(dot(r[k], r[k]) / static_cast<double>(n)));
     }
@@ -177,50 +199,40 @@ class SampleResidual final : public ceres::CostFunction {
   double target_;
 };
 
-// All samples as one block of residuals r_i = sum_j design[i][j] c[j] - target_i: without a robust
-// loss the residuals need no separate blocks, and one block lets Ceres fill its dense Jacobian with a
-// single copy of the design matrix instead of a virtual call per sample.
-class AllSamplesResidual final : public ceres::CostFunction {
- public:
-  AllSamplesResidual(const std::vector<double>& design, const std::vector<double>& targets, int num_terms)
-      : design_(design), targets_(targets), num_terms_(num_terms) {
-    set_num_residuals(static_cast<int>(targets.size()));
-    mutable_parameter_block_sizes()->push_back(num_terms);
-  }
-  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    const double* c = parameters[0];
-    const std::size_t k = static_cast<std::size_t>(num_terms_);
-    for (std::size_t i = 0; i < targets_.size(); ++i) {
-      const double* row = &design_[i * k];
-      double s = -targets_[i];
-      for (std::size_t j = 0; j < k; ++j) s += row[j] * c[j];
-      residuals[i] = s;
-    }
-    if (jacobians != nullptr && jacobians[0] != nullptr) std::copy(design_.begin(), design_.end(), jacobians[0]);
-    return true;
-  }
-
- private:
-  const std::vector<double>& design_;
-  const std::vector<double>& targets_;
-  int num_terms_;
-};
-
 }  // namespace
+
+std::vector<std::vector<double>> solve_least_squares(const std::vector<double>& design, int num_terms,
+                                                     const std::vector<std::vector<double>>& targets) {
+  const auto n = static_cast<Eigen::Index>(num_terms);
+  const auto rows = static_cast<Eigen::Index>(design.size()) / std::max<Eigen::Index>(n, 1);
+  const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> a(design.data(), rows, n);
+  Eigen::MatrixXd b(rows, static_cast<Eigen::Index>(targets.size()));
+  for (std::size_t o = 0; o < targets.size(); ++o) {
+    if (static_cast<Eigen::Index>(targets[o].size()) != rows) throw FitError("solve_least_squares: one target per design row needed");
+    b.col(static_cast<Eigen::Index>(o)) = Eigen::Map<const Eigen::VectorXd>(targets[o].data(), rows);
+  }
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(a);
+  const Eigen::MatrixXd c = qr.solve(b);
+  if (!c.allFinite()) throw FitError("solve_least_squares: the solution is not finite");
+  std::vector<std::vector<double>> out(targets.size(), std::vector<double>(static_cast<std::size_t>(n)));
+  for (std::size_t o = 0; o < targets.size(); ++o) {
+    for (Eigen::Index j = 0; j < n; ++j) out[o][static_cast<std::size_t>(j)] = c(j, static_cast<Eigen::Index>(o));
+  }
+  return out;
+}
 
 int solve_coefficients(const std::vector<double>& design, const std::vector<double>& targets, int num_terms,
                        ceres::LossFunction* loss, std::vector<double>& coefficients) {
+  if (loss == nullptr) {
+    coefficients = solve_least_squares(design, num_terms, {targets}).front();
+    return 1;
+  }
   ceres::Problem::Options problem_options;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
-  if (loss == nullptr) {
-    problem.AddResidualBlock(new AllSamplesResidual(design, targets, num_terms), nullptr, coefficients.data());
-  } else {
-    // A robust loss acts on each residual block's squared norm: one block per sample.
-    for (std::size_t i = 0; i < targets.size(); ++i) {
-      problem.AddResidualBlock(new SampleResidual(&design[i * num_terms], num_terms, targets[i]), loss,
-                               coefficients.data());
-    }
+  // A robust loss acts on each residual block's squared norm: one block per sample.
+  for (std::size_t i = 0; i < targets.size(); ++i) {
+    problem.AddResidualBlock(new SampleResidual(&design[i * num_terms], num_terms, targets[i]), loss, coefficients.data());
   }
   ceres::Solver::Options solver_options;
   solver_options.linear_solver_type = ceres::DENSE_QR;  // QR: the normal equations would square the condition number

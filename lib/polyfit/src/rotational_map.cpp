@@ -5,7 +5,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "least_squares.h"
+#include "map_fit.h"
 #include "lensmith/core/errors.h"
 
 namespace lensmith {
@@ -100,23 +100,7 @@ RotationalFitResult fit_rows(const std::vector<PolyPoint>& inputs, bool vector,
                              const FitOptions& options) {
   options.validate();
   const std::size_t rows_per_input = vector ? 2 : 1;
-  const std::size_t rows = inputs.size() * rows_per_input;
-  if (inputs.empty()) throw FitError("fit_rotational_map: no samples");
-  if (targets.empty() || targets.size() > static_cast<std::size_t>(kMaxMapOutputs)) {
-    throw FitError("fit_rotational_map: " + std::to_string(targets.size()) + " outputs: need 1.." +
-                   std::to_string(kMaxMapOutputs));
-  }
-  for (const auto& t : targets) {
-    if (t.size() != rows) throw FitError("fit_rotational_map: every output needs one target per input");
-    for (const double v : t) {
-      if (!std::isfinite(v)) throw FitError("fit_rotational_map: a target is not finite");
-    }
-  }
-  for (const PolyPoint& p : inputs) {
-    for (const double v : p) {
-      if (!std::isfinite(v)) throw FitError("fit_rotational_map: an input is not finite");
-    }
-  }
+  polyfit_detail::check_map_data("fit_rotational_map", inputs, rows_per_input, targets);
   std::vector<InvariantTerm> usable;
   for (const InvariantTerm& t : pool) {
     if (t.total_degree() > options.max_degree) continue;
@@ -130,58 +114,12 @@ RotationalFitResult fit_rows(const std::vector<PolyPoint>& inputs, bool vector,
   int degree = 0;
   for (const InvariantTerm& t : usable) degree = std::max(degree, t.total_degree());
   const InvariantTable table(inputs, inputs.size(), degree);
-
-  std::vector<InvariantTerm> terms;
-  if (usable.size() <= static_cast<std::size_t>(options.max_terms)) {
-    terms = usable;
-  } else {
-    std::size_t m = rows;
-    if (options.max_selection_samples > 0) {
-      m = std::min(rows, static_cast<std::size_t>(options.max_selection_samples) / rows_per_input * rows_per_input);
-      m = std::max(m, rows_per_input);
-    }
-    std::vector<std::vector<double>> subset;
-    for (const auto& t : targets) subset.emplace_back(t.begin(), t.begin() + static_cast<std::ptrdiff_t>(m));
-    std::vector<std::vector<double>> selection_rms;
-    const auto chosen = select_columns(
-        usable.size(),
-        [&](std::size_t j, std::vector<double>& column) {
-          for (std::size_t r = 0; r < column.size(); ++r) column[r] = basis_value(table, inputs, vector, r, usable[j]);
-        },
-        subset, options, selection_rms);
-    for (const std::size_t j : chosen) terms.push_back(usable[j]);
-  }
-
-  const std::size_t k = terms.size();
-  const std::size_t outputs = targets.size();
-  RotationalFitResult result;
-  std::vector<double> coefficients(k * outputs, 0.0);
-  if (k > 0) {
-    std::vector<double> design(rows * k);
-    for (std::size_t r = 0; r < rows; ++r) {
-      for (std::size_t j = 0; j < k; ++j) design[r * k + j] = basis_value(table, inputs, vector, r, terms[j]);
-    }
-    std::vector<double> c(k);
-    for (std::size_t o = 0; o < outputs; ++o) {
-      std::fill(c.begin(), c.end(), 0.0);
-      result.solver_iterations += solve_coefficients(design, targets[o], static_cast<int>(k), nullptr, c);
-      for (std::size_t j = 0; j < k; ++j) coefficients[j * outputs + o] = c[j];
-    }
-  }
-  result.map = RotationalMap(std::move(terms), static_cast<int>(outputs), std::move(coefficients));
-  result.train_rms.assign(outputs, 0.0);
-  std::vector<double> value(outputs * rows_per_input);
-  for (std::size_t i = 0; i < inputs.size(); ++i) {
-    result.map.evaluate(inputs[i], value);
-    for (std::size_t o = 0; o < outputs; ++o) {
-      for (std::size_t a = 0; a < rows_per_input; ++a) {
-        const double e = value[o * rows_per_input + a] - targets[o][i * rows_per_input + a];
-        result.train_rms[o] += e * e;
-      }
-    }
-  }
-  for (double& v : result.train_rms) v = std::sqrt(v / static_cast<double>(inputs.size()));
-  return result;
+  return polyfit_detail::fit_map_rows<RotationalFitResult>(
+      inputs, rows_per_input, targets, usable, options,
+      [&](std::size_t row, const InvariantTerm& t) { return basis_value(table, inputs, vector, row, t); },
+      [](std::vector<InvariantTerm> terms, int outputs, std::vector<double> coefficients) {
+        return RotationalMap(std::move(terms), outputs, std::move(coefficients));
+      });
 }
 
 }  // namespace
@@ -445,17 +383,7 @@ std::string RotationalMap::to_string() const {
 RotationalFitResult fit_rotational_map(const std::vector<PolyPoint>& inputs,
                                        const std::vector<std::vector<std::array<double, 2>>>& targets,
                                        const std::vector<InvariantTerm>& pool, const FitOptions& options) {
-  std::vector<std::vector<double>> rows;
-  for (const auto& t : targets) {
-    std::vector<double> r;
-    r.reserve(2 * t.size());
-    for (const auto& xy : t) {
-      r.push_back(xy[0]);
-      r.push_back(xy[1]);
-    }
-    rows.push_back(std::move(r));
-  }
-  return fit_rows(inputs, true, rows, pool, options);
+  return fit_rows(inputs, true, polyfit_detail::target_rows(targets), pool, options);
 }
 
 RotationalFitResult fit_rotational_scalar_map(const std::vector<PolyPoint>& inputs,

@@ -415,6 +415,7 @@ ojson fit_json(const LensFit& fit) {
   j["prescription_hash"] = fit.lens_hash();
   j["degree"] = fit.options().degree;
   j["terms"] = fit.term_budget();
+  j["symmetry"] = std::string(to_string(fit.symmetry()));
   j["terms_sensor_to_outer"] = fit.sensor_to_outer().size();
   j["terms_outer_to_sensor"] = fit.outer_to_sensor().size();
   j["clip_surfaces"] = ojson::array();

@@ -14,7 +14,9 @@
 // travel toward the image (+z), so the same four numbers describe the line whichever way it is traced.
 //
 // Maps, each a rotation-invariant polynomial (rotational_map.h: out = A p + B d with A, B polynomials
-// in |p|^2, p.d, |d|^2 and the wavelength) with its own greedily chosen term set:
+// in |p|^2, p.d, |d|^2 and the wavelength) or, for an anamorphic lens (cylinders, toroids, biconics on
+// one axis: symmetric only under its two section mirrors), each output component its own polynomial in
+// the monomials those mirrors allow (component_map.h), with its own greedily chosen term set:
 //   sensor -> outer:  position and direction on the outer pupil;
 //   sensor -> clip:   position on every clipping surface (the stop first), from the sensor ray;
 //   outer -> sensor:  position and direction on the sensor plane;
@@ -41,7 +43,7 @@
 #include <vector>
 
 #include "lensmith/polyfit/polynomial.h"
-#include "lensmith/polyfit/rotational_map.h"
+#include "lensmith/polyfit/fitted_map.h"
 #include "lensmith/prescription/prescription.h"
 
 namespace lensmith {
@@ -167,10 +169,22 @@ struct FitAim {
   friend std::ostream& operator<<(std::ostream& os, const FitAim& a) { return os << a.to_string(); }
 };
 
+// The symmetry a fit's maps are written for: rotational (the invariant form) or only the mirrors of the
+// x-z and y-z planes (an anamorphic lens; the component form).
+enum class LensSymmetry { kRotational, kSectionMirrors };
+std::string_view to_string(LensSymmetry symmetry);  // "rotational", "section mirrors"
+
 class LensFit {
  public:
-  // The automatic term budget for a lens of `surfaces` surfaces (LensFitOptions::terms = 0).
-  static int automatic_term_budget(std::size_t surfaces);
+  // Why `lens` cannot be fitted (empty: it can): mirrors, coordinate breaks (tilts, decentres) and
+  // explicit aperture shapes are not implemented; a lens that is not rotationally symmetric must keep the
+  // mirror symmetry of both sections (its toroids and biconics on the axis, their sections in x and y).
+  static std::optional<std::string> why_not_fittable(const Prescription& lens);
+  // The symmetry the maps of `lens` are written for (why_not_fittable must be empty).
+  static LensSymmetry symmetry_of(const Prescription& lens);
+  // The automatic term budget for a lens of `surfaces` surfaces (LensFitOptions::terms = 0); the
+  // component form of a lens without rotational symmetry gets three times the invariant form's.
+  static int automatic_term_budget(std::size_t surfaces, LensSymmetry symmetry = LensSymmetry::kRotational);
   // Traces training and test rays through `lens` (materials resolved) and fits every map. Reports
   // progress in [0, 1] when given. Throws OptionsError, FitError (too few rays pass the lens) and what
   // the tracer throws.
@@ -206,11 +220,12 @@ class LensFit {
   const std::vector<ClipSurface>& clip_surfaces() const { return clip_; }
   const LensFitErrors& errors() const { return errors_; }
   const LensFitTiming& timing() const { return timing_; }
-  const RotationalMap& sensor_to_outer() const { return sensor_to_outer_; }
-  const RotationalMap& sensor_to_clip() const { return sensor_clip_; }
-  const RotationalMap& outer_to_sensor() const { return outer_to_sensor_; }
-  const RotationalMap& outer_to_clip() const { return outer_clip_; }
-  const RotationalMap& transmittance_map() const { return transmittance_; }
+  LensSymmetry symmetry() const { return symmetry_; }
+  const FittedMap& sensor_to_outer() const { return sensor_to_outer_; }
+  const FittedMap& sensor_to_clip() const { return sensor_clip_; }
+  const FittedMap& outer_to_sensor() const { return outer_to_sensor_; }
+  const FittedMap& outer_to_clip() const { return outer_clip_; }
+  const FittedMap& transmittance_map() const { return transmittance_; }
 
   // Evaluation. `stop_radius_mm` is the stop's radius to clip at (a camera's f-number), at most the
   // fit's; empty: stop_radius_mm(). Thread-safe, allocation-free.
@@ -257,7 +272,9 @@ class LensFit {
     double wavelength_half_range_nm = 200.0;
     friend bool operator==(const Scales&, const Scales&) = default;
   };
-  // First-order data at the primary wavelength, for first guesses.
+  // First-order data at the primary wavelength, for first guesses: pupils() in the y section,
+  // pupils_x() in the x section (the same numbers for a rotationally symmetric lens; an anamorphic
+  // front group puts the x section's entrance pupil far from the y section's).
   struct Pupils {
     double z_entrance_pupil_mm = 0.0;
     double entrance_per_stop = 1.0;  // entrance-pupil radius over stop radius, signed (< 0: inverted image)
@@ -267,20 +284,26 @@ class LensFit {
   };
   const Scales& scales() const { return scales_; }
   const Pupils& pupils() const { return pupils_; }
-  // The shape of surface 1 (the outer pupil): z = sag(r) with the surface's conic and even asphere.
+  const Pupils& pupils_x() const { return pupils_x_; }
+  // The shape of surface 1 (the outer pupil), as in Surface: a standard conic with even asphere, or a
+  // toroid or biconic (y section: curvature, conic, asphere; x section: curvature_x_per_mm, conic_x).
   struct FrontSurface {
+    SurfaceKind kind = SurfaceKind::Standard;
     double curvature_per_mm = 0.0;
     double conic = 0.0;
     std::array<double, 8> even_asphere{};  // a2 .. a16 as in Surface
+    double curvature_x_per_mm = 0.0;
+    double conic_x = 0.0;
     friend bool operator==(const FrontSurface&, const FrontSurface&) = default;
   };
   const FrontSurface& front_surface() const { return front_; }
-  // Sag of the front surface at r^2 (mm^2): its z (mm, from its vertex) and optionally dz / d(r^2);
-  // empty beyond the conic's domain.
-  std::optional<double> front_sag(double r2, double* dz_dr2) const;
+  // Sag of the front surface at (x, y) (mm): its z (mm, from its vertex) and dz/dx, dz/dy; empty
+  // outside the shape's domain (Surface::sag_and_slope).
+  std::optional<double> front_sag(double x_mm, double y_mm, double& dz_dx, double& dz_dy) const;
 
  private:
   LensFit() = default;
+  void set_front_surface(const FrontSurface& front);  // front_ and front_shape_
   // outer_ray_from_object's ray with the derivatives of its direction in the surface point's x, y.
   struct OuterLine {
     PlaneRay ray;
@@ -290,7 +313,7 @@ class LensFit {
   double normalised_wavelength(double wavelength_nm) const {
     return (wavelength_nm - scales_.wavelength_centre_nm) / scales_.wavelength_half_range_nm;
   }
-  FitTrace evaluate(const RotationalMap& map, const RotationalMap& clip, double position_scale, double direction_scale,
+  FitTrace evaluate(const FittedMap& map, const FittedMap& clip, double position_scale, double direction_scale,
                     const PlaneRay& in, double wavelength_nm, std::optional<double> stop_radius_mm) const;
 
   std::string lens_name_;
@@ -302,12 +325,15 @@ class LensFit {
   std::vector<ClipSurface> clip_;
   Scales scales_;
   Pupils pupils_;
+  Pupils pupils_x_;
   FrontSurface front_;
-  RotationalMap sensor_to_outer_;  // outputs: position, direction on the outer pupil
-  RotationalMap sensor_clip_;      // outputs: position on each clip surface
-  RotationalMap outer_to_sensor_;  // outputs: position, direction on the sensor plane
-  RotationalMap outer_clip_;       // outputs: position on each clip surface
-  RotationalMap transmittance_;    // one scalar output
+  Surface front_shape_;  // front_ as a Surface, for its sag
+  LensSymmetry symmetry_ = LensSymmetry::kRotational;
+  FittedMap sensor_to_outer_;  // outputs: position, direction on the outer pupil
+  FittedMap sensor_clip_;      // outputs: position on each clip surface
+  FittedMap outer_to_sensor_;  // outputs: position, direction on the sensor plane
+  FittedMap outer_clip_;       // outputs: position on each clip surface
+  FittedMap transmittance_;    // one scalar output
   LensFitErrors errors_;
   LensFitTiming timing_;
 };

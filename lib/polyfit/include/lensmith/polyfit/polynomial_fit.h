@@ -1,5 +1,5 @@
 // Least-squares fit of a SparsePolynomial to samples, with greedy term selection (order-recursive
-// matching pursuit: Natarajan 1995; Rebollo-Neira & Lowe 2002) and coefficients solved by Ceres.
+// matching pursuit: Natarajan 1995; Rebollo-Neira & Lowe 2002) and coefficients by a rank-revealing QR (Ceres for a robust loss).
 // This is the fitting step of polynomial optics (Schrade, Hanika & Dachsbacher 2016, sec. 4).
 #pragma once
 

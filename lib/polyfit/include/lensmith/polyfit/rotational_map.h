@@ -105,7 +105,7 @@ struct RotationalFitResult {
 
 // Fits a vector map: targets[k][i] is output k's (x, y) for input i; inputs as in evaluate(). The
 // terms are chosen greedily for all outputs together from `pool` (vector_invariant_terms), each ray
-// giving two rows (its x and its y component), then each output's coefficients are solved by Ceres.
+// giving two rows (its x and its y component), then every output's coefficients by one rank-revealing QR.
 RotationalFitResult fit_rotational_map(const std::vector<PolyPoint>& inputs,
                                        const std::vector<std::vector<std::array<double, 2>>>& targets,
                                        const std::vector<InvariantTerm>& pool, const FitOptions& options);
