@@ -458,6 +458,8 @@ class Fit:
         self._native.check_matches(lens._handle)
 
     lens_name = property(lambda self: self._native.lens_name)
+    symmetry = property(lambda self: self._native.symmetry,
+                        doc="'rotational', or 'section mirrors' for an anamorphic lens (its x and y fitted apart)")
 
     def __repr__(self):
         return repr(self._native)

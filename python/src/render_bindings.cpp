@@ -414,6 +414,8 @@ void bind_render(py::module_& m) {
       .def_property_readonly("lens_name", &LensFit::lens_name)
       .def_property_readonly("lens_hash", &LensFit::lens_hash)
       .def_property_readonly("image_radius_mm", &LensFit::image_radius_mm)
+      .def_property_readonly("symmetry", [](const LensFit& f) { return std::string(to_string(f.symmetry())); },
+                             "'rotational' (the invariant form) or 'section mirrors' (an anamorphic lens, fitted in x and y components)")
       .def("__repr__", [](const LensFit& f) { return f.to_string(); });
 }
 

@@ -248,6 +248,16 @@ TEST_CASE("An anamorphic fit is written as version 2 and read back evaluating bi
   CHECK_THAT(round.to_json(), !Contains("symmetry"));
 }
 
+TEST_CASE("A fit of an anamorphic lens refuses the lens with another x section") {
+  // The hash covers the x curvature of toroids and biconics: a fit must not serve a lens whose cylinders differ.
+  Prescription lens = read_lens_file(std::string(LENSMITH_TEST_DATA_DIR) + "/lentil/lenses.json#2004").prescription;
+  const std::string hash = LensFit::prescription_hash(lens);
+  REQUIRE(lens.surfaces[0].kind != SurfaceKind::Standard);
+  lens.surfaces[0].curvature_x_per_mm *= 1.01;
+  CHECK(LensFit::prescription_hash(lens) != hash);
+  CHECK_THROWS_WITH(anamorphic_fit().check_matches(lens), Contains("not for"));
+}
+
 TEST_CASE("A lens with mirrors or tilted elements is refused by the fit with its reason") {
   const Prescription cassegrain = read_lens_file(std::string(LENSMITH_SOURCE_DIR) + "/examples/lenses/cassegrain-500mm.json").prescription;
   REQUIRE(LensFit::why_not_fittable(cassegrain));

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import lensmith
-from conftest import assert_same_json
+from conftest import SOURCE_DIR, assert_same_json
 
 
 def test_a_fit_saved_and_loaded_reports_the_same_and_matches_the_command(cli, tmp_path):
@@ -40,6 +40,16 @@ def test_bokeh_with_the_poly_model_takes_a_fit():
     assert np.isfinite(out).all() and out.mean() > 0.3
     with pytest.raises(lensmith.UsageError, match="poly"):
         lensmith.bokeh(image, depth, lens=lens, focus_m=2, model="seidel", fit=fit)
+
+
+def test_an_anamorphic_lens_is_fitted_in_x_and_y_components_and_a_mirror_lens_is_refused():
+    anamorphic = lensmith.Lens.load(str(SOURCE_DIR / "tests/data/lentil/lenses.json") + "#2004")
+    fit = anamorphic.fit(degree=3, training_rays=3000, test_rays=500)
+    assert fit.symmetry == "section mirrors"
+    assert fit.report.to_dict()["symmetry"] == "section mirrors"
+    assert lensmith.Lens.load("zeiss-biotar-1927").fit(degree=3, training_rays=2000, test_rays=300).symmetry == "rotational"
+    with pytest.raises(lensmith.Error, match="mirror"):
+        lensmith.Lens.load(str(SOURCE_DIR / "examples/lenses/cassegrain-500mm.json")).fit(degree=3, training_rays=2000, test_rays=300)
 
 
 @pytest.mark.parametrize("analysis", ["spot", "fan", "distortion", "field_curves", "focal_shift", "illumination", "pupil", "seidel"])
