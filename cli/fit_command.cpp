@@ -22,6 +22,7 @@ std::shared_ptr<const LensFit> fit_for_models(const std::vector<RayModelKind>& m
     if (!fit_file.empty()) throw UsageError("--fit is for --model poly");
     return nullptr;
   }
+  require_poly_model_lens(camera);
   if (!fit_file.empty()) {
     auto fit = std::make_shared<const LensFit>(LensFit::read(fit_file));
     fit->check_matches(lens);

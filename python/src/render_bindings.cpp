@@ -213,6 +213,7 @@ py::array_t<float> render(const py::array& image, const py::array& depth, py::di
     fit->check_matches(*cam->lens());
     model_options.fit = std::move(fit);
   }
+  if (kind == RayModelKind::Poly) require_poly_model_lens(*cam);
   if (kind == RayModelKind::Poly && !model_options.fit) {
     // A fit made for this render, as the command makes it: the camera's f-number and a sensor radius
     // covering its frame.

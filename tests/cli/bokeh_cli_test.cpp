@@ -498,6 +498,11 @@ TEST_CASE("lensmith bokeh without --model photographs a mirror lens with the exa
                                    "/examples/lenses/cassegrain-500mm.json --focus 30 --model seidel -o " + out.string());
   CHECK(seidel.exit_code != 0);
   CHECK_THAT(seidel.err, Catch::Contains("--model exact"));
+  // The poly model refuses mirrors before any fitting, naming the way out.
+  const auto poly = run_lensmith("bokeh --image " + image.string() + " --depth " + depth.string() + " --lens " + source +
+                                 "/examples/lenses/cassegrain-500mm.json --focus 30 --model poly -o " + out.string());
+  CHECK(poly.exit_code == 3);  // the lens lacks what the command needs
+  CHECK_THAT(poly.err, Catch::Contains("2 mirrors") && Catch::Contains("--model exact"));
 }
 
 TEST_CASE("lensmith bokeh writes an anamorphic lens's picture squeezed as on the sensor, desqueezed on request, and refuses a "

@@ -77,6 +77,21 @@ LensFitOptions lens_fit_options_for(const Camera& camera) {
   return o;
 }
 
+void require_poly_model_lens(const Camera& camera) {
+  if (camera.is_thin_lens()) return;  // make_ray_model says what the poly model needs
+  // A fit takes anamorphic lenses too (their maps in the component form); what it cannot fit is
+  // refused with its reason.
+  const Prescription& lens = *camera.lens();
+  if (const auto why = LensFit::why_not_fittable(lens)) {
+    throw OptionsError("the poly model cannot fit this lens: " + *why + ": use the exact model (--model exact)");
+  }
+  const bool obscured =
+      std::any_of(lens.surfaces.begin(), lens.surfaces.end(), [](const Surface& s) { return s.aperture && s.aperture->obscuration; });
+  if (obscured) {
+    throw OptionsError("the poly model does not clip at a central obscuration (not implemented): use the exact model (--model exact)");
+  }
+}
+
 std::unique_ptr<RayModel> make_ray_model(RayModelKind kind, const Camera& camera, const RayModelOptions& options) {
   options.validate();
   if (kind == RayModelKind::Thin) {
@@ -90,15 +105,7 @@ std::unique_ptr<RayModel> make_ray_model(RayModelKind kind, const Camera& camera
   }
   if (kind == RayModelKind::Exact) return std::make_unique<camera_detail::ExactModel>(camera);
   if (kind == RayModelKind::Poly) {
-    // A fit takes anamorphic lenses too (their maps in the component form); what it cannot fit is
-    // refused with its reason.
-    const Prescription& lens = *camera.lens();
-    if (const auto why = LensFit::why_not_fittable(lens)) {
-      throw OptionsError("the poly model cannot fit this lens: " + *why + ": use the exact model (--model exact)");
-    }
-    const bool obscured = std::any_of(lens.surfaces.begin(), lens.surfaces.end(),
-                                      [](const Surface& s) { return s.aperture && s.aperture->obscuration; });
-    if (obscured) throw OptionsError("the poly model does not clip at a central obscuration (not implemented): use the exact model (--model exact)");
+    require_poly_model_lens(camera);
   } else if (camera.exact_model_only()) {
     throw OptionsError("the " + std::string(to_string(kind)) + " model assumes a rotationally symmetric refracting lens with a round "
                        "aperture, and this one is not (" + *camera.exact_model_only() + "): use the exact model (--model exact)");

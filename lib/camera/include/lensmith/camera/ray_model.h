@@ -138,6 +138,10 @@ struct RayModelOptions {
 // radius covering its frame with the default's 15 % margin (at least the default's), so that a fit
 // made for a render covers what is rendered.
 LensFitOptions lens_fit_options_for(const Camera& camera);
+// Throws OptionsError, with the reason and naming --model exact, when the poly model cannot take the
+// camera's lens (LensFit::why_not_fittable: mirrors, tilts, decentres; a central obscuration): callers
+// that fit before making the model check first.
+void require_poly_model_lens(const Camera& camera);
 
 // Thin needs a thin-lens camera; the others a camera made from a prescription. Throws OptionsError
 // for a mismatch (poly: a fit of another lens, a stop wider than the fit's, a frame or wavelength
