@@ -9,6 +9,7 @@
 #include "lensmith/core/number_parsing.h"
 #include "lensmith/paraxial/paraxial_spectral_table.h"
 #include "lensmith/paraxial/paraxial_system.h"
+#include "model_implementations.h"
 
 namespace lensmith {
 
@@ -97,9 +98,7 @@ Camera Camera::thin_lens(double focal_length_mm, const CameraOptions& options, i
 std::optional<std::string> Camera::exact_model_only_for(const Prescription& lens) {
   if (const auto why = lens.why_not_rotationally_symmetric()) return *why;
   if (const int mirrors = lens.mirror_count(); mirrors > 0) return "it has " + std::to_string(mirrors) + " mirrors";
-  const bool obscured =
-      std::any_of(lens.surfaces.begin(), lens.surfaces.end(), [](const Surface& s) { return s.aperture && s.aperture->obscuration; });
-  if (obscured) return std::string("it has a central obscuration");
+  if (camera_detail::has_central_obscuration(lens)) return std::string("it has a central obscuration");
   return std::nullopt;
 }
 

@@ -20,6 +20,12 @@
 
 namespace lensmith::camera_detail {
 
+// Whether a surface of `lens` carries a central obscuration (an aperture that stops the rays inside it):
+// a mirror lens's secondary shadow, which only the exact model clips at.
+inline bool has_central_obscuration(const Prescription& lens) {
+  return std::any_of(lens.surfaces.begin(), lens.surfaces.end(), [](const Surface& s) { return s.aperture && s.aperture->obscuration; });
+}
+
 // The unnormalised radiometric weight of a ray from scene point `p` through the point (x, y) of a
 // plane normal to the axis at z_plane_mm (ray_model.h, SensorHit::weight): the pinhole framing's
 // cos(theta) (the patch's area seen from the perspective centre grows as 1 / cos^3 theta while its

@@ -85,9 +85,7 @@ void require_poly_model_lens(const Camera& camera) {
   if (const auto why = LensFit::why_not_fittable(lens)) {
     throw OptionsError("the poly model cannot fit this lens: " + *why + ": use the exact model (--model exact)");
   }
-  const bool obscured =
-      std::any_of(lens.surfaces.begin(), lens.surfaces.end(), [](const Surface& s) { return s.aperture && s.aperture->obscuration; });
-  if (obscured) {
+  if (camera_detail::has_central_obscuration(lens)) {
     throw OptionsError("the poly model does not clip at a central obscuration (not implemented): use the exact model (--model exact)");
   }
 }

@@ -8,18 +8,13 @@
 #include "lensmith/core/errors.h"
 #include "lensmith/polyfit/term_pool.h"
 #include "map_fit.h"
+#include "power_table.h"
 
 namespace lensmith {
 namespace {
 
-using Powers = std::array<std::array<double, kMaxPolyDegree + 1>, kPolyVariables>;
-
-void fill_powers(const PolyPoint& v, const std::array<int, kPolyVariables>& max_exponent, Powers& pw) {
-  for (int i = 0; i < kPolyVariables; ++i) {
-    pw[i][0] = 1.0;
-    for (int e = 1; e <= max_exponent[i]; ++e) pw[i][e] = pw[i][e - 1] * v[static_cast<std::size_t>(i)];
-  }
-}
+using polyfit_detail::fill_powers;
+using Powers = polyfit_detail::PointPowers;
 
 double monomial_value(const Powers& pw, const Monomial& m) {
   const auto& e = m.exponents;
@@ -40,30 +35,6 @@ std::vector<ComponentTerm> component_terms(int max_degree, bool vector) {
   return pool;
 }
 
-// Powers of every input, for the fit's columns: values[(i * 5 + variable) * (D + 1) + e].
-class PowerTable {
- public:
-  PowerTable(const std::vector<PolyPoint>& inputs, int max_degree)
-      : stride_(static_cast<std::size_t>(max_degree) + 1), values_(inputs.size() * kPolyVariables * stride_) {
-    for (std::size_t i = 0; i < inputs.size(); ++i) {
-      for (std::size_t k = 0; k < kPolyVariables; ++k) {
-        double* row = &values_[(i * kPolyVariables + k) * stride_];
-        row[0] = 1.0;
-        for (std::size_t e = 1; e < stride_; ++e) row[e] = row[e - 1] * inputs[i][k];
-      }
-    }
-  }
-  double monomial(std::size_t i, const Monomial& m) const {
-    const double* p = &values_[i * kPolyVariables * stride_];
-    double v = 1.0;
-    for (std::size_t k = 0; k < kPolyVariables; ++k) v *= p[k * stride_ + m.exponents[k]];
-    return v;
-  }
-
- private:
-  std::size_t stride_;
-  std::vector<double> values_;
-};
 
 ComponentFitResult fit_component_rows(const std::vector<PolyPoint>& inputs, bool vector,
                                       const std::vector<std::vector<double>>& targets, const std::vector<ComponentTerm>& pool,
@@ -83,7 +54,7 @@ ComponentFitResult fit_component_rows(const std::vector<PolyPoint>& inputs, bool
   if (usable.empty()) throw FitError("fit_component_map: no pool term within the maximum degree");
   int degree = 0;
   for (const ComponentTerm& t : usable) degree = std::max(degree, t.total_degree());
-  const PowerTable table(inputs, degree);
+  const polyfit_detail::SamplePowers table(inputs, degree);
   // A component term is its monomial in the rows of its own component and zero in the other's.
   auto basis = [&](std::size_t row, const ComponentTerm& t) {
     if (!vector) return table.monomial(row, t.monomial);

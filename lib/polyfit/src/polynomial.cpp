@@ -6,21 +6,12 @@
 #include <cmath>
 #include <string>
 
+#include "power_table.h"
+
 namespace lensmith {
 namespace {
 
 constexpr std::array<const char*, kPolyVariables> kVariableNames{"x", "y", "dx", "dy", "lambda"};
-
-using PowerTable = std::array<std::array<double, kMaxPolyDegree + 1>, kPolyVariables>;
-
-// table[k][e] = v[k]^e for e = 0..max_exponent[k], by repeated multiplication (exact for e <= 2).
-void fill_powers(const PolyPoint& v, const std::array<int, kPolyVariables>& max_exponent, PowerTable& table) {
-  for (int k = 0; k < kPolyVariables; ++k) {
-    auto& row = table[k];
-    row[0] = 1.0;
-    for (int e = 1; e <= max_exponent[k]; ++e) row[e] = row[e - 1] * v[k];
-  }
-}
 
 std::string shortest(double value) {
   std::array<char, 32> buffer{};
@@ -68,8 +59,8 @@ SparsePolynomial::SparsePolynomial(std::vector<Monomial> terms, std::vector<doub
 }
 
 double SparsePolynomial::evaluate(const PolyPoint& v) const {
-  PowerTable pw;
-  fill_powers(v, max_exponent_, pw);
+  polyfit_detail::PointPowers pw;
+  polyfit_detail::fill_powers(v, max_exponent_, pw);
   double sum = 0.0;
   for (std::size_t i = 0; i < terms_.size(); ++i) {
     const auto& e = terms_[i].exponents;
@@ -88,8 +79,8 @@ void SparsePolynomial::evaluate(std::span<const PolyPoint> points, std::span<dou
 
 double SparsePolynomial::evaluate_with_gradient(const PolyPoint& v,
                                                 std::array<double, kPolyVariables>& gradient_out) const {
-  PowerTable pw;
-  fill_powers(v, max_exponent_, pw);
+  polyfit_detail::PointPowers pw;
+  polyfit_detail::fill_powers(v, max_exponent_, pw);
   double sum = 0.0;
   gradient_out.fill(0.0);
   for (std::size_t i = 0; i < terms_.size(); ++i) {

@@ -5,6 +5,7 @@
 #include "lensmith/polyfit/polynomial_fit.h"
 
 #include "least_squares.h"
+#include "power_table.h"
 
 #include <ceres/ceres.h>
 
@@ -23,32 +24,6 @@ namespace {
 // dependent on them: choosing it would only make the coefficient solve ill-conditioned.
 constexpr double kDependentColumn = 1e-10;
 
-// Powers of every variable of every sample: pw[(i * 5 + k) * (D + 1) + e] = inputs[i][k]^e.
-class PowerTable {
- public:
-  PowerTable(const std::vector<PolyPoint>& inputs, int max_degree)
-      : stride_(max_degree + 1), values_(inputs.size() * kPolyVariables * static_cast<std::size_t>(stride_)) {
-    for (std::size_t i = 0; i < inputs.size(); ++i) {
-      for (int k = 0; k < kPolyVariables; ++k) {
-        double* row = &values_[(i * kPolyVariables + k) * stride_];
-        row[0] = 1.0;
-        for (int e = 1; e < stride_; ++e) row[e] = row[e - 1] * inputs[i][k];
-      }
-    }
-  }
-  double monomial(std::size_t i, const Monomial& m) const {
-    const double* p = &values_[i * kPolyVariables * stride_];
-    return p[m.exponents[0]] * p[stride_ + m.exponents[1]] * p[2 * stride_ + m.exponents[2]] *
-           p[3 * stride_ + m.exponents[3]] * p[4 * stride_ + m.exponents[4]];
-  }
-  void column(const Monomial& m, std::vector<double>& out) const {
-    for (std::size_t i = 0; i < out.size(); ++i) out[i] = monomial(i, m);
-  }
-
- private:
-  int stride_;
-  std::vector<double> values_;
-};
 
 // Candidate column values select_columns keeps in memory (256 MiB of doubles).
 constexpr std::size_t kCachedColumnValues = std::size_t{32} << 20;
@@ -315,7 +290,7 @@ FitResult fit_polynomial(const std::vector<PolyPoint>& inputs, const std::vector
   }
   int degree = 0;
   for (const Monomial& m : usable) degree = std::max(degree, m.total_degree());
-  const PowerTable powers(inputs, degree);
+  const polyfit_detail::SamplePowers powers(inputs, degree);
 
   FitResult result;
   std::vector<Monomial> terms;
@@ -326,7 +301,7 @@ FitResult fit_polynomial(const std::vector<PolyPoint>& inputs, const std::vector
                               ? std::min(inputs.size(), static_cast<std::size_t>(options.max_selection_samples))
                               : inputs.size();
     const std::vector<PolyPoint> subset(inputs.begin(), inputs.begin() + static_cast<std::ptrdiff_t>(m));
-    const PowerTable subset_powers(subset, degree);
+    const polyfit_detail::SamplePowers subset_powers(subset, degree);
     std::vector<std::vector<double>> selection_rms;
     const auto chosen = select_columns(
         usable.size(), [&](std::size_t j, std::vector<double>& c) { subset_powers.column(usable[j], c); },

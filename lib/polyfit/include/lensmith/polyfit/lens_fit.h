@@ -176,9 +176,10 @@ std::string_view to_string(LensSymmetry symmetry);  // "rotational", "section mi
 
 class LensFit {
  public:
-  // Why `lens` cannot be fitted (empty: it can): mirrors, coordinate breaks (tilts, decentres) and
-  // explicit aperture shapes are not implemented; a lens that is not rotationally symmetric must keep the
-  // mirror symmetry of both sections (its toroids and biconics on the axis, their sections in x and y).
+  // Why `lens` cannot be fitted (empty: it can): fits of mirrors and of coordinate breaks (tilts,
+  // decentres) are not implemented, and surface 1 must be a real surface (the outer pupil). A coaxial lens
+  // of standard, toroidal and biconic surfaces keeps both section mirrors and is fitted. Explicit aperture
+  // shapes are not refused here: the fit clips at circles of the semi-diameters (docs/polyfit.md).
   static std::optional<std::string> why_not_fittable(const Prescription& lens);
   // The symmetry the maps of `lens` are written for (why_not_fittable must be empty).
   static LensSymmetry symmetry_of(const Prescription& lens);
