@@ -115,7 +115,7 @@ TEST_CASE("spectral quadrature: the Monte-Carlo mean over all N strata equals th
   CHECK_THAT(mean.b, WithinAbs(colour.b, kRoundTrip));
 }
 
-TEST_CASE("spectral quadrature: u outside [0, 1) is clamped to the first or last node", "[color][quadrature][montecarlo]") {
+TEST_CASE("spectral quadrature: u below 0 or from 1 up is clamped to the first or last node", "[color][quadrature][montecarlo]") {
   const SpectralQuadrature q = make_quadrature(16);
   CHECK(q.sample(-0.25).index == 0);
   CHECK(q.sample(1.0).index == 15);

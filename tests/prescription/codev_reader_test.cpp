@@ -219,7 +219,7 @@ TEST_CASE("CODE V: ASP with K and A..G gives the conic and the r^4..r^16 coeffic
   CHECK(s.even_asphere[7] == 7.7e-23);
 }
 
-TEST_CASE("CODE V: CON with K alone gives a conic; SPH drops conic and aspheric terms", "[prescription][codev]") {
+TEST_CASE("CODE V: CON with K alone gives a conic, and SPH drops conic and aspheric terms", "[prescription][codev]") {
   CHECK(read_codev(mini_seq("", "  CON\n  K -1\n"), "t.seq").prescription.surfaces[1].conic == -1.0);
   const Surface s = read_codev(mini_seq("", "  ASP\n  K -1; A 1e-6\n  SPH\n"), "t.seq").prescription.surfaces[1];
   CHECK(s.conic == 0.0);
@@ -267,7 +267,7 @@ TEST_CASE("CODE V: a curved image surface is a warning", "[prescription][codev]"
   CHECK(has_diagnostic(r.diagnostics, Diagnostic::Severity::Warning, line_of(text, "SI -100"), "curved"));
 }
 
-TEST_CASE("CODE V: REFL makes a mirror, on the S line, in GLA and in RMD; not on SO or SI", "[prescription][codev]") {
+TEST_CASE("CODE V: REFL makes a mirror, on the S line, in GLA and in RMD, not on SO or SI", "[prescription][codev]") {
   for (const std::string& mirror : {std::string("S -200 -90 REFL"), std::string("S -200 -90\n  RMD REFL"),
                                     std::string("S -200 -90\n  GLA REFL")}) {
     const std::string text = replaced(mini_seq(), "S -200 90", mirror);
@@ -442,7 +442,7 @@ TEST_CASE("CODE V: rays are aimed at the real stop, as CODE V does", "[prescript
   CHECK(read_codev(mini_seq(), "t.seq").prescription.ray_aiming == RayAiming::RealStop);
 }
 
-TEST_CASE("CODE V: without STO surface 1 is the stop, with a note; a second STO moves it", "[prescription][codev]") {
+TEST_CASE("CODE V: without STO surface 1 is the stop, with a note, and a second STO moves it", "[prescription][codev]") {
   const std::string none = replaced(mini_seq(), "  STO\n", "");
   const LensReadResult r = read_codev(none, "t.seq");
   CHECK(r.prescription.surfaces[0].is_stop);
@@ -494,7 +494,7 @@ TEST_CASE("CODE V: a PRV block's glass becomes a model glass from its index tabl
   CHECK_NOTHROW(read_codev(mini_seq("PRV\n  PWL 550\n  'NOA61' LAU 2.36 0.0 0.025\nEND\n"), "t.seq"));  // defined, not used
 }
 
-TEST_CASE("CODE V: comments, ';' separators, '&' continuations and quoted strings", "[prescription][codev]") {
+TEST_CASE("CODE V: comments, semicolon separators, '&' continuations and quoted strings", "[prescription][codev]") {
   const std::string text = replaced(replaced(mini_seq(), "TITLE 'MINI'", "TITLE 'MINI! not a comment' ! a comment"),
                                     "S 50 5 NBK7_SCHOTT\n  CIR 8", "S 50 &\n 5 NBK7_SCHOTT ; CIR &\n8");
   const LensReadResult r = read_codev(text, "t.seq");
@@ -518,7 +518,7 @@ TEST_CASE("CODE V: S k, SO and SI qualifiers name the surface a command changes"
   CHECK_THAT(codev_error(range).what(), Contains("ranges"));
 }
 
-TEST_CASE("CODE V: solves, variable codes and pickups are skipped; the file holds the solved values", "[prescription][codev]") {
+TEST_CASE("CODE V: solves, variable codes and pickups are skipped: the file holds the solved values", "[prescription][codev]") {
   const std::string extra = "  CCY 0; THC 0; THI HMY 0.0\n  PIM\nPIK THI S3 Z1 THI S2 Z1 -1.0\n";
   const LensReadResult r = read_codev(mini_seq("", extra), "t.seq");
   CHECK(r.diagnostics.empty());
@@ -618,7 +618,7 @@ TEST_CASE("CODE V: VUY/VLY/VUX/VLX become OpticStudio-style vignetting factors p
   CHECK_THAT(v.vcx, WithinRel(0.1, 1e-12));
 }
 
-TEST_CASE("CODE V: NAO is an object-space NA aperture; with the object at infinity it is refused on its line", "[prescription][codev]") {
+TEST_CASE("CODE V: NAO is an object-space NA aperture, and with the object at infinity it is refused on its line", "[prescription][codev]") {
   const Prescription p = read_codev(replaced(mini_seq("NAO 0.05\n", "", "SO 0 400"), "EPD 10\n", ""), "t.seq").prescription;
   CHECK(p.aperture == ApertureSpec{ApertureSpec::Kind::ObjectSpaceNA, 0.05});
   const std::string at_infinity = replaced(mini_seq("NAO 0.05\n"), "EPD 10\n", "");

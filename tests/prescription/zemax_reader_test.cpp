@@ -528,7 +528,7 @@ TEST_CASE("Zemax: an object-space NA with the object at infinity is refused on t
   CHECK_THAT(e.what(), Contains("finite object"));
 }
 
-TEST_CASE("Zemax: DIAM sizes a surface without clipping; FLAP makes it a clear aperture (OpticStudio's rule)",
+TEST_CASE("Zemax: DIAM sizes a surface without clipping, FLAP makes it a clear aperture (OpticStudio's rule)",
           "[prescription][zemax]") {
   const Prescription plain = read_zemax(mini_zmx(), "t.zmx").prescription;
   CHECK(*plain.surfaces[1].semi_diameter_mm == 8.0);
@@ -607,7 +607,7 @@ TEST_CASE("Zemax: DIAM 0 leaves a surface unlimited", "[prescription][zemax]") {
   CHECK_FALSE(read_zemax(text, "t.zmx").prescription.surfaces[1].semi_diameter_mm);
 }
 
-TEST_CASE("Zemax: a surface tilt before the surface (SCBD 1) is a coordinate break; others are refused unless zero",
+TEST_CASE("Zemax: a surface tilt before the surface (SCBD 1) is a coordinate break, others are refused unless zero",
           "[prescription][zemax]") {
   const std::string tilted = mini_zmx("", "  SCBD 1 0 0 0.0 0.0 90 0 0\n");
   const LensReadResult r = read_zemax(tilted, "t.zmx");
