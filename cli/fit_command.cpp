@@ -69,8 +69,14 @@ int run_fit(const FitCommandOptions& o, const GlobalOptions& global) {
             << " outer->sensor), " << options.training_rays << " training rays, 380-780 nm\n"
             << (fit.symmetry() == LensSymmetry::kRotational
                     ? "  form: rotation invariants (a rotationally symmetric lens)\n"
-                    : "  form: x and y components apart, the mirror symmetry of both sections kept (an anamorphic lens)\n")
-            << "  clipping surfaces:";
+                    : "  form: x and y components apart, the mirror symmetry of both sections kept (an anamorphic lens)\n");
+  if (const auto core = coaxial_core(lens); core && core->lens.surfaces.size() != lens.surfaces.size()) {
+    // A tilt-shift lens: the coordinate breaks at its ends are applied exactly where the fit is used.
+    std::cout << "  fitted: surfaces " << core->first + 1 << "-" << core->first + core->lens.surfaces.size()
+              << ", the elements without the coordinate breaks at the lens's ends (one fit serves every tilt and shift;"
+              << " the surfaces below are numbered from the lens's surface " << core->first + 1 << ")\n";
+  }
+  std::cout << "  clipping surfaces:";
   for (const ClipSurface& c : fit.clip_surfaces()) std::cout << " " << c.surface;
   std::cout << " (stop first)\n"
             << "Held-out errors (" << e.test_rays << " rays passing the lens)\n"

@@ -480,7 +480,7 @@ TEST_CASE("lensmith bokeh --method gather gathers at half resolution, traces hol
   CHECK_FALSE(fs::exists(scratch("gather-deep.exr")));
 }
 
-TEST_CASE("lensmith bokeh without --model photographs a mirror lens with the exact model, and says so", "[cli][bokeh][mirror]") {
+TEST_CASE("lensmith bokeh without --model photographs a mirror lens with the exact model, and says so, and the poly model fits it and a tilt-shift lens", "[cli][bokeh][mirror]") {
   const fs::path image = scratch("mirror-in.exr"), depth = scratch("mirror-depth.exr"), out = scratch("mirror-out.exr");
   const std::string source = std::string(LENSMITH_SOURCE_DIR);
   const auto rendered = run_lensmith("scene render " + source + "/examples/scenes/mirror-lens-highlights.json --pinhole --width 96 "
@@ -498,11 +498,23 @@ TEST_CASE("lensmith bokeh without --model photographs a mirror lens with the exa
                                    "/examples/lenses/cassegrain-500mm.json --focus 30 --model seidel -o " + out.string());
   CHECK(seidel.exit_code != 0);
   CHECK_THAT(seidel.err, Catch::Contains("--model exact"));
-  // The poly model refuses mirrors before any fitting, naming the way out.
+  // The poly model fits the mirror lens, obscuration and all.
   const auto poly = run_lensmith("bokeh --image " + image.string() + " --depth " + depth.string() + " --lens " + source +
                                  "/examples/lenses/cassegrain-500mm.json --focus 30 --model poly -o " + out.string());
-  CHECK(poly.exit_code == 3);  // the lens lacks what the command needs
-  CHECK_THAT(poly.err, Catch::Contains("2 mirrors") && Catch::Contains("--model exact"));
+  INFO(poly.err);
+  CHECK(poly.exit_code == 0);
+  CHECK(value_of(lensmith::read_image_metadata(out), "lensmith:model") == "poly");
+  // And a tilt-shift lens (its elements fitted without the breaks at its ends).
+  const auto shifted = run_lensmith("bokeh --image " + image.string() + " --depth " + depth.string() + " --lens " + source +
+                                    "/examples/lenses/tilt-shift-50mm.json --focus 3 --model poly -o " + out.string());
+  INFO(shifted.err);
+  CHECK(shifted.exit_code == 0);
+  // It refuses an element tilted inside the lens before any fitting, naming the way out.
+  const std::string folded = std::string(LENSMITH_TEST_DATA_DIR) + "/lensmith/tilted-rear-element.json";
+  const auto tilted = run_lensmith("bokeh --image " + image.string() + " --depth " + depth.string() + " --lens " + folded +
+                                   " --focus 3 --model poly -o " + out.string());
+  CHECK(tilted.exit_code == 3);  // the lens lacks what the command needs
+  CHECK_THAT(tilted.err, Catch::Contains("coordinate break") && Catch::Contains("between elements") && Catch::Contains("--model exact"));
 }
 
 TEST_CASE("lensmith bokeh writes an anamorphic lens's picture squeezed as on the sensor, desqueezed on request, and refuses a "

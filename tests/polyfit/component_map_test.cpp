@@ -215,7 +215,7 @@ TEST_CASE("lentil's Schneider anamorphic is fitted in the component form, and it
   }
 }
 
-TEST_CASE("An anamorphic fit is written as version 2 and read back evaluating bit for bit the same; a round lens's stays version 1") {
+TEST_CASE("An anamorphic fit is written as version 2 and read back evaluating bit for bit the same, and a round lens's stays version 1") {
   const LensFit& fit = anamorphic_fit();
   const std::string text = fit.to_json();
   CHECK_THAT(text, Contains("\"version\": 2"));
@@ -256,14 +256,4 @@ TEST_CASE("A fit of an anamorphic lens refuses the lens with another x section")
   lens.surfaces[0].curvature_x_per_mm *= 1.01;
   CHECK(LensFit::prescription_hash(lens) != hash);
   CHECK_THROWS_WITH(anamorphic_fit().check_matches(lens), Contains("not for"));
-}
-
-TEST_CASE("A lens with mirrors or tilted elements is refused by the fit with its reason") {
-  const Prescription cassegrain = read_lens_file(std::string(LENSMITH_SOURCE_DIR) + "/examples/lenses/cassegrain-500mm.json").prescription;
-  REQUIRE(LensFit::why_not_fittable(cassegrain));
-  CHECK_THAT(*LensFit::why_not_fittable(cassegrain), Contains("mirrors"));
-  CHECK_THROWS_WITH(LensFit::fit(cassegrain), Contains("not implemented"));
-  const Prescription tilted = read_lens_file(std::string(LENSMITH_SOURCE_DIR) + "/examples/lenses/tilt-shift-50mm.json").prescription;
-  REQUIRE(LensFit::why_not_fittable(tilted));
-  CHECK_THAT(*LensFit::why_not_fittable(tilted), Contains("coordinate break"));
 }

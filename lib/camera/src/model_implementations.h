@@ -17,6 +17,7 @@
 #include "lensmith/seidel/aberration_table.h"
 #include "lensmith/trace/ray_aiming.h"
 #include "lensmith/trace/sequential_tracer.h"
+#include "lensmith/trace/surface_frames.h"
 
 namespace lensmith::camera_detail {
 
@@ -320,6 +321,22 @@ class ExactModel final : public RayModel {
 // fit's outer -> stop map from the scene point, then carried to the sensor by the outer -> sensor map
 // and a straight line from the fit's sensor plane to the camera's; clipping by the fitted positions on
 // the clear apertures and the stop at the camera's f-number.
+// Where a fit's coaxial core (LensFit: the lens without the coordinate breaks at its ends) lies in a
+// camera: where its surface 1 lies and how it is turned, and the camera's sensor plane, both in the
+// global frame of the lens (surface_frames). For most lenses the core is the lens and both frames are
+// the axis's own (`moved` false); a tilt-shift lens's core is turned or moved by the breaks before it.
+struct CorePlacement {
+  std::size_t first = 0;  // 0-based index in the camera's lens of the core's surface 1
+  bool moved = false;     // the core or the sensor plane is turned or moved off the axis
+  SurfaceFrame core;
+  SurfaceFrame sensor;
+  // Throws OptionsError when the camera's lens has no coaxial core (LensFit::why_not_fittable).
+  static CorePlacement of(const Camera& camera);
+  // The farthest corner of the camera's frame from the core's axis, mm (on the sensor plane; the fit's
+  // image radius must reach it).
+  double frame_reach_mm(const Camera& camera) const;
+};
+
 class PolyModel final : public RayModel {
  public:
   PolyModel(const Camera& camera, std::shared_ptr<const LensFit> fit);
@@ -336,6 +353,7 @@ class PolyModel final : public RayModel {
   double outer_solid_angle(const ScenePoint& point, double z_perspective_mm, double x_mm, double y_mm) const;
 
   std::shared_ptr<const LensFit> fit_;
+  CorePlacement placement_;
   double stop_radius_mm_ = 0.0;
   WeightNormalisation normalisation_;
   mutable std::atomic<std::size_t> unaimed_{0};

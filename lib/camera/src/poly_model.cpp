@@ -12,14 +12,45 @@
 
 namespace lensmith::camera_detail {
 
-PolyModel::PolyModel(const Camera& camera, std::shared_ptr<const LensFit> fit) : RayModel(camera), fit_(std::move(fit)) {
+CorePlacement CorePlacement::of(const Camera& camera) {
+  const Prescription& lens = *camera.lens();
+  const std::optional<CoaxialCore> core = coaxial_core(lens);
+  if (!core) throw OptionsError("the poly model cannot fit this lens: " + LensFit::why_not_fittable(lens).value_or("no coaxial core"));
+  CorePlacement placement;
+  placement.first = core->first;
+  // The frames as the exact model's tracer places them (its image plane at the camera's sensor).
+  const LensFrames frames = surface_frames(lens, camera.z_sensor_mm() - lens.last_vertex_z_mm());
+  placement.core = frames.surfaces[core->first];
+  placement.sensor = frames.image;
+  const bool axis_own = placement.core.axes.isIdentity(0.0) && placement.core.origin_mm.isZero(0.0) &&
+                        placement.sensor.axes.isIdentity(0.0) && placement.sensor.origin_mm.head<2>().isZero(0.0);
+  placement.moved = !axis_own;
+  return placement;
+}
+
+double CorePlacement::frame_reach_mm(const Camera& camera) const {
+  const double w = camera.frame().width_px(), h = camera.frame().height_px();
+  double reach = 0.0;
+  for (const PixelPoint corner : {PixelPoint{0.0, 0.0}, PixelPoint{w, 0.0}, PixelPoint{0.0, h}, PixelPoint{w, h}}) {
+    const auto [x, y] = camera.sensor_point_mm(corner);
+    // On the core's axis: a tilt turns the sensor by a few degrees, a shift moves the frame across the image circle.
+    const Eigen::Vector3d in_core = core.to_local(sensor.to_global(Eigen::Vector3d(x, y, 0.0)));
+    reach = std::max(reach, std::hypot(in_core.x(), in_core.y()));
+  }
+  return reach;
+}
+
+PolyModel::PolyModel(const Camera& camera, std::shared_ptr<const LensFit> fit)
+    : RayModel(camera), fit_(std::move(fit)), placement_(CorePlacement::of(camera)) {
   const Prescription& lens = *camera.lens();
   fit_->check_matches(lens);
   const ParaxialSystem p(lens);
   stop_radius_mm_ = lens.surfaces[static_cast<std::size_t>(p.stop_surface() - 1)].semi_diameter_mm.value_or(0.0);
-  if (p.stop_surface() != fit_->stop_surface()) {
-    throw OptionsError("the fit's stop is surface " + std::to_string(fit_->stop_surface()) + ", the camera's surface " +
-                       std::to_string(p.stop_surface()));
+  // The fit numbers the core's surfaces.
+  const int core_stop = p.stop_surface() - static_cast<int>(placement_.first);
+  if (core_stop != fit_->stop_surface()) {
+    throw OptionsError("the fit's stop is surface " + std::to_string(fit_->stop_surface()) + " of the fitted core, the camera's surface " +
+                       std::to_string(core_stop));
   }
   if (stop_radius_mm_ > fit_->stop_radius_mm() * (1.0 + 1e-9)) {
     throw OptionsError("f/" + format_number(camera.f_number()) + " opens the stop to " + format_number(stop_radius_mm_) +
@@ -27,8 +58,7 @@ PolyModel::PolyModel(const Camera& camera, std::shared_ptr<const LensFit> fit) :
   }
   // The frame's corner on the fit's sensor plane (the camera's sensor sits elsewhere when it focuses
   // closer; the margin of the default image radius covers that).
-  const double half_diagonal_mm = 0.5 * std::hypot(camera.frame().width_px(), camera.frame().height_px()) /
-                                  std::abs(camera.px_per_sensor_mm());
+  const double half_diagonal_mm = placement_.frame_reach_mm(camera);
   if (half_diagonal_mm > fit_->image_radius_mm()) {
     throw OptionsError("the fit covers the sensor out to " + format_number(fit_->image_radius_mm()) +
                        " mm from the axis; this frame reaches " + format_number(half_diagonal_mm) +
@@ -56,9 +86,31 @@ void PolyModel::map(const ScenePoint& point, double wavelength_nm, std::span<con
   normalisation_.apply(wavelength_nm, hits);
 }
 
-void PolyModel::map_raw(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
+void PolyModel::map_raw(const ScenePoint& camera_point, double wavelength_nm, std::span<const PupilPoint> pupil,
                         std::span<SensorHit> hits) const {
-  const ObjectPoint object{point.tan_x, point.tan_y, point.inverse_depth_per_mm, camera_.z_perspective_mm()};
+  // The scene point in the core's frame. For a lens that is its own core the camera's description as it
+  // is; for a tilt-shift lens the point moved into the turned core's frame, described from the core's
+  // vertex: w P = (tan_x, tan_y, w z_persp - 1) (LensFit::outer_line) taken there and scaled back to
+  // that form, s = -1 / its z. The weight's cos theta and depth squared (patch_solid_angle) are then the
+  // core's; `to_camera_weight` turns them back into the camera's: the ratio of the cosines and s^2.
+  ScenePoint point = camera_point;
+  ObjectPoint object{point.tan_x, point.tan_y, point.inverse_depth_per_mm, camera_.z_perspective_mm()};
+  double to_camera_weight = 1.0;
+  if (placement_.moved) {
+    const double w = camera_point.inverse_depth_per_mm;
+    const Eigen::Vector3d h = placement_.core.axes.transpose() *
+                              (Eigen::Vector3d(camera_point.tan_x, camera_point.tan_y, w * camera_.z_perspective_mm() - 1.0) -
+                               w * placement_.core.origin_mm);
+    if (!(h.z() < 0.0)) {  // not in front of the core
+      for (auto& hit : hits) hit = {};
+      return;
+    }
+    const double s = -1.0 / h.z();
+    point = ScenePoint{s * h.x(), s * h.y(), s * w};
+    object = ObjectPoint{point.tan_x, point.tan_y, point.inverse_depth_per_mm, 0.0};
+    to_camera_weight = s * s * std::sqrt((1.0 + point.tan_x * point.tan_x + point.tan_y * point.tan_y) /
+                                         (1.0 + camera_point.tan_x * camera_point.tan_x + camera_point.tan_y * camera_point.tan_y));
+  }
   const double dz_sensor = camera_.z_sensor_mm() - fit_->sensor_plane_z_mm();
   // Newton for the beam's centre gives the Jacobian of stop position in outer position; every pupil
   // point then iterates with that fixed Jacobian (the chord method, as the exact model does with its
@@ -76,8 +128,8 @@ void PolyModel::map_raw(const ScenePoint& point, double wavelength_nm, std::span
   const std::array<double, 4> inverse{j[3] / det, -j[1] / det, -j[2] / det, j[0] / det};
   // Outer-pupil area (dx dy on surface 1) per unit stop area across this beam, for the rays'
   // radiometric weights: the solid angle of that element of surface 1 seen from the point.
-  const double outer_area = 1.0 / std::abs(det);
-  const double z_persp = camera_.z_perspective_mm();
+  const double outer_area = to_camera_weight / std::abs(det);
+  const double z_persp = object.origin_z_mm;
   // The chord steps of one pupil point: at most kMaxChordEvaluations evaluations of the fit, full steps.
   constexpr int kMaxChordEvaluations = 12;
   RootSolver2dOptions chord;
@@ -117,8 +169,22 @@ void PolyModel::map_raw(const ScenePoint& point, double wavelength_nm, std::span
     // The stop as wide as the aiming tolerance may put a rim ray outside it (exact_model.cpp).
     const FitTrace t = fit_->from_outer(*outer, wavelength_nm, stop_radius_mm_ * (1.0 + kStopEdgeTolerance));
     const double dz = std::sqrt(std::max(1e-12, 1.0 - t.ray.dx * t.ray.dx - t.ray.dy * t.ray.dy));
-    hits[i] = SensorHit{t.ray.x_mm + t.ray.dx / dz * dz_sensor, t.ray.y_mm + t.ray.dy / dz * dz_sensor, t.passes, true,
-                        outer_area * outer_solid_angle(point, z_persp, x, y), t.clearance};
+    const double weight = outer_area * outer_solid_angle(point, z_persp, x, y);
+    if (!placement_.moved) {
+      hits[i] = SensorHit{t.ray.x_mm + t.ray.dx / dz * dz_sensor, t.ray.y_mm + t.ray.dy / dz * dz_sensor, t.passes, true,
+                          weight, t.clearance};
+      continue;
+    }
+    // From the fit's sensor plane in the core's frame, in a straight line (air) to the camera's sensor.
+    const Eigen::Vector3d from =
+        placement_.sensor.to_local(placement_.core.to_global(Eigen::Vector3d(t.ray.x_mm, t.ray.y_mm, fit_->sensor_plane_z_mm())));
+    const Eigen::Vector3d along = placement_.sensor.axes.transpose() * (placement_.core.axes * Eigen::Vector3d(t.ray.dx, t.ray.dy, dz));
+    if (!(along.z() > 0.0)) {
+      hits[i] = {};
+      continue;
+    }
+    const double to_sensor = -from.z() / along.z();
+    hits[i] = SensorHit{from.x() + along.x() * to_sensor, from.y() + along.y() * to_sensor, t.passes, true, weight, t.clearance};
   }
 }
 

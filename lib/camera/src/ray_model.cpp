@@ -70,23 +70,22 @@ LensFitOptions lens_fit_options_for(const Camera& camera) {
   o.f_number = camera.f_number();
   // The frame's corner on the camera's sensor; the fit's own sensor plane (the paraxial focus for
   // infinity) sees it about as far out, and the margin covers the difference.
+  // A tilt-shift lens's frame measured from its core's axis (a shift moves it across the image circle).
   constexpr double kFrameMargin = 1.15;
-  const double half_diagonal_mm =
-      0.5 * std::hypot(camera.frame().width_px(), camera.frame().height_px()) / std::abs(camera.px_per_sensor_mm());
-  o.image_radius_mm = std::max(LensFitOptions::kDefaultImageRadiusMm, kFrameMargin * half_diagonal_mm);
+  const double reach_mm = camera.is_thin_lens() || !coaxial_core(*camera.lens())
+                              ? 0.5 * std::hypot(camera.frame().width_px(), camera.frame().height_px()) / std::abs(camera.px_per_sensor_mm())
+                              : camera_detail::CorePlacement::of(camera).frame_reach_mm(camera);
+  o.image_radius_mm = std::max(LensFitOptions::kDefaultImageRadiusMm, kFrameMargin * reach_mm);
   return o;
 }
 
 void require_poly_model_lens(const Camera& camera) {
   if (camera.is_thin_lens()) return;  // make_ray_model says what the poly model needs
-  // A fit takes anamorphic lenses too (their maps in the component form); what it cannot fit is
-  // refused with its reason.
+  // A fit takes anamorphic lenses (their maps in the component form), mirror lenses with their central
+  // obscurations and tilt-shift lenses (their coaxial core) too; what it cannot fit is refused with its reason.
   const Prescription& lens = *camera.lens();
   if (const auto why = LensFit::why_not_fittable(lens)) {
     throw OptionsError("the poly model cannot fit this lens: " + *why + ": use the exact model (--model exact)");
-  }
-  if (camera_detail::has_central_obscuration(lens)) {
-    throw OptionsError("the poly model does not clip at a central obscuration (not implemented): use the exact model (--model exact)");
   }
 }
 

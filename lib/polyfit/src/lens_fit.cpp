@@ -41,15 +41,19 @@ std::string_view to_string(LensSymmetry symmetry) {
 }
 
 std::optional<std::string> LensFit::why_not_fittable(const Prescription& lens) {
-  if (const int mirrors = lens.mirror_count(); mirrors > 0) {
+  // A tilt-shift lens is fitted as its coaxial core, the breaks at its ends applied exactly where the fit is
+  // used; a break between elements would need the fit to follow a folded or tilted axis inside the lens.
+  const std::optional<CoaxialCore> core = coaxial_core(lens);
+  if (!core) {
+    if (const auto why = lens.why_not_rotationally_symmetric()) {
+      return *why + " between elements (a fit of a lens tilted or decentred inside is not implemented; coordinate breaks "
+                    "before and after all its elements, as in a tilt-shift lens, are)";
+    }
+    return std::string("it has no surface that is not a coordinate break");
+  }
+  if (const int mirrors = core->lens.mirror_count(); mirrors % 2 == 1) {
     return "it has " + std::to_string(mirrors) + " mirror" + (mirrors == 1 ? "" : "s") +
-           " (a fit of a reflecting system is not implemented)";
-  }
-  if (!lens.is_coaxial()) {
-    return *lens.why_not_rotationally_symmetric() + " (a fit of tilted or decentred elements is not implemented)";
-  }
-  if (!lens.surfaces.empty() && lens.surfaces.front().is_coordinate_break()) {
-    return std::string("surface 1 is a coordinate break: the fit takes its outer pupil on the front surface");
+           " (an odd number: its image faces back toward the scene, which a fit does not take; not implemented)";
   }
   return std::nullopt;
 }
@@ -57,7 +61,8 @@ std::optional<std::string> LensFit::why_not_fittable(const Prescription& lens) {
 LensSymmetry LensFit::symmetry_of(const Prescription& lens) {
   // Coaxial standard, toroidal and biconic surfaces: each is even in x and in y (Surface::sag_and_slope),
   // so the lens keeps both section mirrors when it is not rotationally symmetric.
-  return lens.is_rotationally_symmetric() ? LensSymmetry::kRotational : LensSymmetry::kSectionMirrors;
+  const std::optional<CoaxialCore> core = coaxial_core(lens);  // a tilt-shift lens's breaks are not the maps'
+  return (core ? core->lens : lens).is_rotationally_symmetric() ? LensSymmetry::kRotational : LensSymmetry::kSectionMirrors;
 }
 
 void LensFit::set_front_surface(const FrontSurface& front) {
@@ -157,12 +162,15 @@ LensFit LensFit::fit(const Prescription& lens, const LensFitOptions& options,
   options.validate();
   if (const auto why = why_not_fittable(lens)) throw FitError("lens fit of '" + lens.name + "': " + *why);
   const auto start_time = std::chrono::steady_clock::now();
-  const RaySampler sampler(lens, options);
+  // What the maps describe: the lens without the coordinate breaks at its ends (all of it for most lenses).
+  const CoaxialCore core = *coaxial_core(lens);
+  const Prescription& subject = core.lens;
+  const RaySampler sampler(subject, options);
   const ParaxialSystem& paraxial = sampler.paraxial();
 
   LensFit fit;
   fit.lens_name_ = lens.name;
-  fit.lens_hash_ = prescription_hash(lens);
+  fit.lens_hash_ = prescription_hash(subject);
   fit.options_ = options;
   fit.sensor_z_mm_ = sampler.sensor_z_mm();
   fit.image_radius_mm_ = sampler.image_radius_mm();
@@ -172,13 +180,13 @@ LensFit LensFit::fit(const Prescription& lens, const LensFitOptions& options,
   fit.pupils_.entrance_per_stop = ep.magnification;
   fit.pupils_.z_exit_pupil_mm = xp.z_mm;
   fit.pupils_.exit_per_stop = xp.magnification;
-  fit.symmetry_ = symmetry_of(lens);
+  fit.symmetry_ = symmetry_of(subject);
   fit.pupils_x_ = fit.pupils_;
   if (const ParaxialSystem* x = sampler.paraxial_x()) {
     fit.pupils_x_ = Pupils{x->entrance_pupil().z_mm, x->entrance_pupil().magnification, x->exit_pupil().z_mm,
                            x->exit_pupil().magnification};
   }
-  const Surface& front = lens.surfaces.front();
+  const Surface& front = subject.surfaces.front();
   fit.set_front_surface(FrontSurface{front.kind, front.curvature_per_mm, front.conic, front.even_asphere,
                                      front.curvature_x_per_mm, front.conic_x});
 
@@ -232,7 +240,7 @@ LensFit LensFit::fit(const Prescription& lens, const LensFitOptions& options,
   }
   FitOptions fo;
   fo.max_degree = options.degree;
-  fit.term_budget_ = options.terms > 0 ? options.terms : automatic_term_budget(lens.surfaces.size(), fit.symmetry_);
+  fit.term_budget_ = options.terms > 0 ? options.terms : automatic_term_budget(subject.surfaces.size(), fit.symmetry_);
   fo.max_terms = fit.term_budget_;
   fo.max_selection_samples = kSelectionSamples;
   // One fit of each map in the form the lens's symmetry calls for.
@@ -275,8 +283,7 @@ FitTrace LensFit::evaluate(const FittedMap& map, const FittedMap& clip, double p
   t.stop_x_mm = at[0];
   t.stop_y_mm = at[1];
   for (std::size_t q = 0; q < k; ++q) {
-    const double limit = q == 0 && stop_radius_mm ? *stop_radius_mm : clip_[q].semi_diameter_mm;
-    t.clearance = std::min(t.clearance, 1.0 - std::hypot(at[2 * q], at[2 * q + 1]) / limit);
+    t.clearance = std::min(t.clearance, clip_[q].clearance(at[2 * q], at[2 * q + 1], q == 0 ? stop_radius_mm : std::nullopt));
   }
   t.passes = t.ray.dx * t.ray.dx + t.ray.dy * t.ray.dy < 1.0 && t.clearance >= 0.0;
   return t;

@@ -1,7 +1,7 @@
 // Which clear apertures a fit clips at (lens_fit_stages.h): the stop, and every surface whose clear
-// aperture cuts enough of the sampled beam to change a rendered image. At run time a ray passes when
-// its fitted crossing of each lies within that surface's semi-diameter, so vignetting comes from the
-// prescription's clear apertures, not from a polynomial's values.
+// aperture (or explicit aperture: a central obscuration) cuts enough of the sampled beam to change a
+// rendered image. At run time a ray passes when its fitted crossing of each passes that surface's
+// aperture, so vignetting comes from the prescription's apertures, not from a polynomial's values.
 #include <cmath>
 
 #include "lens_fit_stages.h"
@@ -15,16 +15,17 @@ constexpr double kClipFraction = 5e-4;
 }  // namespace
 
 std::vector<ClipSurface> choose_clip_surfaces(const RaySampler& sampler, std::span<const Candidate> train) {
-  const std::vector<double>& semi_diameter = sampler.semi_diameters();
+  const std::vector<ClipSurface>& apertures = sampler.apertures();
   const std::size_t stop_index = static_cast<std::size_t>(sampler.stop_surface() - 1);
-  std::vector<ClipSurface> clip{{sampler.stop_surface(), sampler.stop_radius_mm()}};
-  for (std::size_t k = 0; k < semi_diameter.size(); ++k) {
-    if (k == stop_index || !std::isfinite(semi_diameter[k])) continue;
+  std::vector<ClipSurface> clip{apertures[stop_index]};
+  for (std::size_t k = 0; k < apertures.size(); ++k) {
+    const ClipSurface& a = apertures[k];
+    if (k == stop_index || (!a.aperture && !std::isfinite(a.semi_diameter_mm))) continue;
     std::size_t cut = 0;
-    for (const Candidate& c : train) cut += std::hypot(c.hit_x[k], c.hit_y[k]) > semi_diameter[k] ? 1 : 0;
+    for (const Candidate& c : train) cut += a.clearance(c.hit_x[k], c.hit_y[k]) < 0.0 ? 1 : 0;
     if (static_cast<double>(cut) >= kClipFraction * static_cast<double>(train.size()) &&
         clip.size() < static_cast<std::size_t>(kMaxMapOutputs)) {
-      clip.push_back({static_cast<int>(k + 1), semi_diameter[k]});
+      clip.push_back(a);
     }
   }
   return clip;

@@ -11,7 +11,9 @@
 #include "lensmith/core/json_text.h"
 #include "lensmith/core/located_json.h"
 #include "lensmith/core/text_file.h"
+#include "lensmith/core/units.h"
 #include "lensmith/polyfit/lens_fit.h"
+#include "lensmith/prescription/surface_aperture_json.h"
 
 namespace lensmith {
 namespace {
@@ -234,7 +236,13 @@ std::string LensFit::to_json() const {
   root["sensor_plane_z_mm"] = sensor_z_mm_;
   root["image_radius_mm"] = image_radius_mm_;
   json clip = json::array();
-  for (const ClipSurface& c : clip_) clip.push_back({{"surface", c.surface}, {"semi_diameter_mm", c.semi_diameter_mm}});
+  for (const ClipSurface& c : clip_) {
+    json entry = {{"surface", c.surface}};
+    // An explicit aperture clips instead of the semi-diameter, which may then be unlimited.
+    if (std::isfinite(c.semi_diameter_mm)) entry["semi_diameter_mm"] = c.semi_diameter_mm;
+    if (c.aperture) entry["aperture"] = surface_aperture_json<json>(*c.aperture);
+    clip.push_back(entry);
+  }
   root["clip_surfaces"] = clip;
   root["scales"] = {{"sensor_position_mm", scales_.sensor_position_mm},
                     {"sensor_direction", scales_.sensor_direction},
@@ -345,8 +353,14 @@ LensFit LensFit::parse(std::string_view text, const std::string& file_name) {
                        top.child_path("clip_surfaces") + "[" + std::to_string(q) + "]");
     ClipSurface s;
     s.surface = in.integer(c, "surface", 1, 100000);
-    s.semi_diameter_mm = in.positive(c, "semi_diameter_mm");
-    c.finish({"surface", "semi_diameter_mm"});
+    if (c.get("aperture")) {
+      if (q == 0) c.fail("aperture", "the stop clips as a circle: an explicit aperture is for the other surfaces");
+      s.aperture = read_surface_aperture(doc, c.child_pointer("aperture"), c.child_path("aperture"));
+      s.semi_diameter_mm = c.has("semi_diameter_mm") ? in.positive(c, "semi_diameter_mm") : kInfinity;
+    } else {
+      s.semi_diameter_mm = in.positive(c, "semi_diameter_mm");
+    }
+    c.finish({"surface", "semi_diameter_mm", "aperture"});
     fit.clip_.push_back(s);
   }
   {

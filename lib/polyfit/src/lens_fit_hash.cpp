@@ -8,7 +8,11 @@
 
 namespace lensmith {
 
-std::string LensFit::prescription_hash(const Prescription& lens) {
+std::string LensFit::prescription_hash(const Prescription& given) {
+  // The coaxial core's (a tilt-shift lens's breaks are applied where the fit is used, not fitted: one fit
+  // serves every tilt and shift of the same elements).
+  const std::optional<CoaxialCore> core = coaxial_core(given);
+  const Prescription& lens = core ? core->lens : given;
   // FNV-1a, 64 bit (Fowler, Noll & Vo), over the numbers the rays see.
   std::uint64_t h = 0xcbf29ce484222325ull;
   auto mix = [&](double v) {
@@ -35,6 +39,14 @@ std::string LensFit::prescription_hash(const Prescription& lens) {
       mix(s.conic_x);
     }
     for (const double nm : {380.0, kWavelengthD_nm, 780.0}) mix(s.medium.index(nm));
+    // A mirror, and an explicit aperture other than the stop's (they clip instead of the semi-diameter):
+    // mixed only where present, for the same reason.
+    if (s.mirror) mix(-2.0);
+    if (s.aperture && static_cast<int>(k + 1) != stop) {
+      const SurfaceAperture& a = *s.aperture;
+      mix(static_cast<double>(static_cast<int>(a.shape)));
+      for (const double v : {a.obscuration ? 1.0 : 0.0, a.min_radius_mm, a.half_x_mm, a.half_y_mm, a.decenter_x_mm, a.decenter_y_mm}) mix(v);
+    }
   }
   char text[17];
   std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));

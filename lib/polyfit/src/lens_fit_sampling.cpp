@@ -52,7 +52,10 @@ RaySampler::RaySampler(const Prescription& lens, const LensFitOptions& options)
   }
   sampled_pupil_radius_mm_ = options.pupil_margin * pupil_radius_mm;
   for (std::size_t k = 0; k < lens.surfaces.size(); ++k) {
-    semi_diameter_.push_back(k == stop_index ? stop_radius_mm_ : lens.surfaces[k].semi_diameter_mm.value_or(kInfinity));
+    const Surface& s = lens.surfaces[k];
+    ClipSurface c{static_cast<int>(k + 1), k == stop_index ? stop_radius_mm_ : s.semi_diameter_mm.value_or(kInfinity), std::nullopt};
+    if (k != stop_index && s.aperture) c.aperture = *s.aperture;
+    apertures_.push_back(c);
   }
 }
 
@@ -77,7 +80,7 @@ Candidate RaySampler::make(std::uint64_t stream, std::uint64_t index, std::vecto
   ray.wavelength_nm = c.wavelength_nm;
   const TraceResult t = tracer_.trace_backward(ray, &path);
   if (!t.ok()) return c;
-  const std::size_t surfaces = semi_diameter_.size();
+  const std::size_t surfaces = apertures_.size();
   c.hit_x.assign(surfaces, 0.0);
   c.hit_y.assign(surfaces, 0.0);
   c.in_domain = c.passes = true;
@@ -87,9 +90,12 @@ Candidate RaySampler::make(std::uint64_t stream, std::uint64_t index, std::vecto
     const std::size_t k = static_cast<std::size_t>(h.surface - 1);
     c.hit_x[k] = h.point_mm.x();
     c.hit_y[k] = h.point_mm.y();
+    const ClipSurface& a = apertures_[k];
     const double r = std::hypot(h.point_mm.x(), h.point_mm.y());
-    c.passes = c.passes && r <= semi_diameter_[k];
-    c.in_domain = c.in_domain && r <= options_.aperture_margin * semi_diameter_[k];
+    c.passes = c.passes && a.clearance(h.point_mm.x(), h.point_mm.y()) >= 0.0;
+    // The domain is the beam's outline: a ray in an obscuration's shadow stays in it (the clipping
+    // near the shadow's edge needs the maps there).
+    c.in_domain = c.in_domain && r <= options_.aperture_margin * (a.aperture ? a.aperture->outer_radius_mm() : a.semi_diameter_mm);
   }
   // The object-space ray, as light travels it, where it meets surface 1.
   const Eigen::Vector3d f = -t.ray.direction;

@@ -30,7 +30,9 @@ double median_seconds(int runs, F f) {
 void LensFit::measure_speed(const Prescription& lens) {
   check_matches(lens);
   using polyfit_detail::Candidate;
-  const polyfit_detail::RaySampler sampler(lens, options_);
+  const std::optional<CoaxialCore> core = coaxial_core(lens);  // what the maps describe
+  if (!core) throw OptionsError("LensFit::measure_speed: '" + lens.name + "' " + why_not_fittable(lens).value_or("cannot be fitted"));
+  const polyfit_detail::RaySampler sampler(core->lens, options_);
   const std::size_t wanted = static_cast<std::size_t>(options_.test_rays);
   const std::vector<Candidate> rays = sampler.collect(
       polyfit_detail::stream_of(options_.seed, polyfit_detail::Stream::Speed), wanted,

@@ -50,8 +50,8 @@ inline bool in_domain(const PolyPoint& v) {
 // One traced candidate of the sampled beam.
 struct Candidate {
   // Both false when the unclipped trace did not reach object space (a miss, total internal reflection).
-  bool in_domain = false;   // within every clear aperture enlarged by the margin
-  bool passes = false;      // within every clear aperture
+  bool in_domain = false;   // within every clear aperture enlarged by the margin (obscurations aside)
+  bool passes = false;      // through every clear aperture
   PlaneRay sensor;
   PlaneRay outer;
   double wavelength_nm = 0.0;
@@ -75,8 +75,10 @@ class RaySampler {
   double image_radius_mm() const { return image_radius_mm_; }
   int stop_surface() const { return paraxial_.stop_surface(); }  // 1-based
   double stop_radius_mm() const { return stop_radius_mm_; }
-  // Per surface (index surface - 1): the clear semi-diameter, +inf when unlimited, the stop's as sampled.
-  const std::vector<double>& semi_diameters() const { return semi_diameter_; }
+  // Per surface (index surface - 1): what clips there, as the exact tracer clips: the surface's explicit
+  // aperture where it has one (not at the stop), else its semi-diameter (+inf when unlimited; the
+  // stop's as sampled).
+  const std::vector<ClipSurface>& apertures() const { return apertures_; }
 
   // Candidate `index` of stream `stream` (its own SplitMix64 sequence: the same whatever the thread).
   Candidate make(std::uint64_t stream, std::uint64_t index, std::vector<SurfaceHit>& path) const;
@@ -118,14 +120,14 @@ class RaySampler {
   double image_radius_mm_ = 0.0;
   double stop_radius_mm_ = 0.0;
   double sampled_pupil_radius_mm_ = 0.0;
-  std::vector<double> semi_diameter_;
+  std::vector<ClipSurface> apertures_;
 };
 
 // The candidate streams of a seed: training, held-out test and speed rays never share a candidate.
 enum class Stream { Training, Test, Speed };
 std::uint64_t stream_of(std::uint64_t seed, Stream which);
 
-// The clipping set: the stop first, then every surface whose clear aperture cuts at least
+// The clipping set: the stop first, then every surface whose clear aperture (or explicit aperture) cuts at least
 // kClipFraction of the training rays (at most kMaxMapOutputs in all).
 std::vector<ClipSurface> choose_clip_surfaces(const RaySampler& sampler, std::span<const Candidate> train);
 

@@ -8,6 +8,7 @@
 #include "lensmith/core/json_text.h"
 #include "lensmith/core/located_json.h"
 #include "lensmith/core/units.h"
+#include "lensmith/prescription/surface_aperture_json.h"
 
 namespace lensmith {
 
@@ -170,37 +171,6 @@ std::optional<FieldSpec> read_field(const LocatedJson& doc, JsonObjectReader& to
   return f;
 }
 
-// A surface's explicit aperture: {"shape": "circular", "radius_mm": 12, "min_radius_mm": 3} or
-// {"shape": "rectangular"|"elliptical", "half_x_mm", "half_y_mm"}, with "obscuration" and decentres.
-SurfaceAperture read_surface_aperture(const LocatedJson& doc, const std::string& pointer, const std::string& path) {
-  JsonObjectReader r(doc, pointer, path);
-  SurfaceAperture a;
-  const std::string shape = r.get_optional_string("shape").value_or("circular");
-  if (shape == "circular") {
-    a.shape = SurfaceAperture::Shape::Circular;
-    a.half_x_mm = a.half_y_mm = r.get_number("radius_mm");
-    if (!(a.half_x_mm > 0.0)) r.fail("radius_mm", "must be > 0");
-    if (r.has("half_x_mm") || r.has("half_y_mm")) r.fail("half_x_mm", "a circular aperture has radius_mm, not half widths");
-    a.min_radius_mm = r.get_optional_number("min_radius_mm").value_or(0.0);
-    if (!(a.min_radius_mm >= 0.0 && a.min_radius_mm < a.half_x_mm)) r.fail("min_radius_mm", "must lie in [0, radius_mm)");
-  } else if (shape == "rectangular" || shape == "elliptical") {
-    a.shape = shape == "rectangular" ? SurfaceAperture::Shape::Rectangular : SurfaceAperture::Shape::Elliptical;
-    a.half_x_mm = r.get_number("half_x_mm");
-    a.half_y_mm = r.get_number("half_y_mm");
-    if (!(a.half_x_mm > 0.0)) r.fail("half_x_mm", "must be > 0");
-    if (!(a.half_y_mm > 0.0)) r.fail("half_y_mm", "must be > 0");
-    if (r.has("radius_mm") || r.has("min_radius_mm")) r.fail("radius_mm", "a " + shape + " aperture has half_x_mm and half_y_mm");
-  } else {
-    r.fail("shape", "expected \"circular\", \"rectangular\" or \"elliptical\", got \"" + shape + "\"");
-  }
-  a.obscuration = r.get_optional_bool("obscuration").value_or(false);
-  if (a.obscuration && a.min_radius_mm > 0.0) r.fail("min_radius_mm", "an obscuration has no inner radius");
-  a.decenter_x_mm = r.get_optional_number("decenter_x_mm").value_or(0.0);
-  a.decenter_y_mm = r.get_optional_number("decenter_y_mm").value_or(0.0);
-  r.finish(kApertureKeys);
-  return a;
-}
-
 // A radius (mm) or "flat" as a curvature (1/mm).
 double read_radius(JsonObjectReader& r, const std::string& key) {
   const json* v = r.get(key);
@@ -325,6 +295,35 @@ Surface read_surface(const LocatedJson& doc, const std::string& pointer, const s
 }
 
 }  // namespace
+
+SurfaceAperture read_surface_aperture(const LocatedJson& doc, const std::string& pointer, const std::string& path) {
+  JsonObjectReader r(doc, pointer, path);
+  SurfaceAperture a;
+  const std::string shape = r.get_optional_string("shape").value_or("circular");
+  if (shape == "circular") {
+    a.shape = SurfaceAperture::Shape::Circular;
+    a.half_x_mm = a.half_y_mm = r.get_number("radius_mm");
+    if (!(a.half_x_mm > 0.0)) r.fail("radius_mm", "must be > 0");
+    if (r.has("half_x_mm") || r.has("half_y_mm")) r.fail("half_x_mm", "a circular aperture has radius_mm, not half widths");
+    a.min_radius_mm = r.get_optional_number("min_radius_mm").value_or(0.0);
+    if (!(a.min_radius_mm >= 0.0 && a.min_radius_mm < a.half_x_mm)) r.fail("min_radius_mm", "must lie in [0, radius_mm)");
+  } else if (shape == "rectangular" || shape == "elliptical") {
+    a.shape = shape == "rectangular" ? SurfaceAperture::Shape::Rectangular : SurfaceAperture::Shape::Elliptical;
+    a.half_x_mm = r.get_number("half_x_mm");
+    a.half_y_mm = r.get_number("half_y_mm");
+    if (!(a.half_x_mm > 0.0)) r.fail("half_x_mm", "must be > 0");
+    if (!(a.half_y_mm > 0.0)) r.fail("half_y_mm", "must be > 0");
+    if (r.has("radius_mm") || r.has("min_radius_mm")) r.fail("radius_mm", "a " + shape + " aperture has half_x_mm and half_y_mm");
+  } else {
+    r.fail("shape", "expected \"circular\", \"rectangular\" or \"elliptical\", got \"" + shape + "\"");
+  }
+  a.obscuration = r.get_optional_bool("obscuration").value_or(false);
+  if (a.obscuration && a.min_radius_mm > 0.0) r.fail("min_radius_mm", "an obscuration has no inner radius");
+  a.decenter_x_mm = r.get_optional_number("decenter_x_mm").value_or(0.0);
+  a.decenter_y_mm = r.get_optional_number("decenter_y_mm").value_or(0.0);
+  r.finish(kApertureKeys);
+  return a;
+}
 
 LensReadResult read_lens_json(std::string_view text, const std::string& file_name, const GlassCatalog& catalogue) {
   const LocatedJson doc = LocatedJson::parse(text, file_name);
@@ -533,23 +532,7 @@ std::string write_lens_json(const Prescription& p) {
     }
     if (s.semi_diameter_mm) j["semi_diameter_mm"] = *s.semi_diameter_mm;
     if (s.semi_diameter_mm && !s.clips_rays) j["clips_rays"] = false;
-    if (s.aperture) {
-      const SurfaceAperture& a = *s.aperture;
-      ojson ap;
-      if (a.shape == SurfaceAperture::Shape::Circular) {
-        ap["shape"] = "circular";
-        ap["radius_mm"] = a.half_x_mm;
-        if (a.min_radius_mm > 0.0) ap["min_radius_mm"] = a.min_radius_mm;
-      } else {
-        ap["shape"] = a.shape == SurfaceAperture::Shape::Rectangular ? "rectangular" : "elliptical";
-        ap["half_x_mm"] = a.half_x_mm;
-        ap["half_y_mm"] = a.half_y_mm;
-      }
-      if (a.obscuration) ap["obscuration"] = true;
-      if (a.decenter_x_mm != 0.0) ap["decenter_x_mm"] = a.decenter_x_mm;
-      if (a.decenter_y_mm != 0.0) ap["decenter_y_mm"] = a.decenter_y_mm;
-      j["aperture"] = ap;
-    }
+    if (s.aperture) j["aperture"] = surface_aperture_json<ojson>(*s.aperture);
     if (s.is_stop) j["stop"] = true;
     if (s.conic != 0.0) j["conic"] = s.conic;
     if (s.has_asphere()) {

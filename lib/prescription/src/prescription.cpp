@@ -133,6 +133,24 @@ std::optional<std::string> Prescription::why_no_real_ray_aiming() const {
 
 double Prescription::last_vertex_z_mm() const { return surfaces.empty() ? 0.0 : vertex_z_mm(surfaces.size() - 1); }
 
+std::optional<CoaxialCore> coaxial_core(const Prescription& lens) {
+  const auto is_break = [](const Surface& s) { return s.is_coordinate_break(); };
+  const auto first = std::find_if_not(lens.surfaces.begin(), lens.surfaces.end(), is_break);
+  if (first == lens.surfaces.end()) return std::nullopt;
+  const auto last = std::find_if_not(lens.surfaces.rbegin(), lens.surfaces.rend(), is_break).base();  // one past
+  if (std::any_of(first, last, [](const Surface& s) { return s.is_coordinate_break() && !s.coordinate_break.is_identity(); })) {
+    return std::nullopt;
+  }
+  CoaxialCore core{static_cast<std::size_t>(first - lens.surfaces.begin()), lens};
+  core.lens.surfaces.assign(first, last);
+  double leading_mm = 0.0, trailing_mm = 0.0;
+  for (auto s = lens.surfaces.begin(); s != first; ++s) leading_mm += s->thickness_mm;
+  for (auto s = last; s != lens.surfaces.end(); ++s) trailing_mm += s->thickness_mm;
+  if (std::isfinite(core.lens.object_distance_mm)) core.lens.object_distance_mm += leading_mm;
+  core.lens.surfaces.back().thickness_mm += trailing_mm;
+  return core;
+}
+
 Diagnostics Prescription::geometry_warnings() const {
   Diagnostics out;
   // Built member by member: GCC 12 at -O2 takes the aggregate's empty SourceLocation for

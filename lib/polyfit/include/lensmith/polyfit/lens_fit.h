@@ -25,14 +25,18 @@
 // The ray maps and the clipping maps have separate term sets so the hot path (a ray from one plane
 // to the other) pays only for its own outputs.
 // Clipping surfaces are the stop and every surface whose clear aperture cuts rays of the sampled
-// beam; at run time a ray passes when its fitted position on each lies within the semi-diameter, so
-// vignetting comes from the prescription's clear apertures, not from the polynomial's values.
+// beam; at run time a ray passes when its fitted position on each lies within the semi-diameter (or
+// passes the surface's explicit aperture: a mirror lens's central obscuration), so vignetting comes
+// from the prescription's clear apertures, not from the polynomial's values.
+// Mirror lenses fit as any other (the maps do not care how often the light turned on its way), as long
+// as the image faces the way the light came from the scene: an even number of mirrors on one axis.
 //
 // Inputs are normalised to about [-1, 1] (positions by the largest training position, directions by
 // the largest training direction, wavelength by the fitted range); the scales are part of the fit.
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -89,6 +93,16 @@ struct PlaneRay {
 struct ClipSurface {
   int surface = 0;               // 1-based
   double semi_diameter_mm = 0.0; // the prescription's (for the stop: its wide-open radius)
+  // The surface's explicit aperture (a mirror lens's central obscuration, an annulus, a rectangle),
+  // which clips instead of the circle of semi_diameter_mm, as the exact tracer's does; empty = the
+  // circle. Never set for the stop (a camera opens it as a circle).
+  std::optional<SurfaceAperture> aperture;
+  // How far inside what passes a crossing at (x, y) (mm) lies (SurfaceAperture::clearance; 1 - r / R
+  // for the circle of radius `radius_mm`, the semi-diameter unless given): < 0 where it is stopped.
+  double clearance(double x_mm, double y_mm, std::optional<double> radius_mm = std::nullopt) const {
+    if (aperture) return aperture->clearance(x_mm, y_mm);
+    return 1.0 - std::hypot(x_mm, y_mm) / radius_mm.value_or(semi_diameter_mm);
+  }
   friend bool operator==(const ClipSurface&, const ClipSurface&) = default;
 };
 
@@ -176,10 +190,11 @@ std::string_view to_string(LensSymmetry symmetry);  // "rotational", "section mi
 
 class LensFit {
  public:
-  // Why `lens` cannot be fitted (empty: it can): fits of mirrors and of coordinate breaks (tilts,
-  // decentres) are not implemented, and surface 1 must be a real surface (the outer pupil). A coaxial lens
-  // of standard, toroidal and biconic surfaces keeps both section mirrors and is fitted. Explicit aperture
-  // shapes are not refused here: the fit clips at circles of the semi-diameters (docs/polyfit.md).
+  // Why `lens` cannot be fitted (empty: it can). A fit describes the lens's coaxial core (coaxial_core:
+  // all of it, or a tilt-shift lens's elements between the coordinate breaks at its ends, which are
+  // applied exactly where the fit is used); a break between elements (a fold, an element tilted inside)
+  // and an odd number of mirrors (the image facing the scene) are not implemented. Standard, toroidal
+  // and biconic surfaces, mirrors and explicit apertures (central obscurations) are fitted.
   static std::optional<std::string> why_not_fittable(const Prescription& lens);
   // The symmetry the maps of `lens` are written for (why_not_fittable must be empty).
   static LensSymmetry symmetry_of(const Prescription& lens);
@@ -204,8 +219,10 @@ class LensFit {
   std::string to_json() const;
   void write(const std::string& path) const;
 
-  // 16 hex digits identifying what the rays see of a prescription: every surface's shape, spacing,
-  // clear aperture (the stop's excepted: an f-number changes it) and index at 380, 587.56 and 780 nm.
+  // 16 hex digits identifying what the rays see of a prescription's coaxial core (the whole lens but a
+  // tilt-shift lens's breaks at its ends: one fit serves every tilt and shift of the same elements):
+  // every surface's shape, spacing, clear aperture (the stop's excepted: an f-number changes it),
+  // mirrors, explicit apertures and index at 380, 587.56 and 780 nm.
   static std::string prescription_hash(const Prescription& lens);
   // Throws OptionsError when `lens` is not the prescription this fit was made from.
   void check_matches(const Prescription& lens) const;

@@ -169,4 +169,21 @@ struct Prescription {
   friend std::ostream& operator<<(std::ostream& os, const Prescription& p) { return os << p.to_string(); }
 };
 
+// The surfaces of a lens between the coordinate breaks at its ends, as a coaxial lens of their own: a
+// tilt-shift lens's elements, turned or moved as a whole by the breaks before them and put square to the
+// camera's axis again by those after them. What a polynomial fit describes (docs/polyfit.md, "Tilt-shift
+// lenses"): the breaks are rigid motions, applied exactly where the fit is used.
+struct CoaxialCore {
+  std::size_t first = 0;  // 0-based index in the whole lens of the core's surface 1
+  // The core: the whole lens's surfaces from `first` to the last one that is not a coordinate break, with
+  // the lens's object space (its distance grown by the leading breaks' thicknesses), stop and wavelengths;
+  // the last surface's thickness grown by the trailing breaks' (the image distance along the core's axis).
+  Prescription lens;
+};
+
+// The core of `lens`; the lens itself (first = 0) when no break stands at its ends. Empty when a break that turns or
+// moves something lies between two surfaces that are not breaks (a fold inside the lens), or the lens
+// has no surface that is not a break.
+std::optional<CoaxialCore> coaxial_core(const Prescription& lens);
+
 }  // namespace lensmith
