@@ -811,6 +811,15 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     std::cerr << "warning: " << stats.unaimed_rays << " rays of the " << to_string(kind)
               << " model could not be aimed at their stop points and were drawn as stopped: a failure of the model, not the lens's vignetting\n";
   }
+  // A tilt, a shift or strong distortion photographs past the input's frame: the band between is made of
+  // copies of the input's edge (streaks). Below this share of the frame (the Canon 35 mm's distortion:
+  // 4.4 px of 427) it goes unremarked.
+  constexpr double kEdgeGapShare = 0.02;
+  if (stats.edge_gap_px > kEdgeGapShare * std::min(out.width, out.height) && !global.quiet) {
+    std::cerr << "note: the lens photographs up to " << format_rounded(stats.edge_gap_px, 3)
+              << " px past the input's edge (a tilt, a shift or distortion): that band repeats the input's edge pixels; "
+                 "render the input with overscan (docs/sequences.md, \"Overscan\")\n";
+  }
   return kExitOk;
 }
 

@@ -299,6 +299,7 @@ std::string BokehStatistics::to_string() const {
      << clamped_depths << " clamped depths, max |CoC| " << max_abs_coc_px << " px";
   if (deep_samples > 0) os << ", " << deep_samples << " deep samples, " << volume_slabs << " volume slabs";
   if (unaimed_rays > 0) os << ", " << unaimed_rays << " rays not aimed";
+  if (edge_gap_px > 0.0) os << ", input's edge " << edge_gap_px << " px inside the frame";
   os << ")";
   return os.str();
 }
@@ -326,6 +327,7 @@ Image render_bokeh(const Image& image, const DepthMap& depth, const RayModel& mo
   ScatterSources sources = render_detail::make_scatter_sources(image, depth, camera, options, threads, stats);
   if (options.split_edge_pixels) render_detail::split_mixed_pixels(sources, w, h, camera, threads, stats);
   const int margin = render_detail::frame_margin_px(model, 0.5 * stats.max_abs_coc_px);
+  stats.edge_gap_px = render_detail::frame_edge_gap_px(model);
   add_margin_sources(sources, w, h, margin);
   const DepthLayers layers = render_detail::make_depth_layers(sources, w, h, options.layer_spacing_px, options.max_layers);
   return render_sources(sources, layers, w, h, margin, model, aperture, options, stats);
@@ -347,6 +349,7 @@ Image render_bokeh(const DeepImage& deep, const RayModel& model, const Aperture&
   stats.volume_slabs = deep_sources.volume_slabs;
   const int margin = render_detail::frame_margin_px(model, 0.5 * stats.max_abs_coc_px);
   ScatterSources sources = std::move(deep_sources.sources);
+  stats.edge_gap_px = render_detail::frame_edge_gap_px(model);
   add_margin_sources(sources, deep.width, deep.height, margin);
   const DepthLayers layers = render_detail::make_depth_layers(sources, deep.width, deep.height, deep_sources.spacing);
   return render_sources(sources, layers, deep.width, deep.height, margin, model, aperture, options, stats);

@@ -15,12 +15,15 @@ constexpr double kNearestObjectMm = 1.0;
 constexpr int kClampBisections = 60;
 }  // namespace
 
-int frame_margin_px(const RayModel& model, double reach_px) {
-  constexpr double kMaxFrameMarginPx = 256.0, kTentPx = 2.0;
+namespace {
+
+// For the frame's edge midpoints and corners (output px) and where their chief rays land (output px;
+// NaN where the ray fails): reference wavelength, focus distance.
+template <class Visit>
+void map_frame_edges(const RayModel& model, Visit visit) {
   const Camera& camera = model.camera();
   const double w = camera.frame().width_px(), h = camera.frame().height_px();
   const double inverse = inverse_per_mm(camera.focus_distance_mm());
-  double shift = 0.0;
   static constexpr std::array<PupilPoint, 1> kCentre{{{0.0, 0.0}}};
   std::array<SensorHit, 1> hit;
   for (const PixelPoint at : {PixelPoint{0.0, 0.5 * h}, PixelPoint{w, 0.5 * h}, PixelPoint{0.5 * w, 0.0}, PixelPoint{0.5 * w, h},
@@ -29,10 +32,31 @@ int frame_margin_px(const RayModel& model, double reach_px) {
     model.map({t.x, t.y, inverse}, camera.reference_wavelength_nm(), kCentre, hit);
     if (!(hit[0].ok || hit[0].unclipped)) continue;
     const PixelPoint q = camera.output_pixel(hit[0].x_mm, hit[0].y_mm);
-    if (std::isfinite(q.x) && std::isfinite(q.y)) shift = std::max(shift, std::hypot(q.x - at.x, q.y - at.y));
+    if (std::isfinite(q.x) && std::isfinite(q.y)) visit(at, q);
   }
+}
+
+}  // namespace
+
+int frame_margin_px(const RayModel& model, double reach_px) {
+  constexpr double kMaxFrameMarginPx = 256.0, kTentPx = 2.0;
+  double shift = 0.0;
+  map_frame_edges(model, [&](const PixelPoint& at, const PixelPoint& q) { shift = std::max(shift, std::hypot(q.x - at.x, q.y - at.y)); });
   // (A shift of rounding size, a thin lens's, is none.)
   return static_cast<int>(std::min(std::ceil(std::max(0.0, reach_px + shift - 1e-6)) + kTentPx, kMaxFrameMarginPx));
+}
+
+double frame_edge_gap_px(const RayModel& model) {
+  const double w = model.camera().frame().width_px(), h = model.camera().frame().height_px();
+  double gap = 0.0;
+  map_frame_edges(model, [&](const PixelPoint& at, const PixelPoint& q) {
+    // Inwards from the edges the point lies on (a corner lies on two).
+    if (at.x == 0.0) gap = std::max(gap, q.x);
+    if (at.x == w) gap = std::max(gap, w - q.x);
+    if (at.y == 0.0) gap = std::max(gap, q.y);
+    if (at.y == h) gap = std::max(gap, h - q.y);
+  });
+  return gap;
 }
 
 double clamp_inverse_depth(const Camera& camera, double w, double max_blur_px, std::size_t& clamped) {

@@ -52,6 +52,12 @@ inline PixelPoint source_centre(const ScatterSource& s) {
 // covered only by inner points' blur (scatter: renormalised, their colour drifted to blue).
 int frame_margin_px(const RayModel& model, double reach_px);
 
+// How far inside the output frame the input's edge lands (output px, the largest over the edges'
+// midpoints and corners, as frame_margin_px maps them; 0 when the lens moves no edge inwards): a tilt,
+// a shift or distortion photographs beyond the input's frame there, and those pixels are made of the
+// margin's copies of the input's edge (streaks): an input with overscan is needed.
+double frame_edge_gap_px(const RayModel& model);
+
 // Inverse depth (1/mm) clamped to 1 mm in front of the lens and to `max_blur_px`; `clamped` counts
 // the changed ones.
 double clamp_inverse_depth(const Camera& camera, double inverse_depth_per_mm, double max_blur_px, std::size_t& clamped);

@@ -79,6 +79,9 @@ struct BokehStatistics {
   std::size_t deep_samples = 0;     // samples of a layered (deep) input
   std::size_t volume_slabs = 0;     // slabs its volumetric samples were cut into
   std::size_t unaimed_rays = 0;     // rays the model could not aim (RayModel::unaimed_rays), drawn as stopped
+  // How far inside the output frame the input's edge lands (output px; a tilt, shift or distortion moves
+  // it): the pixels outside it are copies of the input's edge. Render the input with overscan.
+  double edge_gap_px = 0.0;
   std::string to_string() const;
 };
 
