@@ -63,12 +63,12 @@ ExactModel::ExactModel(const Camera& camera) : RayModel(camera) {
   for (std::size_t k = 0; k < lens.surfaces.size(); ++k) {
     const Surface& s = lens.surfaces[k];
     if (s.aperture && static_cast<int>(k) + 1 != stop_surface_) {
-      apertures_.push_back({k, 0.0, *s.aperture});  // as the tracer clips: the explicit aperture instead of the circle
+      apertures_.push_back({static_cast<int>(k) + 1, 0.0, *s.aperture});  // as the tracer clips: the explicit aperture instead of the circle
       continue;
     }
     const std::optional<double>& r = s.semi_diameter_mm;
     if (!r || !(*r > 0.0)) continue;
-    apertures_.push_back({k, static_cast<int>(k) + 1 == stop_surface_ ? *r * (1.0 + kStopEdgeTolerance) : *r, std::nullopt});
+    apertures_.push_back({static_cast<int>(k) + 1, static_cast<int>(k) + 1 == stop_surface_ ? *r * (1.0 + kStopEdgeTolerance) : *r, std::nullopt});
   }
   z_stop_mm_ = free_->vertex_z_mm(stop_surface_);
   for (int k = 1; k <= static_cast<int>(lens.surfaces.size()); ++k) frames_.push_back(free_->surface_frame(k));
@@ -247,9 +247,10 @@ void ExactModel::map_raw(const ScenePoint& point, double wavelength_nm, std::spa
       continue;
     }
     double clearance = 1.0;
-    for (const Clip& c : apertures_) {
-      const Eigen::Vector3d p = frames_[c.surface].to_local(path[c.surface].point_mm);
-      clearance = std::min(clearance, c.aperture ? c.aperture->clearance(p.x(), p.y()) : 1.0 - std::hypot(p.x(), p.y()) / c.radius_mm);
+    for (const ClipSurface& c : apertures_) {
+      const std::size_t k = static_cast<std::size_t>(c.surface - 1);
+      const Eigen::Vector3d p = frames_[k].to_local(path[k].point_mm);
+      clearance = std::min(clearance, c.clearance(p.x(), p.y()));
     }
     hits[i] = SensorHit{f.ray.position_mm.x(), f.ray.position_mm.y(), clearance >= 0.0, true, weight, clearance};
   }

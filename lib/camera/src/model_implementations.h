@@ -22,7 +22,7 @@
 namespace lensmith::camera_detail {
 
 // Whether a surface of `lens` carries a central obscuration (an aperture that stops the rays inside it):
-// a mirror lens's secondary shadow, which only the exact model clips at.
+// a mirror lens's secondary shadow, which the paraxial and Seidel models cannot clip at.
 inline bool has_central_obscuration(const Prescription& lens) {
   return std::any_of(lens.surfaces.begin(), lens.surfaces.end(), [](const Surface& s) { return s.aperture && s.aperture->obscuration; });
 }
@@ -301,13 +301,9 @@ class ExactModel final : public RayModel {
 
   std::shared_ptr<const SequentialTracer> free_;     // no clipping: aiming and the final trace
   std::shared_ptr<const RayAimer> aimer_;            // on free_, real-stop aiming: where the beam's own aim fails
-  // Clipping surfaces: 0-based index and semi-diameter (mm), or an explicit aperture (a central obscuration).
-  struct Clip {
-    std::size_t surface = 0;
-    double radius_mm = 0.0;
-    std::optional<SurfaceAperture> aperture;
-  };
-  std::vector<Clip> apertures_;
+  // Clipping surfaces, as a fit's (lens_fit.h): semi-diameter (mm; the stop's with its edge tolerance) or
+  // an explicit aperture (a central obscuration).
+  std::vector<ClipSurface> apertures_;
   std::vector<SurfaceFrame> frames_;  // where each surface lies (apertures clip in their surface's frame)
   SurfaceFrame stop_frame_;
   int stop_surface_ = 0;                             // 1-based
@@ -317,19 +313,16 @@ class ExactModel final : public RayModel {
   mutable std::atomic<std::size_t> unaimed_{0};
 };
 
-// poly: a polynomial fit of the lens (lens_fit.h). Each pupil point is aimed by Newton steps on the
-// fit's outer -> stop map from the scene point, then carried to the sensor by the outer -> sensor map
-// and a straight line from the fit's sensor plane to the camera's; clipping by the fitted positions on
-// the clear apertures and the stop at the camera's f-number.
 // Where a fit's coaxial core (LensFit: the lens without the coordinate breaks at its ends) lies in a
-// camera: where its surface 1 lies and how it is turned, and the camera's sensor plane, both in the
-// global frame of the lens (surface_frames). For most lenses the core is the lens and both frames are
-// the axis's own (`moved` false); a tilt-shift lens's core is turned or moved by the breaks before it.
+// camera: its surface 1's vertex and axes in the global frame of the lens (surface_frames), and the same
+// frame seen from the camera's sensor plane (its vertex and axes in the sensor's frame, as the exact
+// tracer places the sensor). For most lenses the core is the lens and both are the axis's own (`moved`
+// false); a tilt-shift lens's core is turned or moved by the breaks before it.
 struct CorePlacement {
   std::size_t first = 0;  // 0-based index in the camera's lens of the core's surface 1
   bool moved = false;     // the core or the sensor plane is turned or moved off the axis
-  SurfaceFrame core;
-  SurfaceFrame sensor;
+  SurfaceFrame core;            // global
+  SurfaceFrame core_in_sensor;  // in the sensor's frame
   // Throws OptionsError when the camera's lens has no coaxial core (LensFit::why_not_fittable).
   static CorePlacement of(const Camera& camera);
   // The farthest corner of the camera's frame from the core's axis, mm (on the sensor plane; the fit's
@@ -337,6 +330,10 @@ struct CorePlacement {
   double frame_reach_mm(const Camera& camera) const;
 };
 
+// poly: a polynomial fit of the lens (lens_fit.h). Each pupil point is aimed by Newton steps on the
+// fit's outer -> stop map from the scene point, then carried to the sensor by the outer -> sensor map
+// and a straight line from the fit's sensor plane to the camera's; clipping by the fitted positions on
+// the clear apertures and the stop at the camera's f-number.
 class PolyModel final : public RayModel {
  public:
   PolyModel(const Camera& camera, std::shared_ptr<const LensFit> fit);

@@ -21,9 +21,11 @@ CorePlacement CorePlacement::of(const Camera& camera) {
   // The frames as the exact model's tracer places them (its image plane at the camera's sensor).
   const LensFrames frames = surface_frames(lens, camera.z_sensor_mm() - lens.last_vertex_z_mm());
   placement.core = frames.surfaces[core->first];
-  placement.sensor = frames.image;
+  const SurfaceFrame& sensor = frames.image;
+  placement.core_in_sensor.axes = sensor.axes.transpose() * placement.core.axes;
+  placement.core_in_sensor.origin_mm = sensor.to_local(placement.core.origin_mm);
   const bool axis_own = placement.core.axes.isIdentity(0.0) && placement.core.origin_mm.isZero(0.0) &&
-                        placement.sensor.axes.isIdentity(0.0) && placement.sensor.origin_mm.head<2>().isZero(0.0);
+                        sensor.axes.isIdentity(0.0) && sensor.origin_mm.head<2>().isZero(0.0);
   placement.moved = !axis_own;
   return placement;
 }
@@ -34,7 +36,7 @@ double CorePlacement::frame_reach_mm(const Camera& camera) const {
   for (const PixelPoint corner : {PixelPoint{0.0, 0.0}, PixelPoint{w, 0.0}, PixelPoint{0.0, h}, PixelPoint{w, h}}) {
     const auto [x, y] = camera.sensor_point_mm(corner);
     // On the core's axis: a tilt turns the sensor by a few degrees, a shift moves the frame across the image circle.
-    const Eigen::Vector3d in_core = core.to_local(sensor.to_global(Eigen::Vector3d(x, y, 0.0)));
+    const Eigen::Vector3d in_core = core_in_sensor.to_local(Eigen::Vector3d(x, y, 0.0));
     reach = std::max(reach, std::hypot(in_core.x(), in_core.y()));
   }
   return reach;
@@ -176,9 +178,8 @@ void PolyModel::map_raw(const ScenePoint& camera_point, double wavelength_nm, st
       continue;
     }
     // From the fit's sensor plane in the core's frame, in a straight line (air) to the camera's sensor.
-    const Eigen::Vector3d from =
-        placement_.sensor.to_local(placement_.core.to_global(Eigen::Vector3d(t.ray.x_mm, t.ray.y_mm, fit_->sensor_plane_z_mm())));
-    const Eigen::Vector3d along = placement_.sensor.axes.transpose() * (placement_.core.axes * Eigen::Vector3d(t.ray.dx, t.ray.dy, dz));
+    const Eigen::Vector3d from = placement_.core_in_sensor.to_global(Eigen::Vector3d(t.ray.x_mm, t.ray.y_mm, fit_->sensor_plane_z_mm()));
+    const Eigen::Vector3d along = placement_.core_in_sensor.axes * Eigen::Vector3d(t.ray.dx, t.ray.dy, dz);
     if (!(along.z() > 0.0)) {
       hits[i] = {};
       continue;

@@ -72,7 +72,7 @@ LensFitOptions lens_fit_options_for(const Camera& camera) {
   // infinity) sees it about as far out, and the margin covers the difference.
   // A tilt-shift lens's frame measured from its core's axis (a shift moves it across the image circle).
   constexpr double kFrameMargin = 1.15;
-  const double reach_mm = camera.is_thin_lens() || !coaxial_core(*camera.lens())
+  const double reach_mm = camera.is_thin_lens()
                               ? 0.5 * std::hypot(camera.frame().width_px(), camera.frame().height_px()) / std::abs(camera.px_per_sensor_mm())
                               : camera_detail::CorePlacement::of(camera).frame_reach_mm(camera);
   o.image_radius_mm = std::max(LensFitOptions::kDefaultImageRadiusMm, kFrameMargin * reach_mm);

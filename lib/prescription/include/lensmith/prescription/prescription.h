@@ -181,9 +181,9 @@ struct CoaxialCore {
   Prescription lens;
 };
 
-// The core of `lens`; the lens itself (first = 0) when no break stands at its ends. Empty when a break that turns or
-// moves something lies between two surfaces that are not breaks (a fold inside the lens), or the lens
-// has no surface that is not a break.
+// The core of `lens`; the lens itself (first = 0) when no break stands at its ends. Empty when a break
+// that turns or moves something lies between two surfaces that are not breaks (a fold inside the lens),
+// or the lens has no surface that is not a break.
 std::optional<CoaxialCore> coaxial_core(const Prescription& lens);
 
 }  // namespace lensmith
