@@ -483,3 +483,60 @@ TEST_CASE("splat buffer at 1/2 and 1/4 resolution: a large disc keeps its value 
   bad.downsample = 9;
   CHECK_THROWS_WITH(bad.validate(), Contains("SplatOptions::downsample = 9: must lie in [1, 8]"));
 }
+
+TEST_CASE("difference stamp: added at whole-pixel anchors it deposits what add_polygon deposits for the polygon moved there, edges and bands included", "[render][splat][stamp]") {
+  // The same sub-rows at the same global positions and the same span ends (moved by whole pixels;
+  // vertices on a 1/1024 px grid, so that moving them is exact in float): only the order of the
+  // double additions and float output rounding differ.
+  constexpr double kStampRoundoff = 1e-6;
+  auto snapped = [](std::vector<Point2f> polygon) {
+    for (Point2f& p : polygon) p = {std::round(p.x * 1024.0f) / 1024.0f, std::round(p.y * 1024.0f) / 1024.0f};
+    return polygon;
+  };
+  constexpr int kWidth = 90;
+  constexpr int kHeight = 70;
+  for (const int subrows : {1, 4, 8, 16}) {
+    INFO("sub-rows " << subrows);
+    SplatOptions options;
+    options.subrows = subrows;
+    const std::vector<Point2f> polygons[] = {snapped(disc(0.5, 0.5, 13.0, 48)), snapped(disc(0.5, 0.5, 0.9, 12, 0.3)),
+                                             {{0.5f, -6.0f}, {9.0f, 4.5f}, {-3.25f, 2.0f}}};
+    for (const std::vector<Point2f>& polygon : polygons) {
+      const DifferenceStamp stamp = SplatBuffer::record(polygon, subrows);
+      REQUIRE(stamp.entries() > 0);
+      // Anchors inside, over the left, right, top and bottom edges, and wholly outside.
+      const int anchors[][2] = {{40, 30}, {1, 20}, {88, 50}, {30, 0}, {60, 69}, {-40, 30}, {45, 120}};
+      SplatBuffer by_polygon(kWidth, 0, kHeight, options);
+      std::vector<SplatBuffer> by_stamp_bands;
+      by_stamp_bands.emplace_back(kWidth, 0, 23, options);
+      by_stamp_bands.emplace_back(kWidth, 23, kHeight, options);
+      for (const auto& a : anchors) {
+        std::vector<Point2f> moved = polygon;
+        for (Point2f& p : moved) p = {p.x + static_cast<float>(a[0]), p.y + static_cast<float>(a[1])};
+        by_polygon.add_polygon(moved, kValue);
+        for (SplatBuffer& band : by_stamp_bands) band.add_stamp(stamp, a[0], a[1], kValue);
+      }
+      const Image expected = resolved(by_polygon, kHeight);
+      Image got(kWidth, kHeight, 4);
+      for (const SplatBuffer& band : by_stamp_bands) band.resolve_into(got);
+      CHECK(max_abs_difference(expected, got) < kStampRoundoff);
+      CHECK(channel_sum(got, 0) > 1.0);  // some of it landed
+    }
+  }
+}
+
+TEST_CASE("difference stamp: a stamp sums to its value, records nothing for a non-finite polygon, and only full-resolution buffers take it", "[render][splat][stamp]") {
+  const DifferenceStamp stamp = SplatBuffer::record(disc(0.5, 0.5, 21.0), 8);
+  SplatBuffer buffer(64, 0, 64);
+  buffer.add_stamp(stamp, 30, 30, kValue);
+  CHECK_THAT(channel_sum(resolved(buffer, 64), 3), WithinAbs(kValue[3], kEnergyRoundoff));
+  CHECK_THAT(stamp.to_string(), Contains("rows") && Contains("entries"));
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  CHECK(SplatBuffer::record(std::vector<Point2f>{{0.0f, 0.0f}, {nan, 1.0f}, {1.0f, 1.0f}}, 4).entries() == 0);
+  SplatOptions half;
+  half.downsample = 2;
+  SplatBuffer coarse(64, 0, 64, half);
+  CHECK_THROWS_AS(coarse.add_stamp(stamp, 30, 30, kValue), OptionsError);
+  buffer.add_stamp(stamp, 30, 30, {nan, 0.0f, 0.0f, 0.0f});
+  CHECK(buffer.skipped() == 1);
+}

@@ -100,6 +100,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   LargeVector<FootprintPlan> plans;
   plans.reserve(layer.capacity());
   render_detail::MergeScratch merge_scratch;
+  render_detail::HiddenScratch hidden_scratch;
 
   for (int l = 0; l < layers.count; ++l) {
     const auto u = static_cast<std::size_t>(l);
@@ -108,10 +109,8 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
     const double hidden_blur = layers.max_blur_px[u] + layers.nearer_blur_px[u];
     if (!layer.empty() && l + 1 < layers.count && hidden_blur >= kMinHiddenBlurPx) {
       const double reach = std::min(0.5 * hidden_blur + kHiddenMarginPx, 0.5 * (w + h));
-      ScatterSources extra =
-          render_detail::hidden_sources(sources, layers, l, w, h, reach, options.hidden, camera, threads);
-      stats.hidden_sources += extra.size();
-      layer.insert(layer.end(), extra.begin(), extra.end());
+      stats.hidden_sources += render_detail::append_hidden_sources(sources, layers, l, w, h, reach, options.hidden, camera,
+                                                                   threads, hidden_scratch, layer);
     }
     if (layer.empty()) continue;
     ++stats.layers;
@@ -201,7 +200,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   stats.footprints = footprints;
   stats.triangles = triangles;
   stats.unaimed_rays = model.unaimed_rays() - unaimed_before;
-  return render_detail::finish_composite(result, w, h);
+  return render_detail::finish_composite(result, w, h, threads, hidden_scratch.cells, hidden_scratch.push_pull);
 }
 
 // Sources beyond a w x h frame over `margin` px each side, copies of the nearest edge pixel's parts

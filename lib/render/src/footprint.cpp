@@ -36,6 +36,13 @@ constexpr double kQuarterResolutionPx = 96.0;
 // Share of the chromatic tolerance over which a footprint's light is cross-faded from n - 1 to n
 // wavelength groups (FootprintScatter::plan): the points there deposit both splits.
 constexpr double kGroupBlend = 0.25;
+// Stamps (footprint_stamps.h) are made for scales up to half the full-resolution grid's largest
+// footprint plus this (px): a footprint's planned size is its probe's extent, which for an outline
+// with no vertex at the probe's directions is a little less than twice its scale.
+constexpr double kStampMarginPx = 2.0;
+// A footprint is drawn from a stamp where its centre lies within this of its pixel's centre and its
+// map from the pupil has no shear beyond it (px): a thin lens's are zero to rounding.
+constexpr double kStampPlacementPx = 1e-4;
 // Grid cells of an aperture-picture mesh per pixel of footprint size.
 constexpr double kPxPerGridCell = 1.5;
 
@@ -414,7 +421,8 @@ std::array<float, 4> FootprintScatter::lit(const std::array<float, 4>& value, do
 
 FootprintScatter::FootprintScatter(const RayModel& model, const Aperture& aperture, const SpectralGroups& groups,
                                    const PupilMeshTable& meshes, const BokehOptions& options)
-    : model_(model), camera_(model.camera()), aperture_(aperture), groups_(groups), meshes_(meshes), options_(options) {
+    : model_(model), camera_(model.camera()), aperture_(aperture), groups_(groups), meshes_(meshes), options_(options),
+      stamps_(meshes, 0.5 * kHalfResolutionPx + kStampMarginPx) {
   probe_[0] = {0.0, 0.0};
   for (int k = 0; k < 8; ++k) {
     const double a = kPi / 2.0 + 2.0 * kPi * k / 8.0;
@@ -655,15 +663,26 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
       const PixelPoint o = camera_.output_pixel(hits[0].x_mm, hits[0].y_mm);
       const PixelPoint ex = camera_.output_pixel(hits[1].x_mm, hits[1].y_mm);
       const PixelPoint ey = camera_.output_pixel(hits[2].x_mm, hits[2].y_mm);
+      std::array<float, 4> v = lit(value, hits[0].weight);
+      const auto light = static_cast<float>(options_.vignetting ? passing : 1.0);
+      for (std::size_t c = 0; c < 3; ++c) v[c] *= light;
+      if (p.level == 0 && outline == &meshes_.outline(p.outline)) {
+        // The outline scaled about the pixel's centre (no discs cut it): a stamp.
+        const double ax = std::floor(o.x), ay = std::floor(o.y);
+        const double off = std::abs(o.x - ax - 0.5) + std::abs(o.y - ay - 0.5) + std::abs(ex.y - o.y) + std::abs(ey.x - o.x);
+        if (off <= kStampPlacementPx && std::abs(ax) < 1e6 && std::abs(ay) < 1e6) {
+          if (const DifferenceStamp* stamp = stamps_.find(ex.x - o.x, ey.y - o.y)) {
+            buffer.add_stamp(*stamp, static_cast<int>(ax), static_cast<int>(ay), v);
+            return;
+          }
+        }
+      }
       points.resize(outline->size());
       for (std::size_t i = 0; i < outline->size(); ++i) {
         const PupilPoint& q = (*outline)[i];
         points[i] = {static_cast<float>(o.x + (ex.x - o.x) * q.x + (ey.x - o.x) * q.y),
                      static_cast<float>(o.y + (ex.y - o.y) * q.x + (ey.y - o.y) * q.y)};
       }
-      std::array<float, 4> v = lit(value, hits[0].weight);
-      const auto light = static_cast<float>(options_.vignetting ? passing : 1.0);
-      for (std::size_t c = 0; c < 3; ++c) v[c] *= light;
       buffer.add_polygon(points, v);
       return;
     }

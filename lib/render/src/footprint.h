@@ -3,7 +3,9 @@
 // SplatBuffers as the model maps the aperture. Three ways, cheapest first:
 // - a point, for footprints under 0.2 px (the 2 px tent filter hides their shape);
 // - one uniformly lit polygon, the aperture's outline mapped by three rays, where the model is
-//   affine in the pupil (thin, paraxial) or departs from its affine fit by under 1/4 px;
+//   affine in the pupil (thin, paraxial) or departs from its affine fit by under 1/4 px; where that
+//   polygon is the outline scaled about the pixel's centre (the thin lens), from a stamp
+//   (footprint_stamps.h);
 // - a pupil mesh mapped vertex by vertex: nested ring polygons where the mapped rings nest (the
 //   radial light distribution kept), else triangle by triangle (folds, caustics, vignetting).
 #pragma once
@@ -15,6 +17,7 @@
 
 #include "lensmith/camera/ray_model.h"
 #include "lensmith/render/splat_buffer.h"
+#include "footprint_stamps.h"
 #include "pupil_mesh_table.h"
 #include "scatter_source.h"
 #include "spectral_groups.h"
@@ -113,6 +116,9 @@ class FootprintScatter {
   // The probe: the pupil centre and 8 points on the aperture's edge, from the top anticlockwise.
   std::array<PupilPoint, 9> probe_{};
   PupilMeshTable::Directions probe_directions_;  // of the 8 edge points, for the discs' reach
+  // Single-polygon footprints at full resolution that are the outline scaled about their pixel's
+  // centre (the thin lens's): deposited from stamps.
+  FootprintStamps stamps_;
 };
 
 }  // namespace lensmith::render_detail

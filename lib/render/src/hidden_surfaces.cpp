@@ -16,15 +16,16 @@ double tone(float v) { return static_cast<double>(v) / (1.0 + static_cast<double
 float untone(double t) { return static_cast<float>(std::min(t, kMaxTone) / (1.0 - std::min(t, kMaxTone))); }
 }  // namespace
 
-ScatterSources hidden_sources(const ScatterSources& sources, const DepthLayers& layers, int layer,
-                                          int width, int height, double reach_px, HiddenSurfaces mode, const Camera& camera,
-                                          int threads) {
+std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLayers& layers, int layer, int width, int height,
+                                  double reach_px, HiddenSurfaces mode, const Camera& camera, int threads,
+                                  HiddenScratch& scratch, ScatterSources& out) {
   const int w = width, h = height;
   // Nearer pixels within a (2 reach + 1)-pixel square of a pixel of the layer: a separable
   // dilation, rows then columns, each line independent (threads).
   const int reach = static_cast<int>(reach_px);
   const int far = std::numeric_limits<int>::max() / 4;
-  LargeVector<int> row_distance(static_cast<std::size_t>(w) * h);
+  LargeVector<int>& row_distance = scratch.row_distance;
+  row_distance.resize(static_cast<std::size_t>(w) * h);  // every entry is written below
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (int y = 0; y < h; ++y) {
     int* d = row_distance.data() + static_cast<std::size_t>(y) * w;
@@ -34,14 +35,15 @@ ScatterSources hidden_sources(const ScatterSources& sources, const DepthLayers& 
     last = far;
     for (int x = w - 1; x >= 0; --x) d[x] = std::min(d[x], layers.in(row + x, layer) ? (last = 0) : (last = std::min(far, last + 1)));
   }
-  LargeVector<std::uint8_t> within(static_cast<std::size_t>(w) * h, 0);
+  LargeVector<std::uint8_t>& within = scratch.within;
+  within.resize(static_cast<std::size_t>(w) * h);  // every entry is written below
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (int x = 0; x < w; ++x) {
     int last = far;
     for (int y = 0; y < h; ++y) {
       const std::size_t i = static_cast<std::size_t>(y) * w + x;
       last = row_distance[i] <= reach ? 0 : std::min(far, last + 1);
-      within[i] = last <= reach ? 1 : 0;
+      within[i] = last <= reach ? 1 : 0;  // the first write of this column
     }
     last = far;
     for (int y = h - 1; y >= 0; --y) {
@@ -50,7 +52,8 @@ ScatterSources hidden_sources(const ScatterSources& sources, const DepthLayers& 
       within[i] = (within[i] || last <= reach) ? 1 : 0;
     }
   }
-  std::vector<std::size_t> targets;
+  std::vector<std::size_t>& targets = scratch.targets;
+  targets.clear();
   int x0 = w, x1 = -1, y0 = h, y1 = -1;
   for (std::size_t i = 0; i < within.size(); ++i) {
     if (within[i] && layers.unknown_behind(i, layer) > 0.0f) {
@@ -62,7 +65,7 @@ ScatterSources hidden_sources(const ScatterSources& sources, const DepthLayers& 
       y1 = std::max(y1, y);
     }
   }
-  if (targets.empty()) return {};
+  if (targets.empty()) return 0;
   // Push-pull over the window of the targets widened by the reach, where the layer's pixels that
   // feed them lie.
   x0 = std::max(0, x0 - reach);
@@ -70,7 +73,8 @@ ScatterSources hidden_sources(const ScatterSources& sources, const DepthLayers& 
   x1 = std::min(w - 1, x1 + reach);
   y1 = std::min(h - 1, y1 + reach);
   const int ww = x1 - x0 + 1, wh = y1 - y0 + 1;
-  LargeVector<std::array<double, 5>> cells(static_cast<std::size_t>(ww) * wh, std::array<double, 5>{});
+  LargeVector<std::array<double, 5>>& cells = scratch.cells;
+  cells.assign(static_cast<std::size_t>(ww) * wh, std::array<double, 5>{});
   // The layer's own whole pixels (the parts of split edge pixels are uncertain estimates).
   for (int i : layers.members[static_cast<std::size_t>(layer)]) {
     const ScatterSource& p = sources[static_cast<std::size_t>(i)];
@@ -83,7 +87,7 @@ ScatterSources hidden_sources(const ScatterSources& sources, const DepthLayers& 
     cell[3] += c * p.inverse_depth_per_mm;
     cell[4] += c;
   }
-  push_pull(ww, wh, cells);
+  push_pull(ww, wh, cells, threads, &scratch.push_pull);
   // The layer's share of what lies behind the nearer pixels: among the visible parts of this layer
   // and of every farther one, the fraction on this layer, interpolated by the same push-pull. Each
   // farther layer claims only its share, so that composited "over" one another the layers behind an
@@ -91,7 +95,7 @@ ScatterSources hidden_sources(const ScatterSources& sources, const DepthLayers& 
   // nearest of them hid the others: a branch crossing behind a nearer one was extended under the
   // whole of the nearer branch's blur, 17 % too bright there (examples/scenes/branches.json).
   // (None to compute where no farther layer shows in the window: the layer claims all of it.)
-  LargeVector<std::array<double, 5>> shares;
+  LargeVector<std::array<double, 5>>& shares = scratch.shares;
   bool farther = false;
   for (int y = y0; y <= y1 && !farther; ++y) {
     for (int x = x0; x <= x1 && !farther; ++x) {
@@ -100,7 +104,9 @@ ScatterSources hidden_sources(const ScatterSources& sources, const DepthLayers& 
     }
   }
   if (farther) shares.assign(cells.size(), std::array<double, 5>{});
-  for (int y = y0; y <= y1 && farther; ++y) {
+#pragma omp parallel for num_threads(threads) schedule(static) if (farther)
+  for (int y = y0; y <= y1; ++y) {
+    if (!farther) continue;
     for (int x = x0; x <= x1; ++x) {
       const std::size_t p = static_cast<std::size_t>(y) * w + x;
       std::array<double, 5>& cell = shares[static_cast<std::size_t>(y - y0) * ww + (x - x0)];
@@ -112,9 +118,8 @@ ScatterSources hidden_sources(const ScatterSources& sources, const DepthLayers& 
       }
     }
   }
-  if (farther) push_pull(ww, wh, shares);
-  ScatterSources out;
-  out.reserve(targets.size());
+  if (farther) push_pull(ww, wh, shares, threads, &scratch.push_pull);
+  const std::size_t before = out.size();
   for (std::size_t i : targets) {
     const std::size_t wx = i % static_cast<std::size_t>(w) - static_cast<std::size_t>(x0);
     const std::size_t wy = i / static_cast<std::size_t>(w) - static_cast<std::size_t>(y0);
@@ -131,7 +136,7 @@ ScatterSources hidden_sources(const ScatterSources& sources, const DepthLayers& 
     s.coc_px = camera.signed_coc_px(v[3]);
     out.push_back(s);
   }
-  return out;
+  return out.size() - before;
 }
 
 }  // namespace lensmith::render_detail

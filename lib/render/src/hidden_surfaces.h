@@ -12,17 +12,33 @@
 // colour: its hidden sources only add coverage, and the layer's own colours are renormalised over it.
 #pragma once
 
+#include <array>
+#include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "depth_layers.h"
+#include "push_pull.h"
 #include "scatter_source.h"
 
 namespace lensmith::render_detail {
 
-// Hidden sources of `layer`, under the nearer pixels within `reach_px` (a square) of its own pixels
-// of an image `width` x `height`; coverage-only for HiddenSurfaces::Stretch.
-ScatterSources hidden_sources(const ScatterSources& sources, const DepthLayers& layers, int layer,
-                                          int width, int height, double reach_px, HiddenSurfaces mode, const Camera& camera,
-                                          int threads);
+// Frame-sized working memory of hidden_sources, kept from layer to layer: fresh memory is faulted
+// in page by page, which cost more than the work itself (docs/performance.md).
+struct HiddenScratch {
+  LargeVector<int> row_distance;
+  LargeVector<std::uint8_t> within;
+  std::vector<std::size_t> targets;
+  LargeVector<std::array<double, 5>> cells;
+  LargeVector<std::array<double, 5>> shares;
+  PushPullScratch push_pull;
+};
+
+// Appends to `out` the hidden sources of `layer`, under the nearer pixels within `reach_px` (a
+// square) of its own pixels of an image `width` x `height`; coverage-only for
+// HiddenSurfaces::Stretch. Returns how many it appended.
+std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLayers& layers, int layer, int width, int height,
+                                  double reach_px, HiddenSurfaces mode, const Camera& camera, int threads,
+                                  HiddenScratch& scratch, ScatterSources& out);
 
 }  // namespace lensmith::render_detail

@@ -42,22 +42,26 @@ void composite_layer_over(const LargeVector<float>& layer_rgba, const LargeVecto
   }
 }
 
-Image finish_composite(const LargeVector<double>& result, int width, int height) {
+Image finish_composite(const LargeVector<double>& result, int width, int height, int threads,
+                       LargeVector<std::array<double, 5>>& fill, PushPullScratch& scratch) {
   const std::size_t count = static_cast<std::size_t>(width) * height;
   bool any_gap = false;
   for (std::size_t k = 0; k < count && !any_gap; ++k) any_gap = result[4 * k + 3] < kRenormaliseCoverage;
   // The push-pull fill (5 doubles a pixel) only where some gap is too empty to renormalise.
-  LargeVector<std::array<double, 5>> fill;
+  const auto pixels = static_cast<std::ptrdiff_t>(count);
   if (any_gap) {
-    fill.assign(count, std::array<double, 5>{});
-    for (std::size_t k = 0; k < count; ++k) {
+    fill.resize(count);  // every cell is written below
+#pragma omp parallel for num_threads(threads) schedule(static)
+    for (std::ptrdiff_t k = 0; k < pixels; ++k) {
       const double coverage = result[4 * k + 3];
-      if (coverage >= kKnownCoverage) fill[k] = {result[4 * k], result[4 * k + 1], result[4 * k + 2], 0.0, coverage};
+      fill[k] = coverage >= kKnownCoverage ? std::array<double, 5>{result[4 * k], result[4 * k + 1], result[4 * k + 2], 0.0, coverage}
+                                           : std::array<double, 5>{};
     }
-    push_pull(width, height, fill);
+    push_pull(width, height, fill, threads, &scratch);
   }
   Image out(width, height, 3);
-  for (std::size_t k = 0; k < out.pixel_count(); ++k) {
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (std::ptrdiff_t k = 0; k < pixels; ++k) {
     const double gap = std::max(0.0, 1.0 - result[4 * k + 3]);
     if (gap > 0.0 && result[4 * k + 3] >= kRenormaliseCoverage) {
       for (std::size_t c = 0; c < 3; ++c) out.data[3 * k + c] = static_cast<float>(std::max(0.0, result[4 * k + c] / result[4 * k + 3]));

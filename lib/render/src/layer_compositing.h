@@ -7,9 +7,11 @@
 // push-pull, never its own amplified light. A flat image keeps its mean.
 #pragma once
 
+#include <array>
 #include <vector>
 
 #include "lensmith/core/huge_page_allocator.h"
+#include "push_pull.h"
 
 #include "lensmith/render/image.h"
 
@@ -21,7 +23,9 @@ namespace lensmith::render_detail {
 void composite_layer_over(const LargeVector<float>& layer_rgba, const LargeVector<float>* holes, LargeVector<double>& result,
                           int width, int row_begin, int row_end);
 
-// The output picture: the result with its uncovered remainder filled.
-Image finish_composite(const LargeVector<double>& result, int width, int height);
+// The output picture: the result with its uncovered remainder filled, on `threads` threads; `fill`
+// and `scratch` are working memory kept by the caller (their contents are overwritten).
+Image finish_composite(const LargeVector<double>& result, int width, int height, int threads,
+                       LargeVector<std::array<double, 5>>& fill, PushPullScratch& scratch);
 
 }  // namespace lensmith::render_detail

@@ -9,6 +9,8 @@ namespace lensmith::render_detail {
 namespace {
 
 using Cell = std::array<double, 5>;
+// Levels with fewer cells than this are done on one thread (starting threads would cost more).
+constexpr int kParallelCells = 16384;
 
 // Normalised value of a cell of sums: the 4 values divided by the weight, and its confidence
 // min(weight, 1) in slot 4 (Gortler et al. clamp the pulled weights to 1 the same way).
@@ -22,26 +24,34 @@ Cell normalised(const Cell& v) {
 
 }  // namespace
 
-void push_pull(int w, int h, LargeVector<Cell>& cells) {
+void push_pull(int w, int h, LargeVector<Cell>& cells, int threads, PushPullScratch* scratch) {
   // Pull: each level sums 2 x 2 blocks of the one below, down to a single cell.
-  std::vector<LargeVector<Cell>> levels;
+  PushPullScratch local;
+  std::vector<LargeVector<Cell>>& levels = (scratch ? *scratch : local).levels;
   std::vector<std::pair<int, int>> sizes{{w, h}};
   while (sizes.back().first > 1 || sizes.back().second > 1) {
-    const auto [fw, fh] = sizes.back();
-    const LargeVector<Cell>& f = levels.empty() ? cells : levels.back();
+    const int fw = sizes.back().first, fh = sizes.back().second;
     const int cw = (fw + 1) / 2, ch = (fh + 1) / 2;
-    LargeVector<Cell> c(static_cast<std::size_t>(cw) * ch, Cell{});
-    for (int y = 0; y < fh; ++y) {
-      for (int x = 0; x < fw; ++x) {
-        Cell& dst = c[static_cast<std::size_t>(y / 2) * cw + x / 2];
-        const Cell& src = f[static_cast<std::size_t>(y) * fw + x];
-        for (std::size_t k = 0; k < 5; ++k) dst[k] += src[k];
+    if (levels.size() < sizes.size()) levels.emplace_back();
+    const LargeVector<Cell>& f = sizes.size() == 1 ? cells : levels[sizes.size() - 2];
+    LargeVector<Cell>& c = levels[sizes.size() - 1];
+    c.resize(static_cast<std::size_t>(cw) * ch);  // every cell is written below
+    // Each coarse row from its two fine rows: rows are independent.
+#pragma omp parallel for num_threads(threads) schedule(static) if (fw * fh > kParallelCells)
+    for (int cy = 0; cy < ch; ++cy) {
+      Cell* dst = c.data() + static_cast<std::size_t>(cy) * cw;
+      for (int x = 0; x < cw; ++x) dst[x] = Cell{};
+      for (int y = 2 * cy; y < std::min(fh, 2 * cy + 2); ++y) {
+        const Cell* src = f.data() + static_cast<std::size_t>(y) * fw;
+        for (int x = 0; x < fw; ++x) {
+          for (std::size_t k = 0; k < 5; ++k) dst[x / 2][k] += src[x][k];
+        }
       }
     }
-    levels.push_back(std::move(c));
     sizes.push_back({cw, ch});
   }
-  if (levels.empty()) {  // a single cell
+  const std::size_t level_count = sizes.size() - 1;
+  if (level_count == 0) {  // a single cell
     cells[0] = normalised(cells[0]);
     if (cells[0][4] > 0.0) cells[0][4] = 1.0;
     return;
@@ -49,14 +59,15 @@ void push_pull(int w, int h, LargeVector<Cell>& cells) {
   // Push: from the coarsest level down, every cell becomes its own normalised value blended by its
   // confidence with the bilinear interpolation of the finished level above (cell centres at
   // (x + 0.5) / 2 - 0.5 in its coordinates), so that filled areas are smooth, not 2^k blocks.
-  Cell& top = levels.back()[0];
+  Cell& top = levels[level_count - 1][0];
   top = normalised(top);
   if (top[4] > 0.0) top[4] = 1.0;
-  for (std::size_t l = levels.size(); l-- > 0;) {
+  for (std::size_t l = level_count; l-- > 0;) {
     LargeVector<Cell>& f = l == 0 ? cells : levels[l - 1];
     const LargeVector<Cell>& c = levels[l];
-    const auto [fw, fh] = sizes[l];
-    const auto [cw, ch] = sizes[l + 1];
+    const int fw = sizes[l].first, fh = sizes[l].second;
+    const int cw = sizes[l + 1].first, ch = sizes[l + 1].second;
+#pragma omp parallel for num_threads(threads) schedule(static) if (fw * fh > kParallelCells)
     for (int y = 0; y < fh; ++y) {
       const double cy = std::clamp((y + 0.5) / 2.0 - 0.5, 0.0, static_cast<double>(ch - 1));
       const int y0 = static_cast<int>(cy), y1 = std::min(y0 + 1, ch - 1);

@@ -10,9 +10,15 @@
 
 namespace lensmith::render_detail {
 
+// The coarser levels' memory, kept from call to call (a renderer calls once per depth layer).
+struct PushPullScratch {
+  std::vector<LargeVector<std::array<double, 5>>> levels;
+};
+
 // `cells` holds, per pixel of a w x h grid, four weighted sums and their weight (0 = unknown). Pull
 // sums 2 x 2 blocks down to one cell; push gives every unknown cell its parent's normalised value.
-// On return every cell holds normalised values and weight 1 (all zero if no cell was known).
-void push_pull(int w, int h, LargeVector<std::array<double, 5>>& cells);
+// On return every cell holds normalised values and weight 1 (all zero if no cell was known). Rows
+// are shared among `threads` threads; the result does not depend on their number.
+void push_pull(int w, int h, LargeVector<std::array<double, 5>>& cells, int threads = 1, PushPullScratch* scratch = nullptr);
 
 }  // namespace lensmith::render_detail

@@ -58,22 +58,24 @@ inline EndWeights end_weights(double t) {
   return e;
 }
 
+// e[c] += w * v[c] for the four channels, written so that GCC makes it one 256-bit operation.
+inline void add_scaled(double* e, double w, const double v[kChannels]) {
+  const double e0 = e[0] + w * v[0];
+  const double e1 = e[1] + w * v[1];
+  const double e2 = e[2] + w * v[2];
+  const double e3 = e[3] + w * v[3];
+  e[0] = e0;
+  e[1] = e1;
+  e[2] = e2;
+  e[3] = e3;
+}
+
 // Adds q[j] * coef[c] to entry first + j, channel c. Entries left of 0 fold into entry 0 (the
 // prefix sums of visible pixels stay right); entries at width and beyond are dropped.
 inline void add_weights(double* row, int width, int first, const double q[3], const double coef[kChannels]) {
   if (first >= 0 && first + 2 < width) {
     double* e = row + static_cast<std::ptrdiff_t>(first) * kChannels;
-    for (int j = 0; j < 3; ++j, e += kChannels) {
-      const double qj = q[j];
-      const double e0 = e[0] + qj * coef[0];
-      const double e1 = e[1] + qj * coef[1];
-      const double e2 = e[2] + qj * coef[2];
-      const double e3 = e[3] + qj * coef[3];
-      e[0] = e0;
-      e[1] = e1;
-      e[2] = e2;
-      e[3] = e3;
-    }
+    for (int j = 0; j < 3; ++j, e += kChannels) add_scaled(e, q[j], coef);
     return;
   }
   for (int j = 0; j < 3; ++j) {
@@ -355,6 +357,80 @@ void SplatBuffer::add_polygon(std::span<const Point2f> output_vertices, const st
     if (++m == subrows) {
       m = 0;
       ++pixel_row;
+    }
+  }
+}
+
+std::string DifferenceStamp::to_string() const {
+  const std::size_t rows = row_entries.empty() ? 0 : row_entries.size() - 1;
+  return "DifferenceStamp(" + std::to_string(rows) + " rows, " + std::to_string(entries()) + " entries)";
+}
+
+DifferenceStamp SplatBuffer::record(std::span<const Point2f> vertices, int subrows) {
+  DifferenceStamp stamp;
+  float x_min = std::numeric_limits<float>::infinity(), x_max = -x_min, y_min = x_min, y_max = -x_min;
+  for (const Point2f& p : vertices) {
+    x_min = std::min(x_min, p.x);
+    x_max = std::max(x_max, p.x);
+    y_min = std::min(y_min, p.y);
+    y_max = std::max(y_max, p.y);
+  }
+  if (vertices.empty() || !(std::isfinite(x_min) && std::isfinite(x_max) && std::isfinite(y_min) && std::isfinite(y_max))) {
+    return stamp;
+  }
+  // A buffer around the polygon moved by whole pixels so that its tent (1.5 px from a span end)
+  // never reaches the buffer's edges, where add_polygon folds or drops entries.
+  constexpr int kPad = 4;
+  const int shift_x = kPad - static_cast<int>(fast_floor(x_min));
+  const int shift_y = kPad - static_cast<int>(fast_floor(y_min));
+  const int width = static_cast<int>(fast_ceil(x_max)) + shift_x + kPad;
+  const int rows = static_cast<int>(fast_ceil(y_max)) + shift_y + kPad;
+  SplatOptions options;
+  options.subrows = subrows;
+  SplatBuffer buffer(width, 0, rows, options);
+  std::vector<Point2f> moved(vertices.begin(), vertices.end());
+  for (Point2f& p : moved) p = {p.x + static_cast<float>(shift_x), p.y + static_cast<float>(shift_y)};
+  buffer.add_polygon(moved, {1.0f, 0.0f, 0.0f, 0.0f});
+  if (buffer.skipped() > 0) return stamp;
+  stamp.first_row = -shift_y;
+  stamp.row_entries.push_back(0);
+  for (int r = 0; r < rows; ++r) {
+    const double* d = buffer.diff_.data() + static_cast<std::size_t>(r) * static_cast<std::size_t>(width) * kChannels;
+    for (int x = 0; x < width; ++x) {
+      const double v = d[static_cast<std::size_t>(x) * kChannels];
+      if (v == 0.0) continue;
+      stamp.column.push_back(x - shift_x);
+      stamp.weight.push_back(v);
+    }
+    stamp.row_entries.push_back(static_cast<std::uint32_t>(stamp.column.size()));
+  }
+  return stamp;
+}
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+__attribute__((target_clones("arch=x86-64-v3", "default")))
+#endif
+void SplatBuffer::add_stamp(const DifferenceStamp& stamp, int anchor_x, int anchor_y, const std::array<float, 4>& value) {
+  if (options_.downsample != 1) throw OptionsError("SplatBuffer::add_stamp: " + to_string() + " is not at full resolution");
+  if (!finite_value(value)) {
+    ++skipped_;
+    return;
+  }
+  const int rows = static_cast<int>(stamp.row_entries.size()) - 1;
+  const int r_begin = std::max(0, row_begin_ - anchor_y - stamp.first_row);
+  const int r_end = std::min(rows, row_end_ - anchor_y - stamp.first_row);
+  const double v[kChannels] = {value[0], value[1], value[2], value[3]};
+  const std::int32_t* column = stamp.column.data();
+  const double* weight = stamp.weight.data();
+  for (int r = r_begin; r < r_end; ++r) {
+    const int row = anchor_y + stamp.first_row + r;
+    double* row_diff = diff_.data() + static_cast<std::size_t>(row - row_begin_) * static_cast<std::size_t>(width_) * kChannels;
+    const std::uint32_t end = stamp.row_entries[static_cast<std::size_t>(r) + 1];
+    for (std::uint32_t k = stamp.row_entries[static_cast<std::size_t>(r)]; k < end; ++k) {
+      int x = anchor_x + column[k];
+      if (x >= width_) continue;
+      x = std::max(x, 0);
+      add_scaled(row_diff + static_cast<std::size_t>(x) * kChannels, weight[k], v);
     }
   }
 }

@@ -1,7 +1,7 @@
 // An allocator for the renderer's frame-sized buffers (sources, layers, splat bands, composites):
-// blocks of 2 MiB and more are aligned to 2 MiB and advised to the kernel as transparent huge pages,
-// so that touching them for the first time costs one page fault per 2 MiB instead of one per
-// 4 KiB. On a virtual machine a fault is expensive: on the KVM guest of docs/performance.md, first
+// blocks of 512 KiB and more are aligned to 2 MiB, rounded up to whole 2 MiB pages and advised to
+// the kernel as transparent huge pages, so that touching them for the first time costs one page
+// fault per 2 MiB instead of one per 4 KiB. On a virtual machine a fault is expensive: on the KVM guest of docs/performance.md, first
 // touching 256 MiB took 0.84-0.98 s in 4 KiB pages and 0.025 s in huge pages, and a 1080p render
 // touches several hundred MiB. Where the kernel has transparent huge pages off, or on other systems,
 // the advice is ignored and the allocator behaves like std::allocator.
@@ -18,11 +18,27 @@
 
 namespace lensmith {
 
+// Blocks from this size up are advised as huge pages, rounded up to whole 2 MiB pages: a block of
+// 512 KiB faulted in as 128 small pages costs about 1.5 ms on that guest, as one huge page 0.1 ms.
+inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
+inline constexpr std::size_t kHugePageFromBytes = std::size_t{512} << 10;
+
+// A block of at least kHugePageFromBytes bytes (the caller checks), 2-MiB aligned, its size rounded
+// up to whole huge pages and advised as such; released by std::free. Throws std::bad_alloc.
+inline void* allocate_huge_pages(std::size_t bytes) {
+  if (bytes > static_cast<std::size_t>(-1) - kHugePageBytes) throw std::bad_alloc();
+  const std::size_t rounded = (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
+  void* p = std::aligned_alloc(kHugePageBytes, rounded);
+  if (p == nullptr) throw std::bad_alloc();
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  madvise(p, rounded, MADV_HUGEPAGE);  // advice only: failure leaves ordinary pages
+#endif
+  return p;
+}
+
 template <class T>
 struct HugePageAllocator {
   using value_type = T;
-  // Blocks from this size up are huge-page aligned and advised.
-  static constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
 
   HugePageAllocator() noexcept = default;
   template <class U>
@@ -31,17 +47,11 @@ struct HugePageAllocator {
   T* allocate(std::size_t n) {
     if (n > static_cast<std::size_t>(-1) / sizeof(T)) throw std::bad_array_new_length();
     const std::size_t bytes = n * sizeof(T);
-    if (bytes < kHugePageBytes) return static_cast<T*>(::operator new(bytes, std::align_val_t{alignof(T)}));
-    const std::size_t rounded = (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
-    void* p = std::aligned_alloc(kHugePageBytes, rounded);
-    if (p == nullptr) throw std::bad_alloc();
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    madvise(p, rounded, MADV_HUGEPAGE);  // advice only: failure leaves ordinary pages
-#endif
-    return static_cast<T*>(p);
+    if (bytes < kHugePageFromBytes) return static_cast<T*>(::operator new(bytes, std::align_val_t{alignof(T)}));
+    return static_cast<T*>(allocate_huge_pages(bytes));
   }
   void deallocate(T* p, std::size_t n) noexcept {
-    if (n * sizeof(T) < kHugePageBytes) {
+    if (n * sizeof(T) < kHugePageFromBytes) {
       ::operator delete(p, std::align_val_t{alignof(T)});
     } else {
       std::free(p);

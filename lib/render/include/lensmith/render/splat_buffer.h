@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <ostream>
 #include <span>
 #include <string>
@@ -51,6 +52,22 @@ struct SplatOptions {
   friend std::ostream& operator<<(std::ostream& os, const SplatOptions& o) { return os << o.to_string(); }
 };
 
+// A polygon's deposit recorded in SplatBuffer's own form, first differences along x row by row, so
+// that the same polygon moved by whole pixels is deposited by adding its entries (a few per row)
+// instead of scanning its sub-rows: what SplatBuffer::add_stamp at anchor (i, j) deposits equals
+// add_polygon of the recorded polygon moved by (i, j) px, at the recording's sub-row count. Made by
+// SplatBuffer::record.
+struct DifferenceStamp {
+  int first_row = 0;                       // of its entries, relative to the anchor's row
+  std::vector<std::uint32_t> row_entries;  // row first_row + r has entries [row_entries[r], row_entries[r + 1])
+  std::vector<std::int32_t> column;        // relative to the anchor's column
+  std::vector<double> weight;              // difference per unit of deposited value
+
+  std::size_t entries() const { return column.size(); }
+  std::string to_string() const;  // "DifferenceStamp(14 rows, 96 entries)"
+  friend std::ostream& operator<<(std::ostream& os, const DifferenceStamp& s) { return os << s.to_string(); }
+};
+
 // Accumulates RGBA energy deposits for rows [row_begin, row_end) of an image width_px wide.
 //
 // Filtering: a polygon P carrying value v deposits into pixel (i, j)
@@ -86,6 +103,14 @@ class SplatBuffer {
   void add_triangle(Point2f a, Point2f b, Point2f c, const std::array<float, 4>& value);
   // A point deposit with bilinear weights over the 2 x 2 pixels whose centres surround p.
   void add_point(Point2f p, const std::array<float, 4>& value);
+  // The stamp's polygon moved by (anchor_x, anchor_y) whole px, carrying `value`; clipped like
+  // add_polygon (entries left of the image fold into its first column, those right of it and
+  // outside the band are dropped). Full-resolution buffers only (downsample 1: OptionsError).
+  void add_stamp(const DifferenceStamp& stamp, int anchor_x, int anchor_y, const std::array<float, 4>& value);
+  // The stamp of a convex polygon (px; its deposit at anchor (0, 0) is add_polygon's of `vertices`)
+  // sampled at `subrows` sub-rows per pixel (SplatOptions::subrows' range). Empty (no entries) for
+  // a polygon add_polygon would skip; a polygon with no area records as a point.
+  static DifferenceStamp record(std::span<const Point2f> vertices, int subrows);
 
   // Prefix-sums each row and adds the band into rgba_full_image: the full image, width() x (at
   // least row_end()) pixels x 4 floats, row-major, top row first; rows outside the band untouched.
