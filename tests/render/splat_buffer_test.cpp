@@ -67,21 +67,22 @@ double tent_integral(double a, double b, double c) {
   return sum;
 }
 
-// The x-interval of a convex polygon at height y, by testing every edge (half-open in y).
-bool span_at(const std::vector<Point2f>& poly, double y, double& a, double& b) {
-  a = std::numeric_limits<double>::infinity();
-  b = -a;
+// The x-intervals of any simple polygon at height y: its edge crossings (half-open in y), sorted,
+// paired inside-outside.
+std::vector<std::pair<double, double>> spans_at(const std::vector<Point2f>& poly, double y) {
+  std::vector<double> xs;
   for (std::size_t k = 0; k < poly.size(); ++k) {
     const Point2f p = poly[k];
     const Point2f q = poly[(k + 1) % poly.size()];
     const double y0 = std::min(p.y, q.y);
     const double y1 = std::max(p.y, q.y);
     if (!(y >= y0 && y < y1)) continue;
-    const double x = p.x + (q.x - p.x) * (y - p.y) / (q.y - p.y);
-    a = std::min(a, x);
-    b = std::max(b, x);
+    xs.push_back(p.x + (q.x - p.x) * (y - p.y) / (q.y - p.y));
   }
-  return a <= b;
+  std::sort(xs.begin(), xs.end());
+  std::vector<std::pair<double, double>> spans;
+  for (std::size_t j = 0; j + 1 < xs.size(); j += 2) spans.emplace_back(xs[j], xs[j + 1]);
+  return spans;
 }
 
 // Brute-force tent-filtered deposit of value 1 into a width x height image, y sampled at
@@ -92,15 +93,14 @@ std::vector<double> reference_deposit(const std::vector<Point2f>& poly, int widt
   double sampled_area = 0.0;
   for (int s = 0; s < height * samples_per_px; ++s) {
     const double y = (s + 0.5) / samples_per_px;
-    double a = 0.0;
-    double b = 0.0;
-    if (!span_at(poly, y, a, b)) continue;
-    sampled_area += (b - a) / samples_per_px;
-    for (int j = 0; j < height; ++j) {
-      const double wy = tent(y - (j + 0.5)) / samples_per_px;
-      if (wy == 0.0) continue;
-      for (int i = 0; i < width; ++i) {
-        image[static_cast<std::size_t>(j) * width + i] += wy * tent_integral(a, b, i + 0.5);
+    for (const auto& [a, b] : spans_at(poly, y)) {
+      sampled_area += (b - a) / samples_per_px;
+      for (int j = 0; j < height; ++j) {
+        const double wy = tent(y - (j + 0.5)) / samples_per_px;
+        if (wy == 0.0) continue;
+        for (int i = 0; i < width; ++i) {
+          image[static_cast<std::size_t>(j) * width + i] += wy * tent_integral(a, b, i + 0.5);
+        }
       }
     }
   }
@@ -170,13 +170,34 @@ TEST_CASE("splat buffer: a point-like square on a pixel centre fills that pixel,
   CHECK_THAT(d.at(5, 7, 0), WithinAbs(0.75, kRoundoff));
 }
 
-TEST_CASE("splat buffer: a triangle and a pentagon match a brute-force integral of the tent-filter definition", "[render][splat]") {
+// A crescent opening upwards (a cat's eye's mapped ring that turns back in y): the outer arc of a
+// circle about (cx, cy) below the horizontal, the inner arc of a smaller circle back.
+std::vector<Point2f> crescent(double cx, double cy) {
+  std::vector<Point2f> v;
+  for (int k = 0; k <= 16; ++k) {
+    const double t = std::numbers::pi * (0.1 + 0.8 * k / 16.0);
+    v.push_back({static_cast<float>(cx + 11.3 * std::cos(t)), static_cast<float>(cy + 11.3 * std::sin(t))});
+  }
+  for (int k = 16; k >= 0; --k) {
+    const double t = std::numbers::pi * (0.15 + 0.7 * k / 16.0);
+    v.push_back({static_cast<float>(cx + 7.9 * std::cos(t)), static_cast<float>(cy - 1.7 + 7.9 * std::sin(t))});
+  }
+  return v;
+}
+
+TEST_CASE("splat buffer: a triangle, a pentagon, a U and a crescent match a brute-force integral of the tent-filter definition", "[render][splat]") {
   constexpr int kWidth = 48;
   constexpr int kHeight = 40;
   const std::vector<Point2f> triangle = {{10.3f, 8.7f}, {25.1f, 12.2f}, {14.6f, 27.9f}};
   const std::vector<Point2f> pentagon = disc(30.37, 21.81, 14.6, 5, 0.3);
-  for (const auto* poly : {&triangle, &pentagon}) {
-    INFO((poly == &triangle ? "triangle" : "pentagon"));
+  // Not y-monotone (SplatBuffer's even-odd scan): horizontal lines through the arms cross 4 edges.
+  const std::vector<Point2f> u_shape = {{10.3f, 8.2f},  {16.1f, 8.2f},  {16.1f, 24.35f}, {30.6f, 24.35f},
+                                        {30.6f, 6.9f},  {36.2f, 6.9f},  {36.2f, 30.7f},  {10.3f, 30.7f}};
+  const std::vector<Point2f> moon = crescent(23.4, 17.2);
+  const std::pair<const std::vector<Point2f>*, const char*> shapes[] = {
+      {&triangle, "triangle"}, {&pentagon, "pentagon"}, {&u_shape, "U"}, {&moon, "crescent"}};
+  for (const auto& [poly, name] : shapes) {
+    INFO(name);
     for (const int subrows : {4, 16}) {
       INFO(subrows << " sub-rows");
       SplatOptions options;
@@ -199,6 +220,7 @@ TEST_CASE("splat buffer: a triangle and a pentagon match a brute-force integral 
       const double exact_area = polygon_area(*poly);
       const double quadrature = 1.0 / (2.0 * subrows * exact_area);
       CHECK(max_deviation(image, reference_deposit(*poly, kWidth, kHeight, 1024, exact_area)) < quadrature);
+      CHECK_THAT(channel_sum(image, 0), WithinRel(1.0, kEnergyRoundoff));
     }
   }
 }

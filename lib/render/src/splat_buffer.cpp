@@ -214,7 +214,7 @@ void SplatBuffer::add_triangle(Point2f a, Point2f b, Point2f c, const std::array
   add_polygon(v, value);
 }
 
-void SplatBuffer::build_chains(std::span<const Point2f> vertices) {
+bool SplatBuffer::build_chains(std::span<const Point2f> vertices) {
   const std::size_t n = vertices.size();
   std::size_t top = 0;
   std::size_t bottom = 0;
@@ -223,12 +223,16 @@ void SplatBuffer::build_chains(std::span<const Point2f> vertices) {
     if (vertices[i].y > vertices[bottom].y) bottom = i;
   }
   const double s = options_.subrows;
+  bool monotone = true;
   auto build = [&](std::vector<ChainVertex>& chain, bool forward) {
     chain.clear();
     double first = -std::numeric_limits<double>::infinity();
+    double last_y = -std::numeric_limits<double>::infinity();
     for (std::size_t i = top;; i = forward ? (i + 1 == n ? 0 : i + 1) : (i == 0 ? n - 1 : i - 1)) {
       const double x = vertices[i].x;
       const double y = vertices[i].y;
+      monotone = monotone && y >= last_y;
+      last_y = y;
       // Sub-row centre (k + 0.5) / S >= y  <=>  k >= y S - 0.5.
       first = std::max(first, fast_ceil(y * s - 0.5));
       chain.push_back({x, y, first, 0.0});
@@ -243,6 +247,90 @@ void SplatBuffer::build_chains(std::span<const Point2f> vertices) {
   };
   build(forward_chain_, true);
   build(backward_chain_, false);
+  return monotone;
+}
+
+// One sub-row's span from x_enter (+) to x_leave (-), its tent-filtered x profile as first
+// differences into the two pixel rows the sub-row's tent reaches (sub-row class m of pixel row
+// `pixel_row`); `unit` is the deposit per unit span length.
+inline __attribute__((always_inline)) void SplatBuffer::deposit_span(int pixel_row, int m, double x_enter, double x_leave,
+                                                                      const double unit[4]) {
+  const double w = grid_width_;
+  const EndWeights a = end_weights(clamp_end(x_enter, w));
+  const EndWeights b = end_weights(clamp_end(x_leave, w));
+  const double minus_qb[3] = {-b.q[0], -b.q[1], -b.q[2]};
+  const int upper = pixel_row + subrow_row_offset_[static_cast<std::size_t>(m)];
+  const double lower_weight = subrow_lower_weight_[static_cast<std::size_t>(m)];
+  for (int r = 0; r < 2; ++r) {
+    const int row = upper + r;
+    const double row_weight = r == 0 ? 1.0 - lower_weight : lower_weight;
+    // One sub-row per pixel row samples the row's centre, which the tent gives wholly to it.
+    if (row < grid_row_begin_ || row >= grid_row_end_ || row_weight == 0.0) continue;
+    double coef[kChannels];
+    for (int c = 0; c < kChannels; ++c) coef[c] = row_weight * unit[c];
+    double* row_diff = diff_.data() + static_cast<std::size_t>(row - grid_row_begin_) * grid_width_ * kChannels;
+    add_weights(row_diff, grid_width_, a.first, a.q, coef);
+    add_weights(row_diff, grid_width_, b.first, minus_qb, coef);
+  }
+}
+
+void SplatBuffer::add_general_polygon(std::span<const Point2f> vertices, double cx, double cy, const std::array<float, 4>& value) {
+  // Edges as sub-row ranges, by the rule of the chains: an edge covers the sub-row centres c with
+  // y_upper <= c < y_lower, so each sub-row crosses an even number of edges.
+  const double s = options_.subrows;
+  edges_.clear();
+  const std::size_t n = vertices.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Point2f& p = vertices[i];
+    const Point2f& q = vertices[i + 1 == n ? 0 : i + 1];
+    if (p.y == q.y) continue;
+    const Point2f& up = p.y < q.y ? p : q;
+    const Point2f& down = p.y < q.y ? q : p;
+    const double first = fast_ceil(up.y * s - 0.5), last = fast_ceil(down.y * s - 0.5);
+    if (!(first < last)) continue;
+    edges_.push_back({first, last, up.x, up.y, (static_cast<double>(down.x) - up.x) / (static_cast<double>(down.y) - up.y)});
+  }
+  std::sort(edges_.begin(), edges_.end(), [](const Edge& a, const Edge& b) { return a.first < b.first; });
+  // Spans by even-odd pairs of the crossings of each sub-row, sorted along x.
+  spans_.clear();
+  double twice_area = 0.0;  // sum of span lengths, sub-rows
+  std::size_t next = 0;
+  std::vector<std::size_t>& active = active_edges_;
+  active.clear();
+  double bottom = -std::numeric_limits<double>::infinity();
+  for (const Edge& e : edges_) bottom = std::max(bottom, e.last);
+  for (double sub = edges_.empty() ? 0.0 : edges_.front().first; sub < bottom; sub += 1.0) {
+    while (next < edges_.size() && edges_[next].first <= sub) active.push_back(next++);
+    std::erase_if(active, [&](std::size_t k) { return edges_[k].last <= sub; });
+    const double y = (sub + 0.5) / s;
+    crossings_.clear();
+    for (std::size_t k : active) crossings_.push_back(edges_[k].x + edges_[k].slope * (y - edges_[k].y));
+    std::sort(crossings_.begin(), crossings_.end());
+    for (std::size_t j = 0; j + 1 < crossings_.size(); j += 2) {
+      spans_.push_back({sub, crossings_[j], crossings_[j + 1]});
+      twice_area += crossings_[j + 1] - crossings_[j];
+    }
+  }
+  const double area = twice_area / s;
+  if (!std::isfinite(area)) {
+    ++skipped_;
+    return;
+  }
+  if (area < kPointArea) {
+    deposit_grid_point(cx, cy, value);
+    return;
+  }
+  const double lo = fast_ceil((grid_row_begin_ - 0.5) * s - 0.5);
+  const double hi = fast_ceil((grid_row_end_ + 0.5) * s - 0.5);
+  double unit[kChannels];
+  for (int c = 0; c < kChannels; ++c) unit[c] = value[static_cast<std::size_t>(c)] / (area * s);
+  const int subrows = options_.subrows;
+  for (const SubrowSpan& span : spans_) {
+    if (span.subrow < lo || span.subrow >= hi) continue;
+    const auto sub = static_cast<std::int64_t>(span.subrow);
+    const std::int64_t pixel_row = floor_div(sub, subrows);
+    deposit_span(static_cast<int>(pixel_row), static_cast<int>(sub - pixel_row * subrows), span.x_enter, span.x_leave, unit);
+  }
 }
 
 // With GCC on x86-64, built twice, for AVX2+FMA (x86-64-v3) and for the baseline, and chosen at
@@ -281,7 +369,11 @@ void SplatBuffer::add_polygon(std::span<const Point2f> output_vertices, const st
     deposit_grid_point(cx, cy, value);
     return;
   }
-  build_chains(vertices);
+  if (!build_chains(vertices)) {
+    // Not y-monotone: two chains would smear it between them.
+    add_general_polygon(vertices, cx, cy, value);
+    return;
+  }
 
   // Rasterised area in closed form, O(vertices): an edge is linear in y over its sub-rows, so the sum
   // of its x over them is count * x(mean sub-row y). The scan below assigns sub-rows to edges by the
@@ -331,29 +423,12 @@ void SplatBuffer::add_polygon(std::span<const Point2f> output_vertices, const st
   std::int64_t pixel_row = floor_div(s_lo, subrows);
   auto m = static_cast<int>(s_lo - pixel_row * subrows);
   const double inv_s = 1.0 / s;
-  const double w = grid_width_;
   for (std::int64_t sub = s_lo; sub < s_hi; ++sub) {
     const auto sub_d = static_cast<double>(sub);
     while (ef[1].first_subrow <= sub_d) ++ef;
     while (eb[1].first_subrow <= sub_d) ++eb;
     const double y = (sub_d + 0.5) * inv_s;
-    const EndWeights a = end_weights(clamp_end(ef->x + ef->slope * (y - ef->y), w));
-    const EndWeights b = end_weights(clamp_end(eb->x + eb->slope * (y - eb->y), w));
-    const double minus_qb[3] = {-b.q[0], -b.q[1], -b.q[2]};
-
-    const int upper = static_cast<int>(pixel_row) + subrow_row_offset_[static_cast<std::size_t>(m)];
-    const double lower_weight = subrow_lower_weight_[static_cast<std::size_t>(m)];
-    for (int r = 0; r < 2; ++r) {
-      const int row = upper + r;
-      const double row_weight = r == 0 ? 1.0 - lower_weight : lower_weight;
-      // One sub-row per pixel row samples the row's centre, which the tent gives wholly to it.
-      if (row < grid_row_begin_ || row >= grid_row_end_ || row_weight == 0.0) continue;
-      double coef[kChannels];
-      for (int c = 0; c < kChannels; ++c) coef[c] = row_weight * unit[c];
-      double* row_diff = diff_.data() + static_cast<std::size_t>(row - grid_row_begin_) * grid_width_ * kChannels;
-      add_weights(row_diff, grid_width_, a.first, a.q, coef);
-      add_weights(row_diff, grid_width_, b.first, minus_qb, coef);
-    }
+    deposit_span(static_cast<int>(pixel_row), m, ef->x + ef->slope * (y - ef->y), eb->x + eb->slope * (y - eb->y), unit);
     if (++m == subrows) {
       m = 0;
       ++pixel_row;

@@ -94,11 +94,12 @@ class SplatBuffer {
   // large enough; throws OptionsError for row_begin < 0 or row_end < row_begin.
   void reset(int row_begin, int row_end);
 
-  // Convex polygon, either winding, vertices in px; value = (R, G, B, alpha) energy it deposits.
+  // Simple polygon, either winding, vertices in px; value = (R, G, B, alpha) energy it deposits.
   // Polygons with no vertex, a non-finite vertex or a non-finite value are not deposited but counted
-  // in skipped(); 1 or 2 vertices are a point at their centroid. A non-convex polygon is not
-  // supported: it is spread between its two chains from the topmost to the bottommost vertex, still
-  // depositing exactly its value.
+  // in skipped(); 1 or 2 vertices are a point at their centroid. A y-monotone polygon (convex ones
+  // included) is scanned between its two chains from the topmost to the bottommost vertex; any other
+  // by the even-odd pairs of each sub-row's edge crossings (a crescent, a ring that turns back in
+  // y). A self-crossing polygon is filled by the even-odd rule; either way exactly its value.
   void add_polygon(std::span<const Point2f> vertices, const std::array<float, 4>& value);
   void add_triangle(Point2f a, Point2f b, Point2f c, const std::array<float, 4>& value);
   // A point deposit with bilinear weights over the 2 x 2 pixels whose centres surround p.
@@ -140,7 +141,13 @@ class SplatBuffer {
     double slope;  // dx/dy of that edge; 0 when it covers no sub-row
   };
 
-  void build_chains(std::span<const Point2f> vertices);
+  // The two chains from the topmost to the bottommost vertex; false where y turns back along one
+  // (the polygon is not y-monotone).
+  bool build_chains(std::span<const Point2f> vertices);
+  // add_polygon for a polygon that is not y-monotone; (cx, cy) its vertex centroid in cells.
+  void add_general_polygon(std::span<const Point2f> vertices, double cx, double cy, const std::array<float, 4>& value);
+  // One sub-row's span into the two rows its tent reaches (splat_buffer.cpp).
+  void deposit_span(int pixel_row, int m, double x_enter, double x_leave, const double unit[4]);
   void deposit_point(double x_out_px, double y_out_px, const std::array<float, 4>& value);
   void deposit_grid_point(double x_px, double y_px, const std::array<float, 4>& value);  // grid cells
 
@@ -167,6 +174,24 @@ class SplatBuffer {
   std::vector<double> subrow_lower_weight_;
   std::vector<ChainVertex> forward_chain_;   // scratch: top to bottom vertex by increasing index
   std::vector<ChainVertex> backward_chain_;  // scratch: top to bottom vertex by decreasing index
+  // Scratch of add_general_polygon: its edges by sub-row range, the active ones, one sub-row's
+  // crossings, and the spans of all sub-rows.
+  struct Edge {
+    double first;  // first sub-row it covers
+    double last;   // exclusive
+    double x;      // upper end
+    double y;
+    double slope;  // dx/dy
+  };
+  struct SubrowSpan {
+    double subrow;
+    double x_enter;
+    double x_leave;
+  };
+  std::vector<Edge> edges_;
+  std::vector<std::size_t> active_edges_;
+  std::vector<double> crossings_;
+  std::vector<SubrowSpan> spans_;
 };
 
 }  // namespace lensmith
