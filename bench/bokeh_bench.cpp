@@ -70,12 +70,17 @@ void run(benchmark::State& state, RayModelKind kind) {
   const auto model = bench_model(kind);
   BokehOptions options;
   options.threads = static_cast<int>(state.range(1));
+  BokehStatistics stats;
   for (auto _ : state) {
-    Image out = render_bokeh(scene.image, scene.depth, *model, Aperture::circular(), options);
+    Image out = render_bokeh(scene.image, scene.depth, *model, Aperture::circular(), options, &stats);
     benchmark::DoNotOptimize(out.data.data());
   }
   state.counters["Mpixel/s"] = benchmark::Counter(static_cast<double>(kWidth) * kHeight * 1e-6,
                                                   benchmark::Counter::kIsIterationInvariantRate);
+  // What the deposit had to do: footprints (one per wavelength group) and mesh triangles per pixel.
+  const double pixels = static_cast<double>(kWidth) * kHeight;
+  state.counters["footprints/px"] = static_cast<double>(stats.footprints) / pixels;
+  state.counters["triangles/px"] = static_cast<double>(stats.triangles) / pixels;
 }
 
 // Yu et al.'s light-field synthesis on the same scene (36 views, their default): its cost is the
