@@ -95,7 +95,7 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
   // nearest of them hid the others: a branch crossing behind a nearer one was extended under the
   // whole of the nearer branch's blur, 17 % too bright there (examples/scenes/branches.json).
   // (None to compute where no farther layer shows in the window: the layer claims all of it.)
-  LargeVector<std::array<double, 5>>& shares = scratch.shares;
+  LargeVector<std::array<double, 2>>& shares = scratch.shares;
   bool farther = false;
   for (int y = y0; y <= y1 && !farther; ++y) {
     for (int x = x0; x <= x1 && !farther; ++x) {
@@ -103,22 +103,22 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
       for (std::uint32_t k = layers.part_begin[p]; k < layers.part_begin[p + 1]; ++k) farther = farther || layers.parts[k].layer < layer;
     }
   }
-  if (farther) shares.assign(cells.size(), std::array<double, 5>{});
+  if (farther) shares.assign(cells.size(), std::array<double, 2>{});
 #pragma omp parallel for num_threads(threads) schedule(static) if (farther)
   for (int y = y0; y <= y1; ++y) {
     if (!farther) continue;
     for (int x = x0; x <= x1; ++x) {
       const std::size_t p = static_cast<std::size_t>(y) * w + x;
-      std::array<double, 5>& cell = shares[static_cast<std::size_t>(y - y0) * ww + (x - x0)];
+      std::array<double, 2>& cell = shares[static_cast<std::size_t>(y - y0) * ww + (x - x0)];
       for (std::uint32_t k = layers.part_begin[p]; k < layers.part_begin[p + 1]; ++k) {
         const PixelPart& part = layers.parts[k];
         if (part.layer > layer) continue;
         if (part.layer == layer) cell[0] += part.visible;
-        cell[4] += part.visible;
+        cell[1] += part.visible;
       }
     }
   }
-  if (farther) push_pull(ww, wh, shares, threads, &scratch.push_pull);
+  if (farther) push_pull(ww, wh, shares, threads, &scratch.push_pull_shares);
   const std::size_t before = out.size();
   for (std::size_t i : targets) {
     const std::size_t wx = i % static_cast<std::size_t>(w) - static_cast<std::size_t>(x0);

@@ -29,9 +29,10 @@ struct HiddenScratch {
   LargeVector<int> row_distance;
   LargeVector<std::uint8_t> within;
   std::vector<std::size_t> targets;
-  LargeVector<std::array<double, 5>> cells;
-  LargeVector<std::array<double, 5>> shares;
-  PushPullScratch push_pull;
+  LargeVector<std::array<double, 5>> cells;   // colour (tone-mapped), inverse depth, weight
+  LargeVector<std::array<double, 2>> shares;  // the layer's visible share, weight
+  PushPullScratch<5> push_pull;
+  PushPullScratch<2> push_pull_shares;
 };
 
 // Appends to `out` the hidden sources of `layer`, under the nearer pixels within `reach_px` (a

@@ -43,7 +43,7 @@ void composite_layer_over(const LargeVector<float>& layer_rgba, const LargeVecto
 }
 
 Image finish_composite(const LargeVector<double>& result, int width, int height, int threads,
-                       LargeVector<std::array<double, 5>>& fill, PushPullScratch& scratch) {
+                       LargeVector<std::array<double, 5>>& fill, PushPullScratch<5>& scratch) {
   const std::size_t count = static_cast<std::size_t>(width) * height;
   bool any_gap = false;
   for (std::size_t k = 0; k < count && !any_gap; ++k) any_gap = result[4 * k + 3] < kRenormaliseCoverage;

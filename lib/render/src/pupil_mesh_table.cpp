@@ -25,14 +25,11 @@ int step_index(const std::array<int, N>& steps, double wanted) {
 
 }  // namespace
 
-PupilMeshTable::PupilMeshTable(const Aperture& aperture) {
-  if (aperture.kind() == Aperture::Kind::Mask) {
-    for (int cells : kGridSteps) meshes_.push_back(aperture.mesh(cells, kGridSectorsUnused));
-    return;
-  }
-  for (int rings : kRingSteps) {
-    for (int sectors : kSectorSteps) meshes_.push_back(aperture.mesh(rings, sectors));
-  }
+PupilMeshTable::PupilMeshTable(const Aperture& aperture) : aperture_(&aperture) {
+  const std::size_t count = aperture.kind() == Aperture::Kind::Mask ? kGridSteps.size() : kRingSteps.size() * kSectorSteps.size();
+  meshes_.resize(count);
+  built_ = std::make_unique<std::once_flag[]>(count);
+  if (aperture.kind() == Aperture::Kind::Mask) return;
   for (int sectors : kSectorSteps) {
     outlines_.push_back(aperture.outline(aperture.kind() == Aperture::Kind::Blades ? aperture.blade_count() : sectors));
     dense_outlines_.push_back(aperture.outline(sectors));
@@ -50,6 +47,18 @@ PupilMeshTable::PupilMeshTable(const Aperture& aperture) {
     }
     dense_directions_.push_back(std::move(d));
   }
+}
+
+const PupilMesh& PupilMeshTable::mesh(int index) const {
+  const auto i = static_cast<std::size_t>(index);
+  std::call_once(built_[i], [&] {
+    if (aperture_->kind() == Aperture::Kind::Mask) {
+      meshes_[i] = aperture_->mesh(kGridSteps[i], kGridSectorsUnused);
+    } else {
+      meshes_[i] = aperture_->mesh(kRingSteps[i / kSectorSteps.size()], kSectorSteps[i % kSectorSteps.size()]);
+    }
+  });
+  return meshes_[i];
 }
 
 int PupilMeshTable::sector_step(double diameter_px) {

@@ -8,25 +8,29 @@ namespace lensmith::render_detail {
 
 namespace {
 
-using Cell = std::array<double, 5>;
 // Levels with fewer cells than this are done on one thread (starting threads would cost more).
 constexpr int kParallelCells = 16384;
 
-// Normalised value of a cell of sums: the 4 values divided by the weight, and its confidence
-// min(weight, 1) in slot 4 (Gortler et al. clamp the pulled weights to 1 the same way).
-Cell normalised(const Cell& v) {
-  if (!(v[4] > 0.0)) return Cell{};
-  Cell n;
-  for (int k = 0; k < 4; ++k) n[static_cast<std::size_t>(k)] = v[static_cast<std::size_t>(k)] / v[4];
-  n[4] = std::min(v[4], 1.0);
+// Normalised value of a cell of sums: the N - 1 values divided by the weight, and its confidence
+// min(weight, 1) in the last slot (Gortler et al. clamp the pulled weights to 1 the same way).
+template <std::size_t N>
+std::array<double, N> normalised(const std::array<double, N>& v) {
+  constexpr std::size_t kWeight = N - 1;
+  if (!(v[kWeight] > 0.0)) return {};
+  std::array<double, N> n;
+  for (std::size_t k = 0; k < kWeight; ++k) n[k] = v[k] / v[kWeight];
+  n[kWeight] = std::min(v[kWeight], 1.0);
   return n;
 }
 
 }  // namespace
 
-void push_pull(int w, int h, LargeVector<Cell>& cells, int threads, PushPullScratch* scratch) {
+template <std::size_t N>
+void push_pull(int w, int h, LargeVector<std::array<double, N>>& cells, int threads, PushPullScratch<N>* scratch) {
+  using Cell = std::array<double, N>;
+  constexpr std::size_t kWeight = N - 1;
   // Pull: each level sums 2 x 2 blocks of the one below, down to a single cell.
-  PushPullScratch local;
+  PushPullScratch<N> local;
   std::vector<LargeVector<Cell>>& levels = (scratch ? *scratch : local).levels;
   std::vector<std::pair<int, int>> sizes{{w, h}};
   while (sizes.back().first > 1 || sizes.back().second > 1) {
@@ -44,7 +48,7 @@ void push_pull(int w, int h, LargeVector<Cell>& cells, int threads, PushPullScra
       for (int y = 2 * cy; y < std::min(fh, 2 * cy + 2); ++y) {
         const Cell* src = f.data() + static_cast<std::size_t>(y) * fw;
         for (int x = 0; x < fw; ++x) {
-          for (std::size_t k = 0; k < 5; ++k) dst[x / 2][k] += src[x][k];
+          for (std::size_t k = 0; k < N; ++k) dst[x / 2][k] += src[x][k];
         }
       }
     }
@@ -53,7 +57,7 @@ void push_pull(int w, int h, LargeVector<Cell>& cells, int threads, PushPullScra
   const std::size_t level_count = sizes.size() - 1;
   if (level_count == 0) {  // a single cell
     cells[0] = normalised(cells[0]);
-    if (cells[0][4] > 0.0) cells[0][4] = 1.0;
+    if (cells[0][kWeight] > 0.0) cells[0][kWeight] = 1.0;
     return;
   }
   // Push: from the coarsest level down, every cell becomes its own normalised value blended by its
@@ -61,7 +65,7 @@ void push_pull(int w, int h, LargeVector<Cell>& cells, int threads, PushPullScra
   // (x + 0.5) / 2 - 0.5 in its coordinates), so that filled areas are smooth, not 2^k blocks.
   Cell& top = levels[level_count - 1][0];
   top = normalised(top);
-  if (top[4] > 0.0) top[4] = 1.0;
+  if (top[kWeight] > 0.0) top[kWeight] = 1.0;
   for (std::size_t l = level_count; l-- > 0;) {
     LargeVector<Cell>& f = l == 0 ? cells : levels[l - 1];
     const LargeVector<Cell>& c = levels[l];
@@ -82,16 +86,19 @@ void push_pull(int w, int h, LargeVector<Cell>& cells, int threads, PushPullScra
         const Cell& e = c[static_cast<std::size_t>(y1) * cw + x1];
         Cell& v = f[static_cast<std::size_t>(y) * fw + x];
         const Cell own = normalised(v);
-        const double keep = own[4];
-        for (std::size_t k = 0; k < 4; ++k) {
+        const double keep = own[kWeight];
+        for (std::size_t k = 0; k < kWeight; ++k) {
           const double up = (1.0 - ty) * ((1.0 - tx) * a[k] + tx * b[k]) + ty * ((1.0 - tx) * d[k] + tx * e[k]);
           v[k] = keep * own[k] + (1.0 - keep) * up;
         }
         // Known wherever the level above is (the coarsest cell is known if any cell was).
-        v[4] = std::max({a[4], b[4], d[4], e[4], keep}) > 0.0 ? 1.0 : 0.0;
+        v[kWeight] = std::max({a[kWeight], b[kWeight], d[kWeight], e[kWeight], keep}) > 0.0 ? 1.0 : 0.0;
       }
     }
   }
 }
+
+template void push_pull<2>(int, int, LargeVector<std::array<double, 2>>&, int, PushPullScratch<2>*);
+template void push_pull<5>(int, int, LargeVector<std::array<double, 5>>&, int, PushPullScratch<5>*);
 
 }  // namespace lensmith::render_detail
