@@ -125,6 +125,39 @@ TEST_CASE("A highlight's disc has the thin-lens circle of confusion A f |z - s| 
   }
 }
 
+TEST_CASE("Through a thin lens a 5-bladed iris's bokeh is upright before the focus and turned about its centre behind it", "[render]") {
+  // Rays from a point behind the focus plane cross before the sensor: its footprint is the
+  // aperture's shape turned by 180 degrees, that of a point before it is not (every thin-lens
+  // footprint is drawn from a stamp, one per scale step and sign: this pins the signs). Equal blur
+  // at 1.2 m and 6 m with focus at 2 m (|z - s| / z = 2/3); the sub-rows and the tent are symmetric
+  // about a pixel's centre, so the turned deposit matches to float rounding.
+  constexpr double kTurned = 1e-4;        // of the peak
+  constexpr double kNotSymmetric = 0.05;  // of the peak: a pentagon is not symmetric about its centre
+  const int w = 240, h = 240, c = 120;
+  const Camera cam = Camera::thin_lens(100.0, camera_options(2.0, 1.4), w, h);
+  const auto model = make_ray_model(RayModelKind::Thin, cam);
+  BokehOptions o;
+  o.vignetting = false;
+  const Scene near = highlight_scene(w, h, 1.2, 2.0, c, c);
+  const Scene far = highlight_scene(w, h, 6.0, 6.0, c, c);
+  const Image a = render_bokeh(near.image, near.depth, *model, Aperture::blades(5, 0.0), o);
+  const Image b = render_bokeh(far.image, far.depth, *model, Aperture::blades(5, 0.0), o);
+  double peak = 0.0, turned = 0.0, asymmetry = 0.0;
+  for (int y = 1; y < h; ++y) {
+    for (int x = 1; x < w; ++x) {
+      const double va = a.at(x, y, 1), vb = b.at(2 * c - x, 2 * c - y, 1), va_turned = a.at(2 * c - x, 2 * c - y, 1);
+      peak = std::max(peak, va);
+      turned = std::max(turned, std::abs(va - vb));
+      asymmetry = std::max(asymmetry, std::abs(va - va_turned));
+    }
+  }
+  INFO("peak " << peak << ", near against far turned " << turned << ", near against itself turned " << asymmetry);
+  // (100 / 1.4) mm x 100 mm x 2/3 / 2000 mm = 2.38 mm across the pentagon's circle, 15.9 px of 0.15 mm.
+  CHECK(disc_diameter_px(a) > 10.0);
+  CHECK(turned < kTurned * peak);
+  CHECK(asymmetry > kNotSymmetric * peak);
+}
+
 TEST_CASE("A 200-pixel highlight is a solid, noise-free disc, and a 5-bladed iris makes a pentagon", "[render]") {
   // Two counts of pixels at half level, each edge placed to about 0.5 px: about 1 % of a 200 px shape's area each.
   constexpr double kPentagonArea = 0.02;
