@@ -1,7 +1,8 @@
 // The command line's global operator new and delete: blocks of 512 KiB and more come as whole,
-// 2-MiB aligned pages advised to the kernel as transparent huge pages, the advice HugePageAllocator gives the
-// renderer's own frame-sized buffers, so that the rest (pictures and depth maps as read, the EXR
-// codec's buffers, the output picture) is faulted in 2 MiB at a time as well. On the KVM guests of
+// 2-MiB aligned pages advised to the kernel as transparent huge pages (allocate_huge_pages, what
+// HugePageAllocator gives the renderer's own frame-sized buffers), so that the rest (pictures and
+// depth maps as read, the EXR codec's buffers, the output picture) is faulted in 2 MiB at a time
+// as well. On the KVM guests of
 // docs/performance.md a first touch costs about 12 us per 4 KiB page (3 ms per MiB): the 600 x 400
 // street scene's whole `lensmith bokeh` process spent about 25 ms of its 0.22 s on such faults.
 // Smaller blocks are plain malloc; every block is released by free (aligned_alloc's blocks are

@@ -103,22 +103,23 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
       for (std::uint32_t k = layers.part_begin[p]; k < layers.part_begin[p + 1]; ++k) farther = farther || layers.parts[k].layer < layer;
     }
   }
-  if (farther) shares.assign(cells.size(), std::array<double, 2>{});
-#pragma omp parallel for num_threads(threads) schedule(static) if (farther)
-  for (int y = y0; y <= y1; ++y) {
-    if (!farther) continue;
-    for (int x = x0; x <= x1; ++x) {
-      const std::size_t p = static_cast<std::size_t>(y) * w + x;
-      std::array<double, 2>& cell = shares[static_cast<std::size_t>(y - y0) * ww + (x - x0)];
-      for (std::uint32_t k = layers.part_begin[p]; k < layers.part_begin[p + 1]; ++k) {
-        const PixelPart& part = layers.parts[k];
-        if (part.layer > layer) continue;
-        if (part.layer == layer) cell[0] += part.visible;
-        cell[1] += part.visible;
+  if (farther) {
+    shares.assign(cells.size(), std::array<double, 2>{});
+#pragma omp parallel for num_threads(threads) schedule(static)
+    for (int y = y0; y <= y1; ++y) {
+      for (int x = x0; x <= x1; ++x) {
+        const std::size_t p = static_cast<std::size_t>(y) * w + x;
+        std::array<double, 2>& cell = shares[static_cast<std::size_t>(y - y0) * ww + (x - x0)];
+        for (std::uint32_t k = layers.part_begin[p]; k < layers.part_begin[p + 1]; ++k) {
+          const PixelPart& part = layers.parts[k];
+          if (part.layer > layer) continue;
+          if (part.layer == layer) cell[0] += part.visible;
+          cell[1] += part.visible;
+        }
       }
     }
+    push_pull(ww, wh, shares, threads, &scratch.push_pull_shares);
   }
-  if (farther) push_pull(ww, wh, shares, threads, &scratch.push_pull_shares);
   const std::size_t before = out.size();
   for (std::size_t i : targets) {
     const std::size_t wx = i % static_cast<std::size_t>(w) - static_cast<std::size_t>(x0);

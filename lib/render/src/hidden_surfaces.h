@@ -23,7 +23,7 @@
 
 namespace lensmith::render_detail {
 
-// Frame-sized working memory of hidden_sources, kept from layer to layer: fresh memory is faulted
+// Frame-sized working memory of append_hidden_sources, kept from layer to layer: fresh memory is faulted
 // in page by page, which cost more than the work itself (docs/performance.md).
 struct HiddenScratch {
   LargeVector<int> row_distance;

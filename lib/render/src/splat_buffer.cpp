@@ -293,7 +293,7 @@ void SplatBuffer::add_general_polygon(std::span<const Point2f> vertices, double 
   std::sort(edges_.begin(), edges_.end(), [](const Edge& a, const Edge& b) { return a.first < b.first; });
   // Spans by even-odd pairs of the crossings of each sub-row, sorted along x.
   spans_.clear();
-  double twice_area = 0.0;  // sum of span lengths, sub-rows
+  double span_length = 0.0;  // summed over every sub-row, px
   std::size_t next = 0;
   std::vector<std::size_t>& active = active_edges_;
   active.clear();
@@ -308,10 +308,10 @@ void SplatBuffer::add_general_polygon(std::span<const Point2f> vertices, double 
     std::sort(crossings_.begin(), crossings_.end());
     for (std::size_t j = 0; j + 1 < crossings_.size(); j += 2) {
       spans_.push_back({sub, crossings_[j], crossings_[j + 1]});
-      twice_area += crossings_[j + 1] - crossings_[j];
+      span_length += crossings_[j + 1] - crossings_[j];
     }
   }
-  const double area = twice_area / s;
+  const double area = span_length / s;
   if (!std::isfinite(area)) {
     ++skipped_;
     return;

@@ -99,7 +99,8 @@ class SplatBuffer {
   // in skipped(); 1 or 2 vertices are a point at their centroid. A y-monotone polygon (convex ones
   // included) is scanned between its two chains from the topmost to the bottommost vertex; any other
   // by the even-odd pairs of each sub-row's edge crossings (a crescent, a ring that turns back in
-  // y). A self-crossing polygon is filled by the even-odd rule; either way exactly its value.
+  // y); either way exactly its value. A self-crossing polygon is not supported (a y-monotone one is
+  // spread between its chains, any other filled by the even-odd rule).
   void add_polygon(std::span<const Point2f> vertices, const std::array<float, 4>& value);
   void add_triangle(Point2f a, Point2f b, Point2f c, const std::array<float, 4>& value);
   // A point deposit with bilinear weights over the 2 x 2 pixels whose centres surround p.
@@ -108,7 +109,7 @@ class SplatBuffer {
   // add_polygon (entries left of the image fold into its first column, those right of it and
   // outside the band are dropped). Full-resolution buffers only (downsample 1: OptionsError).
   void add_stamp(const DifferenceStamp& stamp, int anchor_x, int anchor_y, const std::array<float, 4>& value);
-  // The stamp of a convex polygon (px; its deposit at anchor (0, 0) is add_polygon's of `vertices`)
+  // The stamp of a polygon (px; its deposit at anchor (0, 0) is add_polygon's of `vertices`)
   // sampled at `subrows` sub-rows per pixel (SplatOptions::subrows' range). Empty (no entries) for
   // a polygon add_polygon would skip; a polygon with no area records as a point.
   static DifferenceStamp record(std::span<const Point2f> vertices, int subrows);
