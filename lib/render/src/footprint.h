@@ -58,6 +58,15 @@ struct FootprintScratch {
   std::vector<std::size_t> ring_offsets;  // clipped rings: where each ring's vertices end in `pupil`
   std::vector<double> pupil_areas;
   std::vector<double> ring_weights;
+  // Ring polygons to deposit (deposit_nested_rings): the ring (1-based), its light and coverage.
+  struct RingDeposit {
+    int ring = 0;
+    double light = 0.0;
+    double coverage = 0.0;
+  };
+  std::vector<RingDeposit> ring_deposits;
+  std::vector<Point2f> moved_ring;
+  std::vector<Point2f> ring_points;  // mapped points of the ring polygons, untangled (footprint.cpp)
   std::vector<std::span<const Point2f>> ring_spans;
   // One footprint's maps at each of its wavelengths, kept from the check whether its rings nest at
   // all of them to their deposit (set 0: the mesh by map, 1: the clipped rings by map_passing).

@@ -83,6 +83,7 @@ struct BokehStatistics {
   // it): the pixels outside it are copies of the input's edge. Render the input with overscan.
   double edge_gap_px = 0.0;
   std::string to_string() const;
+  friend std::ostream& operator<<(std::ostream& os, const BokehStatistics& s) { return os << s.to_string(); }
 };
 
 // The picture `model` takes of the scene (image: linear Rec.709 RGB, 3 channels; depth: planar
