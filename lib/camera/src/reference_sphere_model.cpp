@@ -119,7 +119,6 @@ void ReferenceSphereModel::map_passing(const ScenePoint& point, double wavelengt
 void ReferenceSphereModel::map_with(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
                                     std::span<SensorHit> hits, bool with_clearance) const {
   const FirstOrderSample fo = camera_.first_order(wavelength_nm);
-  const GaussianImage g = camera_.gaussian_image(point, fo);
   const double r_exit = fo.exit_pupil_radius_mm * camera_.pupil_orientation();
   const double z_exit = fo.z_exit_pupil_mm;
   const double z_sensor = camera_.z_sensor_mm();
@@ -168,7 +167,9 @@ void ReferenceSphereModel::map_with(const ScenePoint& point, double wavelength_n
   };
 
   if (kind_ != RayModelKind::Seidel) {
-    // Straight line from the exit-pupil point through the Gaussian image point to the sensor.
+    // Straight line from the exit-pupil point through the Gaussian image point to the sensor (the
+    // Seidel branch's SeidelRayGeometry finds that point itself).
+    const GaussianImage g = camera_.gaussian_image(point, fo);
     const double t = (z_sensor - z_exit) / (g.z_mm - z_exit);
     for (std::size_t i = 0; i < pupil.size(); ++i) {
       const double px = r_exit * pupil[i].x, py = r_exit * pupil[i].y;
@@ -179,7 +180,7 @@ void ReferenceSphereModel::map_with(const ScenePoint& point, double wavelength_n
 
   // Seidel: depth is measured from the perspective centre, object distances from surface 1.
   const double object_distance_mm = distance_mm_from_inverse(point.inverse_depth_per_mm) - camera_.z_perspective_mm();
-  const AberrationCoefficients c = table_->at(wavelength_nm, std::max(object_distance_mm, 1.0)).coefficients;
+  const AberrationCoefficients c = table_->coefficients_at(wavelength_nm, std::max(object_distance_mm, 1.0));
   const SeidelRayGeometry geometry(camera_, fo, point, c.max_field_tangent);
   FieldTerms terms = FieldTerms::at(c, geometry.y0);
   // Fitted: the real lens's terms, and its light relative to the first-order weights and clipping.

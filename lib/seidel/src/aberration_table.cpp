@@ -88,6 +88,16 @@ AberrationTable::AberrationTable(const Prescription& lens, const AberrationTable
   }
 }
 
+AberrationCoefficients AberrationTable::coefficients_at(double wavelength_nm, double object_distance_mm) const {
+  const auto [i, ti] = grid_interval(wavelengths_nm_, wavelength_nm);
+  const auto [j, tj] = grid_interval(inverse_distances_per_mm_, inverse_per_mm(object_distance_mm));
+  const std::size_t i1 = std::min(i + 1, wavelengths_nm_.size() - 1);
+  const std::size_t j1 = std::min(j + 1, distances_mm_.size() - 1);
+  const AberrationCoefficients near_lambda = lerp(sample(i, j).coefficients, sample(i1, j).coefficients, ti);
+  const AberrationCoefficients far_lambda = lerp(sample(i, j1).coefficients, sample(i1, j1).coefficients, ti);
+  return lerp(near_lambda, far_lambda, tj);
+}
+
 AberrationSample AberrationTable::at(double wavelength_nm, double object_distance_mm) const {
   const auto [i, ti] = grid_interval(wavelengths_nm_, wavelength_nm);
   const auto [j, tj] = grid_interval(inverse_distances_per_mm_, inverse_per_mm(object_distance_mm));

@@ -40,6 +40,8 @@ class AberrationTable {
   AberrationSample& sample(std::size_t i, std::size_t j) { return samples_[j * wavelengths_nm_.size() + i]; }
   // Bilinear interpolation in wavelength and in 1 / object distance; clamps outside the table.
   AberrationSample at(double wavelength_nm, double object_distance_mm) const;
+  // The coefficients of at() alone, without its paraxial data (a renderer asks per footprint).
+  AberrationCoefficients coefficients_at(double wavelength_nm, double object_distance_mm) const;
   std::string to_string() const;
 
  private:
