@@ -199,9 +199,9 @@ void untangle_ring(std::span<Point2f> ring) {
   }
 }
 
-// Mapped ring polygons (rings[k - 1] = the `counts[k - 1]` points after those of rings before it
-// in `points`, from `first`) copied to scratch.ring_points, untangled (untangle_ring), as
-// scratch.ring_spans: the triangles keep the mapped points as they are.
+// The mapped ring polygons (ring k is points [ring_range(k).first, ring_range(k).second)) copied to
+// scratch.ring_points, untangled (untangle_ring), as scratch.ring_spans: the triangles keep the
+// mapped points as they are.
 template <typename RingEnd>
 void untangled_ring_spans(const std::vector<Point2f>& points, int rings, RingEnd&& ring_range, FootprintScratch& scratch) {
   scratch.ring_points.assign(points.begin(), points.end());
@@ -259,35 +259,44 @@ bool rings_nest(const std::vector<std::span<const Point2f>>& rings, std::vector<
   return true;
 }
 
-// The centroid (px) of the light of the triangles between a footprint's mapped rings (a fan from the
-// centre, then two per cell between rings; what deposit_clipped_rings would deposit): each carries
-// its pupil area (times its rays' mean radiometric weight when `weighted`) at its mapped corners'
-// mean. Rings have `n` vertices each, ring k's from ring_begin(k); the centre is point 0. False
-// where no triangle has pupil area.
-template <typename Pupil, typename RingBegin>
-bool fan_light_centroid(const Pupil& pupil, const std::vector<Point2f>& points, const std::vector<SensorHit>& hits, int rings,
-                        std::size_t n, RingBegin&& ring_begin, bool weighted, double& cx, double& cy) {
-  double sx = 0.0, sy = 0.0, total = 0.0;
-  auto triangle = [&](std::size_t a, std::size_t b, std::size_t c) {
-    double w = std::abs((pupil[b].x - pupil[a].x) * (pupil[c].y - pupil[a].y) - (pupil[c].x - pupil[a].x) * (pupil[b].y - pupil[a].y));
-    if (weighted) w *= hits[a].weight + hits[b].weight + hits[c].weight;
-    sx += w * (static_cast<double>(points[a].x) + points[b].x + points[c].x);
-    sy += w * (static_cast<double>(points[a].y) + points[b].y + points[c].y);
-    total += w;
+// The triangles between a footprint's pupil rings: a fan from the centre (point 0), then two per
+// cell between rings; rings have `n` vertices each, ring k's from ring_begin(k). Calls
+// triangle(a, b, c, pupil_area) for each, in that order.
+template <typename Pupil, typename RingBegin, typename Triangle>
+void for_each_ring_triangle(const Pupil& pupil, int rings, std::size_t n, RingBegin&& ring_begin, Triangle&& triangle) {
+  auto visit = [&](std::size_t a, std::size_t b, std::size_t c) {
+    triangle(a, b, c,
+             0.5 * std::abs((pupil[b].x - pupil[a].x) * (pupil[c].y - pupil[a].y) - (pupil[c].x - pupil[a].x) * (pupil[b].y - pupil[a].y)));
   };
   for (int k = 1; k <= rings; ++k) {
     const std::size_t outer = ring_begin(k);
     for (std::size_t j = 0; j < n; ++j) {
       const std::size_t j1 = j + 1 == n ? 0 : j + 1;
       if (k == 1) {
-        triangle(0, outer + j, outer + j1);
+        visit(0, outer + j, outer + j1);
         continue;
       }
       const std::size_t inner = ring_begin(k - 1);
-      triangle(inner + j, outer + j, outer + j1);
-      triangle(inner + j, outer + j1, inner + j1);
+      visit(inner + j, outer + j, outer + j1);
+      visit(inner + j, outer + j1, inner + j1);
     }
   }
+}
+
+// The centroid (px) of the light of the triangles between a footprint's mapped rings
+// (for_each_ring_triangle; what deposit_clipped_rings would deposit): each carries its pupil area
+// (times its rays' mean radiometric weight when `weighted`) at its mapped corners' mean. False where
+// no triangle has pupil area.
+template <typename Pupil, typename RingBegin>
+bool fan_light_centroid(const Pupil& pupil, const std::vector<Point2f>& points, const std::vector<SensorHit>& hits, int rings,
+                        std::size_t n, RingBegin&& ring_begin, bool weighted, double& cx, double& cy) {
+  double sx = 0.0, sy = 0.0, total = 0.0;
+  for_each_ring_triangle(pupil, rings, n, ring_begin, [&](std::size_t a, std::size_t b, std::size_t c, double area) {
+    const double w = weighted ? area * (hits[a].weight + hits[b].weight + hits[c].weight) : area;
+    sx += w * (static_cast<double>(points[a].x) + points[b].x + points[c].x);
+    sy += w * (static_cast<double>(points[a].y) + points[b].y + points[c].y);
+    total += w;
+  });
   if (!(total > 0.0)) return false;
   cx = sx / (3.0 * total);
   cy = sy / (3.0 * total);
@@ -550,47 +559,30 @@ void FootprintScatter::deposit_clipped_rings(const ScenePoint& point, double wav
   // more than the iris's, and where neighbouring points' outlines switched from 16 to 24 vertices
   // a uniform defocused sky showed a line.
   const double full_pupil_area = scratch.pupil_areas.back() / passing;
+  auto ring_begin = [&scratch](int k) { return scratch.ring_offsets[static_cast<std::size_t>(k) - 1]; };
   auto centroid = [&](double& cx, double& cy) {
-    return fan_light_centroid(pupil, points, hits, rings, outline.size(),
-                              [&scratch](int k) { return scratch.ring_offsets[static_cast<std::size_t>(k) - 1]; },
-                              options_.vignetting, cx, cy);
+    return fan_light_centroid(pupil, points, hits, rings, outline.size(), ring_begin, options_.vignetting, cx, cy);
   };
   if (allow_rings && deposit_nested_rings(scratch.ring_spans, scratch.pupil_areas, scratch.ring_weights, full_pupil_area,
                                           value, options_.vignetting, centroid, buffer, scratch)) {
     return;
   }
-  // The same clipped rings as triangles: a fan from the centre, then two per cell between rings
-  // (every ring has the outline's vertex count). Each carries its own pupil area's light and
+  // The same clipped rings as triangles (for_each_ring_triangle; every ring has the outline's vertex
+  // count). Each carries its own pupil area's light and
   // coverage, so that the beam keeps its clipped shape: the mesh's triangles, clipped in place by
   // interpolated clearances, would spread a coarse mesh's edge cells over their unclipped images,
   // and where neighbouring sources switch between the two the sky showed seams.
   const double pupil_total = scratch.pupil_areas.back();
   if (!(pupil_total > 0.0)) return;
   const double light_area = options_.vignetting ? full_pupil_area : pupil_total;
-  auto triangle = [&](std::size_t a, std::size_t b, std::size_t c) {
-    const double area = 0.5 * std::abs((pupil[b].x - pupil[a].x) * (pupil[c].y - pupil[a].y) -
-                                       (pupil[c].x - pupil[a].x) * (pupil[b].y - pupil[a].y));
+  for_each_ring_triangle(pupil, rings, outline.size(), ring_begin, [&](std::size_t a, std::size_t b, std::size_t c, double area) {
     if (!(area > 0.0)) return;
     const double weight = options_.vignetting ? (hits[a].weight + hits[b].weight + hits[c].weight) / 3.0 : 1.0;
     const auto f = static_cast<float>(area / light_area * weight);
     const auto cover = static_cast<float>(area / pupil_total);
     fine.add_triangle(points[a], points[b], points[c], {value[0] * f, value[1] * f, value[2] * f, value[3] * cover});
     ++triangles;
-  };
-  const std::size_t n = outline.size();
-  for (int k = 1; k <= rings; ++k) {
-    const std::size_t outer = scratch.ring_offsets[static_cast<std::size_t>(k) - 1];
-    for (std::size_t j = 0; j < n; ++j) {
-      const std::size_t j1 = (j + 1) % n;
-      if (k == 1) {
-        triangle(0, outer + j, outer + j1);
-        continue;
-      }
-      const std::size_t inner = scratch.ring_offsets[static_cast<std::size_t>(k) - 2];
-      triangle(inner + j, outer + j, outer + j1);
-      triangle(inner + j, outer + j1, inner + j1);
-    }
-  }
+  });
 }
 
 std::array<float, 4> FootprintScatter::lit(const std::array<float, 4>& value, double weight) const {

@@ -88,24 +88,24 @@ AberrationTable::AberrationTable(const Prescription& lens, const AberrationTable
   }
 }
 
-AberrationCoefficients AberrationTable::coefficients_at(double wavelength_nm, double object_distance_mm) const {
+AberrationTable::Cell AberrationTable::cell(double wavelength_nm, double object_distance_mm) const {
   const auto [i, ti] = grid_interval(wavelengths_nm_, wavelength_nm);
   const auto [j, tj] = grid_interval(inverse_distances_per_mm_, inverse_per_mm(object_distance_mm));
-  const std::size_t i1 = std::min(i + 1, wavelengths_nm_.size() - 1);
-  const std::size_t j1 = std::min(j + 1, distances_mm_.size() - 1);
-  const AberrationCoefficients near_lambda = lerp(sample(i, j).coefficients, sample(i1, j).coefficients, ti);
-  const AberrationCoefficients far_lambda = lerp(sample(i, j1).coefficients, sample(i1, j1).coefficients, ti);
-  return lerp(near_lambda, far_lambda, tj);
+  return {i, std::min(i + 1, wavelengths_nm_.size() - 1), ti, j, std::min(j + 1, distances_mm_.size() - 1), tj};
+}
+
+AberrationCoefficients AberrationTable::coefficients_at(double wavelength_nm, double object_distance_mm) const {
+  const Cell c = cell(wavelength_nm, object_distance_mm);
+  const AberrationCoefficients near_lambda = lerp(sample(c.i, c.j).coefficients, sample(c.i1, c.j).coefficients, c.ti);
+  const AberrationCoefficients far_lambda = lerp(sample(c.i, c.j1).coefficients, sample(c.i1, c.j1).coefficients, c.ti);
+  return lerp(near_lambda, far_lambda, c.tj);
 }
 
 AberrationSample AberrationTable::at(double wavelength_nm, double object_distance_mm) const {
-  const auto [i, ti] = grid_interval(wavelengths_nm_, wavelength_nm);
-  const auto [j, tj] = grid_interval(inverse_distances_per_mm_, inverse_per_mm(object_distance_mm));
-  const std::size_t i1 = std::min(i + 1, wavelengths_nm_.size() - 1);
-  const std::size_t j1 = std::min(j + 1, distances_mm_.size() - 1);
-  const AberrationSample near_lambda = lerp(sample(i, j), sample(i1, j), ti);
-  const AberrationSample far_lambda = lerp(sample(i, j1), sample(i1, j1), ti);
-  AberrationSample s = lerp(near_lambda, far_lambda, tj);
+  const Cell c = cell(wavelength_nm, object_distance_mm);
+  const AberrationSample near_lambda = lerp(sample(c.i, c.j), sample(c.i1, c.j), c.ti);
+  const AberrationSample far_lambda = lerp(sample(c.i, c.j1), sample(c.i1, c.j1), c.ti);
+  AberrationSample s = lerp(near_lambda, far_lambda, c.tj);
   s.object_distance_mm = object_distance_mm;
   return s;
 }

@@ -3,6 +3,7 @@
 // in wavelength and in inverse object distance (dioptres), which is how they vary smoothly.
 #pragma once
 
+#include <cstddef>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -45,6 +46,15 @@ class AberrationTable {
   std::string to_string() const;
 
  private:
+  // The table cell around (wavelength, 1 / distance): its corner indices and fractions.
+  struct Cell {
+    std::size_t i, i1;
+    double ti;
+    std::size_t j, j1;
+    double tj;
+  };
+  Cell cell(double wavelength_nm, double object_distance_mm) const;
+
   std::vector<double> wavelengths_nm_;
   std::vector<double> distances_mm_;
   std::vector<double> inverse_distances_per_mm_;  // 1 / distance, ascending (0 = infinity)
