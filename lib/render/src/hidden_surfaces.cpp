@@ -73,19 +73,23 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
   x1 = std::min(w - 1, x1 + reach);
   y1 = std::min(h - 1, y1 + reach);
   const int ww = x1 - x0 + 1, wh = y1 - y0 + 1;
-  LargeVector<std::array<double, 5>>& cells = scratch.cells;
-  cells.assign(static_cast<std::size_t>(ww) * wh, std::array<double, 5>{});
+  LargeVector<PushPullCell<5>>& cells = scratch.cells;
+  // The whole frame's address space once (reserve is free until touched), so that no layer's
+  // larger window moves the cells to fresh memory.
+  cells.reserve(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+  scratch.push_pull.reserve(w, h);
+  cells.assign(static_cast<std::size_t>(ww) * wh, PushPullCell<5>{});
   // The layer's own whole pixels (the parts of split edge pixels are uncertain estimates).
   for (int i : layers.members[static_cast<std::size_t>(layer)]) {
     const ScatterSource& p = sources[static_cast<std::size_t>(i)];
     if (p.x < x0 || p.x > x1 || p.y < y0 || p.y > y1 || p.coverage < 1.0f) continue;
-    std::array<double, 5>& cell = cells[static_cast<std::size_t>(p.y - y0) * ww + (p.x - x0)];
+    PushPullCell<5>& cell = cells[static_cast<std::size_t>(p.y - y0) * ww + (p.x - x0)];
     const double c = p.coverage;
-    cell[0] += c * tone(p.rgb[0] / p.coverage);
-    cell[1] += c * tone(p.rgb[1] / p.coverage);
-    cell[2] += c * tone(p.rgb[2] / p.coverage);
-    cell[3] += c * p.inverse_depth_per_mm;
-    cell[4] += c;
+    cell[0] += static_cast<float>(c * tone(p.rgb[0] / p.coverage));
+    cell[1] += static_cast<float>(c * tone(p.rgb[1] / p.coverage));
+    cell[2] += static_cast<float>(c * tone(p.rgb[2] / p.coverage));
+    cell[3] += static_cast<float>(c * p.inverse_depth_per_mm);
+    cell[4] += static_cast<float>(c);
   }
   push_pull(ww, wh, cells, threads, &scratch.push_pull);
   // The layer's share of what lies behind the nearer pixels: among the visible parts of this layer
@@ -95,7 +99,7 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
   // nearest of them hid the others: a branch crossing behind a nearer one was extended under the
   // whole of the nearer branch's blur, 17 % too bright there (examples/scenes/branches.json).
   // (None to compute where no farther layer shows in the window: the layer claims all of it.)
-  LargeVector<std::array<double, 2>>& shares = scratch.shares;
+  LargeVector<PushPullCell<2>>& shares = scratch.shares;
   bool farther = false;
   for (int y = y0; y <= y1 && !farther; ++y) {
     for (int x = x0; x <= x1 && !farther; ++x) {
@@ -104,12 +108,14 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
     }
   }
   if (farther) {
-    shares.assign(cells.size(), std::array<double, 2>{});
+    shares.reserve(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+    scratch.push_pull_shares.reserve(w, h);
+    shares.assign(cells.size(), PushPullCell<2>{});
 #pragma omp parallel for num_threads(threads) schedule(static)
     for (int y = y0; y <= y1; ++y) {
       for (int x = x0; x <= x1; ++x) {
         const std::size_t p = static_cast<std::size_t>(y) * w + x;
-        std::array<double, 2>& cell = shares[static_cast<std::size_t>(y - y0) * ww + (x - x0)];
+        PushPullCell<2>& cell = shares[static_cast<std::size_t>(y - y0) * ww + (x - x0)];
         for (std::uint32_t k = layers.part_begin[p]; k < layers.part_begin[p + 1]; ++k) {
           const PixelPart& part = layers.parts[k];
           if (part.layer > layer) continue;

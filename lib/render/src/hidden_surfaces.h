@@ -29,8 +29,8 @@ struct HiddenScratch {
   LargeVector<int> row_distance;
   LargeVector<std::uint8_t> within;
   std::vector<std::size_t> targets;
-  LargeVector<std::array<double, 5>> cells;   // colour (tone-mapped), inverse depth, weight
-  LargeVector<std::array<double, 2>> shares;  // the layer's visible share, weight
+  LargeVector<PushPullCell<5>> cells;   // colour (tone-mapped), inverse depth, weight
+  LargeVector<PushPullCell<2>> shares;  // the layer's visible share, weight
   PushPullScratch<5> push_pull;
   PushPullScratch<2> push_pull_shares;
 };

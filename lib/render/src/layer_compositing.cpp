@@ -43,19 +43,20 @@ void composite_layer_over(const LargeVector<float>& layer_rgba, const LargeVecto
 }
 
 Image finish_composite(const LargeVector<double>& result, int width, int height, int threads,
-                       LargeVector<std::array<double, 5>>& fill, PushPullScratch<5>& scratch) {
+                       LargeVector<PushPullCell<5>>& fill, PushPullScratch<5>& scratch) {
   const std::size_t count = static_cast<std::size_t>(width) * height;
   bool any_gap = false;
   for (std::size_t k = 0; k < count && !any_gap; ++k) any_gap = result[4 * k + 3] < kRenormaliseCoverage;
-  // The push-pull fill (5 doubles a pixel) only where some gap is too empty to renormalise.
+  // The push-pull fill (5 floats a pixel) only where some gap is too empty to renormalise.
   const auto pixels = static_cast<std::ptrdiff_t>(count);
   if (any_gap) {
     fill.resize(count);  // every cell is written below
 #pragma omp parallel for num_threads(threads) schedule(static)
     for (std::ptrdiff_t k = 0; k < pixels; ++k) {
       const double coverage = result[4 * k + 3];
-      fill[k] = coverage >= kKnownCoverage ? std::array<double, 5>{result[4 * k], result[4 * k + 1], result[4 * k + 2], 0.0, coverage}
-                                           : std::array<double, 5>{};
+      fill[k] = coverage >= kKnownCoverage ? PushPullCell<5>{static_cast<float>(result[4 * k]), static_cast<float>(result[4 * k + 1]),
+                                                             static_cast<float>(result[4 * k + 2]), 0.0f, static_cast<float>(coverage)}
+                                           : PushPullCell<5>{};
     }
     push_pull(width, height, fill, threads, &scratch);
   }

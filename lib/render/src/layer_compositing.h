@@ -26,6 +26,6 @@ void composite_layer_over(const LargeVector<float>& layer_rgba, const LargeVecto
 // The output picture: the result with its uncovered remainder filled, on `threads` threads; `fill`
 // and `scratch` are working memory kept by the caller (their contents are overwritten).
 Image finish_composite(const LargeVector<double>& result, int width, int height, int threads,
-                       LargeVector<std::array<double, 5>>& fill, PushPullScratch<5>& scratch);
+                       LargeVector<PushPullCell<5>>& fill, PushPullScratch<5>& scratch);
 
 }  // namespace lensmith::render_detail

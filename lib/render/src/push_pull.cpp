@@ -14,20 +14,20 @@ constexpr int kParallelCells = 16384;
 // Normalised value of a cell of sums: the N - 1 values divided by the weight, and its confidence
 // min(weight, 1) in the last slot (Gortler et al. clamp the pulled weights to 1 the same way).
 template <std::size_t N>
-std::array<double, N> normalised(const std::array<double, N>& v) {
+PushPullCell<N> normalised(const PushPullCell<N>& v) {
   constexpr std::size_t kWeight = N - 1;
-  if (!(v[kWeight] > 0.0)) return {};
-  std::array<double, N> n;
+  if (!(v[kWeight] > 0.0f)) return {};
+  PushPullCell<N> n;
   for (std::size_t k = 0; k < kWeight; ++k) n[k] = v[k] / v[kWeight];
-  n[kWeight] = std::min(v[kWeight], 1.0);
+  n[kWeight] = std::min(v[kWeight], 1.0f);
   return n;
 }
 
 }  // namespace
 
 template <std::size_t N>
-void push_pull(int w, int h, LargeVector<std::array<double, N>>& cells, int threads, PushPullScratch<N>* scratch) {
-  using Cell = std::array<double, N>;
+void push_pull(int w, int h, LargeVector<PushPullCell<N>>& cells, int threads, PushPullScratch<N>* scratch) {
+  using Cell = PushPullCell<N>;
   constexpr std::size_t kWeight = N - 1;
   // Pull: each level sums 2 x 2 blocks of the one below, down to a single cell.
   PushPullScratch<N> local;
@@ -57,7 +57,7 @@ void push_pull(int w, int h, LargeVector<std::array<double, N>>& cells, int thre
   const std::size_t level_count = sizes.size() - 1;
   if (level_count == 0) {  // a single cell
     cells[0] = normalised(cells[0]);
-    if (cells[0][kWeight] > 0.0) cells[0][kWeight] = 1.0;
+    if (cells[0][kWeight] > 0.0f) cells[0][kWeight] = 1.0f;
     return;
   }
   // Push: from the coarsest level down, every cell becomes its own normalised value blended by its
@@ -65,7 +65,7 @@ void push_pull(int w, int h, LargeVector<std::array<double, N>>& cells, int thre
   // (x + 0.5) / 2 - 0.5 in its coordinates), so that filled areas are smooth, not 2^k blocks.
   Cell& top = levels[level_count - 1][0];
   top = normalised(top);
-  if (top[kWeight] > 0.0) top[kWeight] = 1.0;
+  if (top[kWeight] > 0.0f) top[kWeight] = 1.0f;
   for (std::size_t l = level_count; l-- > 0;) {
     LargeVector<Cell>& f = l == 0 ? cells : levels[l - 1];
     const LargeVector<Cell>& c = levels[l];
@@ -89,16 +89,16 @@ void push_pull(int w, int h, LargeVector<std::array<double, N>>& cells, int thre
         const double keep = own[kWeight];
         for (std::size_t k = 0; k < kWeight; ++k) {
           const double up = (1.0 - ty) * ((1.0 - tx) * a[k] + tx * b[k]) + ty * ((1.0 - tx) * d[k] + tx * e[k]);
-          v[k] = keep * own[k] + (1.0 - keep) * up;
+          v[k] = static_cast<float>(keep * own[k] + (1.0 - keep) * up);
         }
         // Known wherever the level above is (the coarsest cell is known if any cell was).
-        v[kWeight] = std::max({a[kWeight], b[kWeight], d[kWeight], e[kWeight], keep}) > 0.0 ? 1.0 : 0.0;
+        v[kWeight] = std::max({a[kWeight], b[kWeight], d[kWeight], e[kWeight], own[kWeight]}) > 0.0f ? 1.0f : 0.0f;
       }
     }
   }
 }
 
-template void push_pull<2>(int, int, LargeVector<std::array<double, 2>>&, int, PushPullScratch<2>*);
-template void push_pull<5>(int, int, LargeVector<std::array<double, 5>>&, int, PushPullScratch<5>*);
+template void push_pull<2>(int, int, LargeVector<PushPullCell<2>>&, int, PushPullScratch<2>*);
+template void push_pull<5>(int, int, LargeVector<PushPullCell<5>>&, int, PushPullScratch<5>*);
 
 }  // namespace lensmith::render_detail

@@ -11,10 +11,28 @@
 
 namespace lensmith::render_detail {
 
+// A cell: N - 1 weighted sums and their weight, in float: the push-pull guesses colour and depth
+// where the picture does not know them, far coarser than float's 1e-7, and a frame's cells in double
+// (40 bytes a pixel for N = 5) were a large part of the memory a render first touches, which is what
+// costs on the virtual machines of docs/performance.md.
+template <std::size_t N>
+using PushPullCell = std::array<float, N>;
+
 // The coarser levels' memory, kept from call to call (a renderer calls once per depth layer).
 template <std::size_t N>
 struct PushPullScratch {
-  std::vector<LargeVector<std::array<double, N>>> levels;
+  std::vector<LargeVector<PushPullCell<N>>> levels;
+  // Address space for the levels of grids up to w x h, so that a later call on a larger window
+  // reuses the memory an earlier one faulted in instead of copying it to a fresh block (on a virtual
+  // machine the first touch of fresh memory is what costs: docs/performance.md).
+  void reserve(int w, int h) {
+    for (std::size_t l = 0; w > 1 || h > 1; ++l) {
+      w = (w + 1) / 2;
+      h = (h + 1) / 2;
+      if (levels.size() <= l) levels.emplace_back();
+      levels[l].reserve(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+    }
+  }
 };
 
 // `cells` holds, per pixel of a w x h grid, N - 1 weighted sums and their weight (slot N - 1; 0 =
@@ -23,6 +41,6 @@ struct PushPullScratch {
 // was known). Rows are shared among `threads` threads; the result does not depend on their number.
 // Made for N = 2 (a share) and N = 5 (colour and inverse depth).
 template <std::size_t N>
-void push_pull(int w, int h, LargeVector<std::array<double, N>>& cells, int threads = 1, PushPullScratch<N>* scratch = nullptr);
+void push_pull(int w, int h, LargeVector<PushPullCell<N>>& cells, int threads = 1, PushPullScratch<N>* scratch = nullptr);
 
 }  // namespace lensmith::render_detail
