@@ -42,17 +42,13 @@ using render_detail::FootprintScratch;
 using render_detail::ScatterSource;
 using render_detail::ScatterSources;
 
-// Footprint heights (px, with margins) from which half and a quarter of the sub-rows are used: only
-// a tall footprint's top and bottom rows see the y sampling.
-constexpr float kMediumFootprintPx = 20.0f;
-constexpr float kTallFootprintPx = 68.0f;
 // Splat grids: full resolution, 2 x 2 and 4 x 4 px cells (FootprintPlan::level).
 constexpr int kLevels = 3;
-// A thread's splat buffers by [light | hidden coverage][grid level][sub-row class], and which of
-// them the current band uses.
+// A thread's splat buffers by [light | hidden coverage][grid level], and which of them the current
+// band uses. Each footprint chooses its own sub-rows within them (footprint_subrows).
 struct BandBuffers {
-  std::array<std::array<std::array<std::optional<SplatBuffer>, 3>, kLevels>, 2> buffers;
-  std::array<std::array<std::array<bool, 3>, kLevels>, 2> used{};
+  std::array<std::array<std::optional<SplatBuffer>, kLevels>, 2> buffers;
+  std::array<std::array<bool, kLevels>, 2> used{};
 };
 // Bands of rows per thread: each band scatters the footprints that reach it.
 constexpr int kBandsPerThread = 4;
@@ -61,13 +57,6 @@ constexpr int kBandsPerThread = 4;
 constexpr double kHiddenMarginPx = 2.0;
 // Where the layer and the nearer ones blur less than this (px) together, nothing hidden shows.
 constexpr double kMinHiddenBlurPx = 1.0;
-
-// The splat options with the sub-row count divided by `divisor` (at least 1).
-SplatOptions subrow_options(const SplatOptions& splat, int divisor) {
-  SplatOptions o = splat;
-  o.subrows = std::max(1, o.subrows / divisor);
-  return o;
-}
 
 int thread_count(const BokehOptions& options) { return options.threads > 0 ? options.threads : omp_get_max_threads(); }
 
@@ -136,35 +125,26 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
       for (int b = 0; b < bands; ++b) {
         const int row_begin = b * h / bands, row_end = (b + 1) * h / bands;
         if (row_begin == row_end) continue;
-        // A buffer is made only for the grids and sub-row classes this band meets in this layer;
-        // light and (Stretch) the coverage of hidden sources apart.
+        // A buffer is made only for the grids this band meets in this layer; light and (Stretch) the
+        // coverage of hidden sources apart.
         BandBuffers& buffers = pools[static_cast<std::size_t>(omp_get_thread_num())];
-        for (auto& set : buffers.used) {
-          for (auto& level : set) level.fill(false);
-        }
+        for (auto& set : buffers.used) set.fill(false);
         for (std::size_t i = 0; i < layer.size(); ++i) {
           if (plans[i].y_max < static_cast<float>(row_begin) - 1.0f || plans[i].y_min > static_cast<float>(row_end) + 1.0f) continue;
           const int level = plans[i].level;
-          const float height = (plans[i].y_max - plans[i].y_min) / static_cast<float>(1 << level);
-          const int kind = height < kMediumFootprintPx ? 0 : height < kTallFootprintPx ? 1 : 2;
           const std::size_t set = layer[i].coverage_only ? 1 : 0, lv = static_cast<std::size_t>(level);
-          // The thread's buffer for this grid and sub-row class, made once and reset for each band.
-          auto use = [&](int subrow_kind) -> SplatBuffer& {
-            std::optional<SplatBuffer>& slot = buffers.buffers[set][lv][static_cast<std::size_t>(subrow_kind)];
-            bool& used = buffers.used[set][lv][static_cast<std::size_t>(subrow_kind)];
-            if (!slot) {
-              SplatOptions o = subrow_options(options.splat, 1 << subrow_kind);
-              o.downsample = 1 << level;
-              slot.emplace(w, row_begin, row_end, o);
-            } else if (!used) {
-              slot->reset(row_begin, row_end);
-            }
-            used = true;
-            return *slot;
-          };
-          SplatBuffer& buffer = use(kind);
-          SplatBuffer& fine = plans[i].mesh >= 0 ? use(0) : buffer;
-          scatter.deposit(layer[i], plans[i], buffer, fine, scratch, local_triangles);
+          // The thread's buffer for this grid, made once and reset for each band.
+          std::optional<SplatBuffer>& slot = buffers.buffers[set][lv];
+          bool& used = buffers.used[set][lv];
+          if (!slot) {
+            SplatOptions o = options.splat;
+            o.downsample = 1 << level;
+            slot.emplace(w, row_begin, row_end, o);
+          } else if (!used) {
+            slot->reset(row_begin, row_end);
+          }
+          used = true;
+          scatter.deposit(layer[i], plans[i], *slot, scratch, local_triangles);
           // A footprint cross-faded between two group counts deposits both splits.
           local_footprints += static_cast<std::size_t>(plans[i].groups + (plans[i].blend < 1.0f ? plans[i].groups - 1 : 0));
         }
@@ -174,11 +154,9 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
           float* rows = target.data() + static_cast<std::size_t>(row_begin) * w * 4;
           std::fill(rows, rows + static_cast<std::size_t>(row_end - row_begin) * w * 4, 0.0f);
           for (std::size_t lv = 0; lv < static_cast<std::size_t>(kLevels); ++lv) {
-            for (std::size_t kind = 0; kind < 3; ++kind) {
-              if (!buffers.used[static_cast<std::size_t>(set)][lv][kind]) continue;
-              buffers.buffers[static_cast<std::size_t>(set)][lv][kind]->resolve_into(target.data());
-              any = true;
-            }
+            if (!buffers.used[static_cast<std::size_t>(set)][lv]) continue;
+            buffers.buffers[static_cast<std::size_t>(set)][lv]->resolve_into(target.data());
+            any = true;
           }
         }
         if (any) render_detail::composite_layer_over(layer_rgba, stretch ? &hole_rgba : nullptr, result, w, row_begin, row_end);

@@ -53,6 +53,10 @@ constexpr double kCentroidKeptPx = 4.0;
 constexpr double kEdgeKeptPx = 8.0;
 // Grid cells of an aperture-picture mesh per pixel of footprint size.
 constexpr double kPxPerGridCell = 1.5;
+// Footprint heights (grid cells, with margins) from which half and a quarter of the sub-rows are used
+// for its own polygons (footprint_subrows).
+constexpr float kMediumFootprintPx = 10.0f;
+constexpr float kTallFootprintPx = 34.0f;
 
 // Whether the pupil's centre (the chief ray) passes every disc: the passing region, an intersection
 // of convex sets around it, is then star-shaped about it.
@@ -327,7 +331,7 @@ bool polygon_centroid(std::span<const Point2f> ring, double& cx, double& cy) {
 template <typename LightCentroid>
 bool deposit_nested_rings(const std::vector<std::span<const Point2f>>& rings, const std::vector<double>& pupil_areas,
                           const std::vector<double>& ring_weights, double full_pupil_area, const std::array<float, 4>& value,
-                          bool weighted, LightCentroid&& light_centroid, SplatBuffer& buffer, FootprintScratch& scratch) {
+                          bool weighted, LightCentroid&& light_centroid, SplatBuffer& buffer, int subrows, FootprintScratch& scratch) {
   std::vector<double>& areas = scratch.areas;
   if (!rings_nest(rings, areas)) return false;
   const int count = static_cast<int>(rings.size());
@@ -414,7 +418,7 @@ bool deposit_nested_rings(const std::vector<std::span<const Point2f>>& rings, co
     }
     const auto f = static_cast<float>(d.light);
     const auto c = static_cast<float>(d.coverage);
-    buffer.add_polygon(ring, {value[0] * f, value[1] * f, value[2] * f, value[3] * c});
+    buffer.add_polygon(ring, {value[0] * f, value[1] * f, value[2] * f, value[3] * c}, subrows);
   }
   return true;
 }
@@ -454,7 +458,8 @@ bool mesh_ring_spans(const PupilMesh& mesh, const std::vector<SensorHit>& hits, 
 }
 
 bool deposit_ring_polygons(const PupilMesh& mesh, const std::vector<SensorHit>& hits, const std::vector<Point2f>& points,
-                           const std::array<float, 4>& value, bool weighted, SplatBuffer& buffer, FootprintScratch& scratch) {
+                           const std::array<float, 4>& value, bool weighted, SplatBuffer& buffer, int subrows,
+                           FootprintScratch& scratch) {
   if (!mesh_ring_spans(mesh, hits, points, scratch)) return false;
   const auto sectors = static_cast<std::size_t>(mesh.sectors);
   auto centroid = [&](double& cx, double& cy) {
@@ -462,7 +467,7 @@ bool deposit_ring_polygons(const PupilMesh& mesh, const std::vector<SensorHit>& 
                               [sectors](int k) { return 1 + static_cast<std::size_t>(k - 1) * sectors; }, weighted, cx, cy);
   };
   return deposit_nested_rings(scratch.ring_spans, scratch.pupil_areas, scratch.ring_weights, 1.0, value, weighted, centroid,
-                              buffer, scratch);
+                              buffer, subrows, scratch);
 }
 
 }  // namespace
@@ -547,7 +552,7 @@ void FootprintScatter::map_clipped_rings(const ScenePoint& point, double wavelen
 
 void FootprintScatter::deposit_clipped_rings(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p, double passing,
                                              bool allow_rings, const std::array<float, 4>& value, SplatBuffer& buffer,
-                                             SplatBuffer& fine, FootprintScratch& scratch, std::size_t& triangles) const {
+                                             int ring_subrows, FootprintScratch& scratch, std::size_t& triangles) const {
   const int rings = meshes_.mesh(p.mesh).rings;
   const std::vector<PupilPoint>& outline = meshes_.dense_outline(PupilMeshTable::sector_step_of_mesh(p.mesh));
   const std::vector<PupilPoint>& pupil = scratch.ring_pupil;
@@ -564,7 +569,7 @@ void FootprintScatter::deposit_clipped_rings(const ScenePoint& point, double wav
     return fan_light_centroid(pupil, points, hits, rings, outline.size(), ring_begin, options_.vignetting, cx, cy);
   };
   if (allow_rings && deposit_nested_rings(scratch.ring_spans, scratch.pupil_areas, scratch.ring_weights, full_pupil_area,
-                                          value, options_.vignetting, centroid, buffer, scratch)) {
+                                          value, options_.vignetting, centroid, buffer, ring_subrows, scratch)) {
     return;
   }
   // The same clipped rings as triangles (for_each_ring_triangle; every ring has the outline's vertex
@@ -580,7 +585,7 @@ void FootprintScatter::deposit_clipped_rings(const ScenePoint& point, double wav
     const double weight = options_.vignetting ? (hits[a].weight + hits[b].weight + hits[c].weight) / 3.0 : 1.0;
     const auto f = static_cast<float>(area / light_area * weight);
     const auto cover = static_cast<float>(area / pupil_total);
-    fine.add_triangle(points[a], points[b], points[c], {value[0] * f, value[1] * f, value[2] * f, value[3] * cover});
+    buffer.add_triangle(points[a], points[b], points[c], {value[0] * f, value[1] * f, value[2] * f, value[3] * cover});
     ++triangles;
   });
 }
@@ -741,8 +746,15 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
   return p;
 }
 
-void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, SplatBuffer& buffer, SplatBuffer& fine,
-                               FootprintScratch& scratch, std::size_t& triangles) const {
+int footprint_subrows(const FootprintPlan& p, int buffer_subrows) {
+  const float height = (p.y_max - p.y_min) / static_cast<float>(1 << p.level);
+  const int divisor = height < kMediumFootprintPx ? 1 : height < kTallFootprintPx ? 2 : 4;
+  return std::max(1, buffer_subrows / divisor);
+}
+
+void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, SplatBuffer& buffer, FootprintScratch& scratch,
+                               std::size_t& triangles) const {
+  const int own_subrows = footprint_subrows(p, buffer.options().subrows);
   std::vector<SensorHit>& hits = scratch.hits;
   std::vector<Point2f>& points = scratch.points;
   const Tangents t = camera_.frame().tangents_at(source_centre(s));
@@ -855,12 +867,12 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
         points[i] = {static_cast<float>(o.x + (ex.x - o.x) * q.x + (ey.x - o.x) * q.y),
                      static_cast<float>(o.y + (ex.y - o.y) * q.x + (ey.y - o.y) * q.y)};
       }
-      buffer.add_polygon(points, v);
+      buffer.add_polygon(points, v, own_subrows);
       return;
     }
     const PupilMesh& mesh = meshes_.mesh(p.mesh);
     if (rings_clipped) {
-      deposit_clipped_rings(point, g.wavelength_nm, p, passing, allow_rings, value, buffer, fine, scratch, triangles);
+      deposit_clipped_rings(point, g.wavelength_nm, p, passing, allow_rings, value, buffer, own_subrows, scratch, triangles);
       return;
     }
     map_cached(point, g.wavelength_nm, 0, mesh.points, hits, scratch, false);
@@ -870,7 +882,10 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
       const PixelPoint q = camera_.output_pixel(hits[i].x_mm, hits[i].y_mm);
       points[i] = {static_cast<float>(q.x), static_cast<float>(q.y)};
     }
-    if (mesh.sectors > 0 && allow_rings && deposit_ring_polygons(mesh, hits, points, value, options_.vignetting, buffer, scratch)) return;
+    if (mesh.sectors > 0 && allow_rings &&
+        deposit_ring_polygons(mesh, hits, points, value, options_.vignetting, buffer, own_subrows, scratch)) {
+      return;
+    }
     // A triangle whose corners a clear aperture partly stops (exact, poly) passes the part of its
     // area where the linear interpolation of their clearances is >= 0, in place: the beam's edge
     // falls inside it, to first order.
@@ -901,7 +916,7 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
       const std::array<std::size_t, 3> corner{static_cast<std::size_t>(tri.a), static_cast<std::size_t>(tri.b),
                                               static_cast<std::size_t>(tri.c)};
       if (fraction >= 1.0) {
-        fine.add_triangle(points[corner[0]], points[corner[1]], points[corner[2]], lit_value);
+        buffer.add_triangle(points[corner[0]], points[corner[1]], points[corner[2]], lit_value);
       } else {
         // Its passing part only, where the interpolated clearance is >= 0, mapped by interpolating
         // the corners' landing points (first order): spread over the whole triangle's image, the
@@ -921,7 +936,7 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
           }
         }
         if (count < 3) continue;
-        fine.add_polygon(std::span<const Point2f>(clipped.data(), count), lit_value);
+        buffer.add_polygon(std::span<const Point2f>(clipped.data(), count), lit_value);
       }
       ++triangles;
     }

@@ -79,6 +79,12 @@ struct FootprintScratch {
   std::size_t cached_count = 0;
 };
 
+// Sub-rows per pixel (of `buffer_subrows`, the buffer's) at which a footprint's own polygons (its
+// outline, its ring polygons) are scanned: all of them below kMediumFootprintPx grid cells high, half
+// below kTallFootprintPx, a quarter above (at least 1). Only a tall footprint's top and bottom rows
+// see the y sampling; its mesh triangles keep every sub-row.
+int footprint_subrows(const FootprintPlan& p, int buffer_subrows);
+
 // Everything a footprint depends on besides its source; one per render, shared by the threads.
 class FootprintScatter {
  public:
@@ -86,21 +92,23 @@ class FootprintScatter {
                    const PupilMeshTable& meshes, const BokehOptions& options);
 
   FootprintPlan plan(const ScatterSource& s, FootprintScratch& scratch) const;
-  // Deposits the footprint: footprint-sized polygons into `buffer`, mesh triangles into `fine`
-  // (which has every sub-row). Adds the mesh triangles deposited to `triangles`.
-  void deposit(const ScatterSource& s, const FootprintPlan& p, SplatBuffer& buffer, SplatBuffer& fine,
-               FootprintScratch& scratch, std::size_t& triangles) const;
+  // Deposits the footprint into `buffer` (the plan's grid level): footprint-sized polygons at the
+  // plan's sub-rows (footprint_subrows), mesh triangles at every sub-row of the buffer. Adds the mesh
+  // triangles deposited to `triangles`.
+  void deposit(const ScatterSource& s, const FootprintPlan& p, SplatBuffer& buffer, FootprintScratch& scratch,
+               std::size_t& triangles) const;
 
  private:
   // A polar mesh's rings clipped by scratch.discs (first-order vignetting), mapped and deposited as
-  // nested rings, or where they do not nest (a cat's eye mapped to a crescent that turns back in
-  // y), as the triangles between them into `fine` (adding them to `triangles`).
+  // nested rings (at `ring_subrows` sub-rows), or where they do not nest (a cat's eye mapped to a
+  // crescent that turns back in y), as the triangles between them at every sub-row (adding them to
+  // `triangles`).
   bool clip_rings(const FootprintPlan& p, FootprintScratch& scratch) const;  // into scratch.ring_pupil; false: do not nest
   // `passing` (> 0) is the share of the aperture that passes, measured on a dense outline: the rings'
   // own outline may be coarse (16 vertices cut a cat's eye's cusps by chords). `allow_rings` false:
   // the triangles whether or not the rings nest (another wavelength of the footprint's did not).
   void deposit_clipped_rings(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p, double passing,
-                             bool allow_rings, const std::array<float, 4>& value, SplatBuffer& buffer, SplatBuffer& fine,
+                             bool allow_rings, const std::array<float, 4>& value, SplatBuffer& buffer, int ring_subrows,
                              FootprintScratch& scratch, std::size_t& triangles) const;
   // model.map (set 0) or map_passing (set 1) of `pupil` at one wavelength into `hits`, from
   // scratch.cached_maps when this footprint mapped them there already, else mapped (and kept when

@@ -90,6 +90,30 @@ inline bool finite_value(const std::array<float, 4>& value) {
   return std::isfinite(value[0]) && std::isfinite(value[1]) && std::isfinite(value[2]) && std::isfinite(value[3]);
 }
 
+// Per sub-row count s (1..kMaxSubrows) and sub-row m in [0, s): the upper of the two pixel rows its
+// tent reaches relative to the pixel row it lies in (-1 or 0), and the tent weight of the lower row
+// (the upper row gets 1 - weight).
+struct SubrowTent {
+  int upper_offset[kMaxSubrows + 1][kMaxSubrows];
+  double lower_weight[kMaxSubrows + 1][kMaxSubrows];
+};
+const SubrowTent& subrow_tent() {
+  static const SubrowTent table = [] {
+    SubrowTent t{};
+    for (int s = 1; s <= kMaxSubrows; ++s) {
+      for (int m = 0; m < s; ++m) {
+        // Sub-row centre relative to its pixel row's centre, in (-0.5, 0.5).
+        const double offset = (m + 0.5) / s - 0.5;
+        const int upper = offset < 0.0 ? -1 : 0;
+        t.upper_offset[s][m] = upper;
+        t.lower_weight[s][m] = offset - upper;
+      }
+    }
+    return t;
+  }();
+  return table;
+}
+
 // floor(a / b) for b > 0.
 inline std::int64_t floor_div(std::int64_t a, std::int64_t b) {
   const std::int64_t q = a / b;
@@ -138,16 +162,6 @@ SplatBuffer::SplatBuffer(int width_px, int row_begin, int row_end, const SplatOp
     throw OptionsError("SplatBuffer: width " + std::to_string(width_px) + " px: need width >= 1");
   }
   reset(row_begin, row_end);
-  const int s = options_.subrows;
-  subrow_row_offset_.resize(static_cast<std::size_t>(s));
-  subrow_lower_weight_.resize(static_cast<std::size_t>(s));
-  for (int m = 0; m < s; ++m) {
-    // Sub-row centre relative to its pixel row's centre, in (-0.5, 0.5).
-    const double offset = (m + 0.5) / s - 0.5;
-    const int upper = offset < 0.0 ? -1 : 0;
-    subrow_row_offset_[static_cast<std::size_t>(m)] = upper;
-    subrow_lower_weight_[static_cast<std::size_t>(m)] = offset - upper;
-  }
 }
 
 void SplatBuffer::reset(int row_begin, int row_end) {
@@ -214,7 +228,7 @@ void SplatBuffer::add_triangle(Point2f a, Point2f b, Point2f c, const std::array
   add_polygon(v, value);
 }
 
-bool SplatBuffer::build_chains(std::span<const Point2f> vertices) {
+bool SplatBuffer::build_chains(std::span<const Point2f> vertices, int subrows) {
   const std::size_t n = vertices.size();
   std::size_t top = 0;
   std::size_t bottom = 0;
@@ -222,7 +236,7 @@ bool SplatBuffer::build_chains(std::span<const Point2f> vertices) {
     if (vertices[i].y < vertices[top].y) top = i;
     if (vertices[i].y > vertices[bottom].y) bottom = i;
   }
-  const double s = options_.subrows;
+  const double s = subrows;
   bool monotone = true;
   auto build = [&](std::vector<ChainVertex>& chain, bool forward) {
     chain.clear();
@@ -253,14 +267,15 @@ bool SplatBuffer::build_chains(std::span<const Point2f> vertices) {
 // One sub-row's span from x_enter (+) to x_leave (-), its tent-filtered x profile as first
 // differences into the two pixel rows the sub-row's tent reaches (sub-row class m of pixel row
 // `pixel_row`); `unit` is the deposit per unit span length.
-inline __attribute__((always_inline)) void SplatBuffer::deposit_span(int pixel_row, int m, double x_enter, double x_leave,
-                                                                      const double unit[4]) {
+inline __attribute__((always_inline)) void SplatBuffer::deposit_span(int pixel_row, int subrows, int m, double x_enter,
+                                                                      double x_leave, const double unit[4]) {
   const double w = grid_width_;
   const EndWeights a = end_weights(clamp_end(x_enter, w));
   const EndWeights b = end_weights(clamp_end(x_leave, w));
   const double minus_qb[3] = {-b.q[0], -b.q[1], -b.q[2]};
-  const int upper = pixel_row + subrow_row_offset_[static_cast<std::size_t>(m)];
-  const double lower_weight = subrow_lower_weight_[static_cast<std::size_t>(m)];
+  const SubrowTent& tent = subrow_tent();
+  const int upper = pixel_row + tent.upper_offset[subrows][m];
+  const double lower_weight = tent.lower_weight[subrows][m];
   for (int r = 0; r < 2; ++r) {
     const int row = upper + r;
     const double row_weight = r == 0 ? 1.0 - lower_weight : lower_weight;
@@ -274,10 +289,11 @@ inline __attribute__((always_inline)) void SplatBuffer::deposit_span(int pixel_r
   }
 }
 
-void SplatBuffer::add_general_polygon(std::span<const Point2f> vertices, double cx, double cy, const std::array<float, 4>& value) {
+void SplatBuffer::add_general_polygon(std::span<const Point2f> vertices, int subrows, double cx, double cy,
+                                      const std::array<float, 4>& value) {
   // Edges as sub-row ranges, by the rule of the chains: an edge covers the sub-row centres c with
   // y_upper <= c < y_lower, so each sub-row crosses an even number of edges.
-  const double s = options_.subrows;
+  const double s = subrows;
   edges_.clear();
   const std::size_t n = vertices.size();
   for (std::size_t i = 0; i < n; ++i) {
@@ -324,12 +340,11 @@ void SplatBuffer::add_general_polygon(std::span<const Point2f> vertices, double 
   const double hi = fast_ceil((grid_row_end_ + 0.5) * s - 0.5);
   double unit[kChannels];
   for (int c = 0; c < kChannels; ++c) unit[c] = value[static_cast<std::size_t>(c)] / (area * s);
-  const int subrows = options_.subrows;
   for (const SubrowSpan& span : spans_) {
     if (span.subrow < lo || span.subrow >= hi) continue;
     const auto sub = static_cast<std::int64_t>(span.subrow);
     const std::int64_t pixel_row = floor_div(sub, subrows);
-    deposit_span(static_cast<int>(pixel_row), static_cast<int>(sub - pixel_row * subrows), span.x_enter, span.x_leave, unit);
+    deposit_span(static_cast<int>(pixel_row), subrows, static_cast<int>(sub - pixel_row * subrows), span.x_enter, span.x_leave, unit);
   }
 }
 
@@ -339,7 +354,12 @@ void SplatBuffer::add_general_polygon(std::span<const Point2f> vertices, double 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 __attribute__((target_clones("arch=x86-64-v3", "default")))
 #endif
-void SplatBuffer::add_polygon(std::span<const Point2f> output_vertices, const std::array<float, 4>& value) {
+void SplatBuffer::add_polygon(std::span<const Point2f> output_vertices, const std::array<float, 4>& value, int polygon_subrows) {
+  if (polygon_subrows < 0 || polygon_subrows > kMaxSubrows) {
+    throw OptionsError("SplatBuffer::add_polygon: " + std::to_string(polygon_subrows) + " sub-rows: must lie in [1, " +
+                       std::to_string(kMaxSubrows) + "], or 0 for the buffer's own");
+  }
+  const int subrows = polygon_subrows > 0 ? polygon_subrows : options_.subrows;
   std::span<const Point2f> vertices = output_vertices;
   if (options_.downsample > 1) {
     // To grid cells; float keeps 1e-6 of a cell's size at 4K / k.
@@ -369,16 +389,16 @@ void SplatBuffer::add_polygon(std::span<const Point2f> output_vertices, const st
     deposit_grid_point(cx, cy, value);
     return;
   }
-  if (!build_chains(vertices)) {
+  if (!build_chains(vertices, subrows)) {
     // Not y-monotone: two chains would smear it between them.
-    add_general_polygon(vertices, cx, cy, value);
+    add_general_polygon(vertices, subrows, cx, cy, value);
     return;
   }
 
   // Rasterised area in closed form, O(vertices): an edge is linear in y over its sub-rows, so the sum
   // of its x over them is count * x(mean sub-row y). The scan below assigns sub-rows to edges by the
   // same first_subrow bounds, so what it deposits sums to this area up to rounding.
-  const double s = options_.subrows;
+  const double s = subrows;
   auto chain_x_sum = [s](const std::vector<ChainVertex>& chain) {
     double sum = 0.0;
     for (std::size_t k = 0; k + 1 < chain.size(); ++k) {
@@ -417,7 +437,6 @@ void SplatBuffer::add_polygon(std::span<const Point2f> output_vertices, const st
   const ChainVertex* eb = backward_chain_.data();
   while (ef[1].first_subrow <= lo) ++ef;
   while (eb[1].first_subrow <= lo) ++eb;
-  const int subrows = options_.subrows;
   const auto s_lo = static_cast<std::int64_t>(lo);
   const auto s_hi = static_cast<std::int64_t>(hi);
   std::int64_t pixel_row = floor_div(s_lo, subrows);
@@ -428,7 +447,7 @@ void SplatBuffer::add_polygon(std::span<const Point2f> output_vertices, const st
     while (ef[1].first_subrow <= sub_d) ++ef;
     while (eb[1].first_subrow <= sub_d) ++eb;
     const double y = (sub_d + 0.5) * inv_s;
-    deposit_span(static_cast<int>(pixel_row), m, ef->x + ef->slope * (y - ef->y), eb->x + eb->slope * (y - eb->y), unit);
+    deposit_span(static_cast<int>(pixel_row), subrows, m, ef->x + ef->slope * (y - ef->y), eb->x + eb->slope * (y - eb->y), unit);
     if (++m == subrows) {
       m = 0;
       ++pixel_row;

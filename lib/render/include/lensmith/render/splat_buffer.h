@@ -100,8 +100,11 @@ class SplatBuffer {
   // included) is scanned between its two chains from the topmost to the bottommost vertex; any other
   // by the even-odd pairs of each sub-row's edge crossings (a crescent, a ring that turns back in
   // y); either way exactly its value. A self-crossing polygon is not supported (a y-monotone one is
-  // spread between its chains, any other filled by the even-odd rule).
-  void add_polygon(std::span<const Point2f> vertices, const std::array<float, 4>& value);
+  // spread between its chains, any other filled by the even-odd rule). `subrows` (1..16) samples
+  // this polygon at its own count of sub-rows per pixel instead of the buffer's (0): a tall
+  // polygon's top and bottom rows alone see the y sampling, so a renderer samples it more coarsely
+  // in the same buffer. Throws OptionsError for a count outside [0, 16].
+  void add_polygon(std::span<const Point2f> vertices, const std::array<float, 4>& value, int subrows = 0);
   void add_triangle(Point2f a, Point2f b, Point2f c, const std::array<float, 4>& value);
   // A point deposit with bilinear weights over the 2 x 2 pixels whose centres surround p.
   void add_point(Point2f p, const std::array<float, 4>& value);
@@ -144,11 +147,12 @@ class SplatBuffer {
 
   // The two chains from the topmost to the bottommost vertex; false where y turns back along one
   // (the polygon is not y-monotone).
-  bool build_chains(std::span<const Point2f> vertices);
+  bool build_chains(std::span<const Point2f> vertices, int subrows);
   // add_polygon for a polygon that is not y-monotone; (cx, cy) its vertex centroid in cells.
-  void add_general_polygon(std::span<const Point2f> vertices, double cx, double cy, const std::array<float, 4>& value);
-  // One sub-row's span into the two rows its tent reaches (splat_buffer.cpp).
-  void deposit_span(int pixel_row, int m, double x_enter, double x_leave, const double unit[4]);
+  void add_general_polygon(std::span<const Point2f> vertices, int subrows, double cx, double cy, const std::array<float, 4>& value);
+  // One sub-row (class m of `subrows` per pixel) and its span into the two rows its tent reaches
+  // (splat_buffer.cpp).
+  void deposit_span(int pixel_row, int subrows, int m, double x_enter, double x_leave, const double unit[4]);
   void deposit_point(double x_out_px, double y_out_px, const std::array<float, 4>& value);
   void deposit_grid_point(double x_px, double y_px, const std::array<float, 4>& value);  // grid cells
 
@@ -169,10 +173,6 @@ class SplatBuffer {
   // First differences along x, double: width_ x (row_end_ - row_begin_) x 4 channels, row-major.
   // double keeps a bright highlight's rounding from streaking along its row through the prefix sum.
   LargeVector<double> diff_;
-  // Per sub-row class m in [0, subrows): the upper of its two rows relative to the pixel row it
-  // lies in (-1 or 0), and the tent weight of the lower row (the upper row gets 1 - weight).
-  std::vector<int> subrow_row_offset_;
-  std::vector<double> subrow_lower_weight_;
   std::vector<ChainVertex> forward_chain_;   // scratch: top to bottom vertex by increasing index
   std::vector<ChainVertex> backward_chain_;  // scratch: top to bottom vertex by decreasing index
   // Scratch of add_general_polygon: its edges by sub-row range, the active ones, one sub-row's
