@@ -228,7 +228,7 @@ void untangled_ring_spans(const std::vector<Point2f>& points, int rings, RingEnd
 // caustic).
 // Whether mapped ring polygons nest, each y-monotone and simple (what deposit_nested_rings needs);
 // their enclosed areas into `areas` (areas[0] = 0).
-bool rings_nest(const std::vector<std::span<const Point2f>>& rings, std::vector<double>& areas) {
+bool rings_nest(const std::vector<std::span<const Point2f>>& rings, std::vector<double>& areas, bool shapes_checked = false) {
   const int count = static_cast<int>(rings.size());
   areas.assign(static_cast<std::size_t>(count) + 1, 0.0);
   double orientation = 0.0;
@@ -246,16 +246,18 @@ bool rings_nest(const std::vector<std::span<const Point2f>>& rings, std::vector<
     // leaves from the wrong place (its thin horns get as much as its middle). Tried: the README main
     // job's vertical mortar lines kinked by a pixel where footprints turned into crescents, and it
     // moved 0.3 dB away from the exact model, for 13 % of its time.
-    int turns = 0;
-    double last_dy = 0.0;
-    for (std::size_t j = 0; j <= n; ++j) {
-      const std::size_t a = j == n ? 0 : j, b = a + 1 == n ? 0 : a + 1;
-      const double dy = static_cast<double>(ring[b].y) - ring[a].y;
-      if (dy == 0.0) continue;
-      if (last_dy != 0.0 && (dy > 0.0) != (last_dy > 0.0)) ++turns;
-      last_dy = dy;
+    if (!shapes_checked) {
+      int turns = 0;
+      double last_dy = 0.0;
+      for (std::size_t j = 0; j <= n; ++j) {
+        const std::size_t a = j == n ? 0 : j, b = a + 1 == n ? 0 : a + 1;
+        const double dy = static_cast<double>(ring[b].y) - ring[a].y;
+        if (dy == 0.0) continue;
+        if (last_dy != 0.0 && (dy > 0.0) != (last_dy > 0.0)) ++turns;
+        last_dy = dy;
+      }
+      if (turns > 2 || !monotone_ring_is_simple(ring)) return false;
     }
-    if (turns > 2 || !monotone_ring_is_simple(ring)) return false;
     const double area = 0.5 * twice * orientation;
     if (!(area > areas[static_cast<std::size_t>(k) - 1] + 1e-3 * std::max(area, 1e-9))) return false;
     areas[static_cast<std::size_t>(k)] = area;
@@ -331,9 +333,10 @@ bool polygon_centroid(std::span<const Point2f> ring, double& cx, double& cy) {
 template <typename LightCentroid>
 bool deposit_nested_rings(const std::vector<std::span<const Point2f>>& rings, const std::vector<double>& pupil_areas,
                           const std::vector<double>& ring_weights, double full_pupil_area, const std::array<float, 4>& value,
-                          bool weighted, LightCentroid&& light_centroid, SplatBuffer& buffer, int subrows, FootprintScratch& scratch) {
+                          bool weighted, LightCentroid&& light_centroid, SplatBuffer& buffer, int subrows, bool shapes_checked,
+                          FootprintScratch& scratch) {
   std::vector<double>& areas = scratch.areas;
-  if (!rings_nest(rings, areas)) return false;
+  if (!rings_nest(rings, areas, shapes_checked)) return false;
   const int count = static_cast<int>(rings.size());
   const double pupil_total = pupil_areas[static_cast<std::size_t>(count)];
   auto pupil = [&](int k) { return pupil_areas[static_cast<std::size_t>(k)] - pupil_areas[static_cast<std::size_t>(k) - 1]; };
@@ -458,7 +461,7 @@ bool mesh_ring_spans(const PupilMesh& mesh, const std::vector<SensorHit>& hits, 
 }
 
 bool deposit_ring_polygons(const PupilMesh& mesh, const std::vector<SensorHit>& hits, const std::vector<Point2f>& points,
-                           const std::array<float, 4>& value, bool weighted, SplatBuffer& buffer, int subrows,
+                           const std::array<float, 4>& value, bool weighted, SplatBuffer& buffer, int subrows, bool shapes_checked,
                            FootprintScratch& scratch) {
   if (!mesh_ring_spans(mesh, hits, points, scratch)) return false;
   const auto sectors = static_cast<std::size_t>(mesh.sectors);
@@ -467,7 +470,7 @@ bool deposit_ring_polygons(const PupilMesh& mesh, const std::vector<SensorHit>& 
                               [sectors](int k) { return 1 + static_cast<std::size_t>(k - 1) * sectors; }, weighted, cx, cy);
   };
   return deposit_nested_rings(scratch.ring_spans, scratch.pupil_areas, scratch.ring_weights, 1.0, value, weighted, centroid,
-                              buffer, subrows, scratch);
+                              buffer, subrows, shapes_checked, scratch);
 }
 
 }  // namespace
@@ -551,8 +554,9 @@ void FootprintScatter::map_clipped_rings(const ScenePoint& point, double wavelen
 }
 
 void FootprintScatter::deposit_clipped_rings(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p, double passing,
-                                             bool allow_rings, const std::array<float, 4>& value, SplatBuffer& buffer,
-                                             int ring_subrows, FootprintScratch& scratch, std::size_t& triangles) const {
+                                             bool allow_rings, bool shapes_checked, const std::array<float, 4>& value,
+                                             SplatBuffer& buffer, int ring_subrows, FootprintScratch& scratch,
+                                             std::size_t& triangles) const {
   const int rings = meshes_.mesh(p.mesh).rings;
   const std::vector<PupilPoint>& outline = meshes_.dense_outline(PupilMeshTable::sector_step_of_mesh(p.mesh));
   const std::vector<PupilPoint>& pupil = scratch.ring_pupil;
@@ -569,7 +573,7 @@ void FootprintScatter::deposit_clipped_rings(const ScenePoint& point, double wav
     return fan_light_centroid(pupil, points, hits, rings, outline.size(), ring_begin, options_.vignetting, cx, cy);
   };
   if (allow_rings && deposit_nested_rings(scratch.ring_spans, scratch.pupil_areas, scratch.ring_weights, full_pupil_area,
-                                          value, options_.vignetting, centroid, buffer, ring_subrows, scratch)) {
+                                          value, options_.vignetting, centroid, buffer, ring_subrows, shapes_checked, scratch)) {
     return;
   }
   // The same clipped rings as triangles (for_each_ring_triangle; every ring has the outline's vertex
@@ -816,6 +820,9 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
       for (const SpectralGroup& g : groups_.split(p.groups - 1)) allow_rings = allow_rings && nest_at(g.wavelength_nm);
     }
   }
+  // Every group's rings found y-monotone and simple above: the deposits below map the same rays
+  // (scratch.cached_maps) and need only their areas.
+  const bool rings_checked = several && allow_rings && p.mesh >= 0 && p.outline != FootprintPlan::kPoint;
   // One wavelength group's share of the light.
   auto deposit_group = [&](const SpectralGroup& g, float share) {
     std::array<float, 4> value{};
@@ -872,7 +879,8 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
     }
     const PupilMesh& mesh = meshes_.mesh(p.mesh);
     if (rings_clipped) {
-      deposit_clipped_rings(point, g.wavelength_nm, p, passing, allow_rings, value, buffer, own_subrows, scratch, triangles);
+      deposit_clipped_rings(point, g.wavelength_nm, p, passing, allow_rings, rings_checked, value, buffer, own_subrows, scratch,
+                            triangles);
       return;
     }
     map_cached(point, g.wavelength_nm, 0, mesh.points, hits, scratch, false);
@@ -883,7 +891,7 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
       points[i] = {static_cast<float>(q.x), static_cast<float>(q.y)};
     }
     if (mesh.sectors > 0 && allow_rings &&
-        deposit_ring_polygons(mesh, hits, points, value, options_.vignetting, buffer, own_subrows, scratch)) {
+        deposit_ring_polygons(mesh, hits, points, value, options_.vignetting, buffer, own_subrows, rings_checked, scratch)) {
       return;
     }
     // A triangle whose corners a clear aperture partly stops (exact, poly) passes the part of its

@@ -106,10 +106,11 @@ class FootprintScatter {
   bool clip_rings(const FootprintPlan& p, FootprintScratch& scratch) const;  // into scratch.ring_pupil; false: do not nest
   // `passing` (> 0) is the share of the aperture that passes, measured on a dense outline: the rings'
   // own outline may be coarse (16 vertices cut a cat's eye's cusps by chords). `allow_rings` false:
-  // the triangles whether or not the rings nest (another wavelength of the footprint's did not).
+  // the triangles whether or not the rings nest (another wavelength of the footprint's did not);
+  // `shapes_checked`: every ring was found y-monotone and simple at this wavelength already.
   void deposit_clipped_rings(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p, double passing,
-                             bool allow_rings, const std::array<float, 4>& value, SplatBuffer& buffer, int ring_subrows,
-                             FootprintScratch& scratch, std::size_t& triangles) const;
+                             bool allow_rings, bool shapes_checked, const std::array<float, 4>& value, SplatBuffer& buffer,
+                             int ring_subrows, FootprintScratch& scratch, std::size_t& triangles) const;
   // model.map (set 0) or map_passing (set 1) of `pupil` at one wavelength into `hits`, from
   // scratch.cached_maps when this footprint mapped them there already, else mapped (and kept when
   // `keep`).
