@@ -20,34 +20,53 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
                                   double reach_px, HiddenSurfaces mode, const Camera& camera, int threads,
                                   HiddenScratch& scratch, ScatterSources& out) {
   const int w = width, h = height;
+  const int reach = static_cast<int>(reach_px);
+  // Only pixels within the reach of the layer's own can be targets: the dilation below runs over the
+  // bounding box of the layer's pixels in the frame widened by the reach (a layer of a few distant
+  // lights costs that box, not the frame).
+  int bx0 = w, bx1 = -1, by0 = h, by1 = -1;
+  for (int i : layers.members[static_cast<std::size_t>(layer)]) {
+    const ScatterSource& p = sources[static_cast<std::size_t>(i)];
+    if (p.x < 0 || p.y < 0 || p.x >= w || p.y >= h) continue;  // the scatter's margin
+    bx0 = std::min(bx0, p.x);
+    bx1 = std::max(bx1, p.x);
+    by0 = std::min(by0, p.y);
+    by1 = std::max(by1, p.y);
+  }
+  if (bx1 < bx0) return 0;
+  bx0 = std::max(0, bx0 - reach);
+  by0 = std::max(0, by0 - reach);
+  bx1 = std::min(w - 1, bx1 + reach);
+  by1 = std::min(h - 1, by1 + reach);
+  const int bw = bx1 - bx0 + 1, bh = by1 - by0 + 1;
   // Nearer pixels within a (2 reach + 1)-pixel square of a pixel of the layer: a separable
   // dilation, rows then columns, each line independent (threads).
-  const int reach = static_cast<int>(reach_px);
   const int far = std::numeric_limits<int>::max() / 4;
+  auto frame_index = [w, bx0, by0](int bx, int by) { return static_cast<std::size_t>(by0 + by) * w + static_cast<std::size_t>(bx0 + bx); };
   LargeVector<int>& row_distance = scratch.row_distance;
-  row_distance.resize(static_cast<std::size_t>(w) * h);  // every entry is written below
+  row_distance.resize(static_cast<std::size_t>(bw) * bh);  // every entry is written below
 #pragma omp parallel for num_threads(threads) schedule(static)
-  for (int y = 0; y < h; ++y) {
-    int* d = row_distance.data() + static_cast<std::size_t>(y) * w;
-    const std::size_t row = static_cast<std::size_t>(y) * w;
+  for (int y = 0; y < bh; ++y) {
+    int* d = row_distance.data() + static_cast<std::size_t>(y) * bw;
+    const std::size_t row = frame_index(0, y);
     int last = far;
-    for (int x = 0; x < w; ++x) d[x] = layers.in(row + x, layer) ? (last = 0) : (last = std::min(far, last + 1));
+    for (int x = 0; x < bw; ++x) d[x] = layers.in(row + x, layer) ? (last = 0) : (last = std::min(far, last + 1));
     last = far;
-    for (int x = w - 1; x >= 0; --x) d[x] = std::min(d[x], layers.in(row + x, layer) ? (last = 0) : (last = std::min(far, last + 1)));
+    for (int x = bw - 1; x >= 0; --x) d[x] = std::min(d[x], layers.in(row + x, layer) ? (last = 0) : (last = std::min(far, last + 1)));
   }
   LargeVector<std::uint8_t>& within = scratch.within;
-  within.resize(static_cast<std::size_t>(w) * h);  // every entry is written below
+  within.resize(static_cast<std::size_t>(bw) * bh);  // every entry is written below
 #pragma omp parallel for num_threads(threads) schedule(static)
-  for (int x = 0; x < w; ++x) {
+  for (int x = 0; x < bw; ++x) {
     int last = far;
-    for (int y = 0; y < h; ++y) {
-      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+    for (int y = 0; y < bh; ++y) {
+      const std::size_t i = static_cast<std::size_t>(y) * bw + x;
       last = row_distance[i] <= reach ? 0 : std::min(far, last + 1);
       within[i] = last <= reach ? 1 : 0;  // the first write of this column
     }
     last = far;
-    for (int y = h - 1; y >= 0; --y) {
-      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+    for (int y = bh - 1; y >= 0; --y) {
+      const std::size_t i = static_cast<std::size_t>(y) * bw + x;
       last = row_distance[i] <= reach ? 0 : std::min(far, last + 1);
       within[i] = (within[i] || last <= reach) ? 1 : 0;
     }
@@ -55,14 +74,16 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
   std::vector<std::size_t>& targets = scratch.targets;
   targets.clear();
   int x0 = w, x1 = -1, y0 = h, y1 = -1;
-  for (std::size_t i = 0; i < within.size(); ++i) {
-    if (within[i] && layers.unknown_behind(i, layer) > 0.0f) {
+  for (int y = 0; y < bh; ++y) {
+    for (int x = 0; x < bw; ++x) {
+      if (!within[static_cast<std::size_t>(y) * bw + x]) continue;
+      const std::size_t i = frame_index(x, y);
+      if (!(layers.unknown_behind(i, layer) > 0.0f)) continue;
       targets.push_back(i);
-      const int x = static_cast<int>(i % static_cast<std::size_t>(w)), y = static_cast<int>(i / static_cast<std::size_t>(w));
-      x0 = std::min(x0, x);
-      x1 = std::max(x1, x);
-      y0 = std::min(y0, y);
-      y1 = std::max(y1, y);
+      x0 = std::min(x0, bx0 + x);
+      x1 = std::max(x1, bx0 + x);
+      y0 = std::min(y0, by0 + y);
+      y1 = std::max(y1, by0 + y);
     }
   }
   if (targets.empty()) return 0;
