@@ -30,6 +30,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <random>
 #include <string>
@@ -239,6 +240,29 @@ TEST_CASE("a float EXR round-trips exactly through write_output_image and read_r
   REQUIRE(read.height == original.height);
   REQUIRE(read.channels == 3);
   CHECK(read.data == original.data);
+}
+
+TEST_CASE("a scanline EXR whose pixel blocks are damaged or cut short is an IoError naming the file, never a picture", "[render][image_io]") {
+  // Flat scanline files are decoded chunk by chunk through OpenEXRCore (exr_codec.cpp,
+  // read_exr_chunks); its error codes must come out as the C++ reader's did.
+  TempDir dir;
+  const fs::path exr = dir / "render.exr";
+  Image original(64, 48, 3);
+  for (std::size_t i = 0; i < original.data.size(); ++i) original.data[i] = 0.001f * static_cast<float>(i % 997);
+  write_output_image(exr, original, {});
+  std::ifstream in(exr, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const fs::path damaged = dir / "damaged.exr", cut = dir / "cut.exr";
+  std::string flipped = bytes;
+  for (std::size_t i = flipped.size() - 600; i < flipped.size() - 300; ++i) flipped[i] = static_cast<char>(flipped[i] ^ 0x5a);
+  std::ofstream(damaged, std::ios::binary) << flipped;
+  std::ofstream(cut, std::ios::binary) << bytes.substr(0, bytes.size() - 400);
+  for (const fs::path& bad : {damaged, cut}) {
+    INFO(bad.filename());
+    CHECK_THROWS_AS(read_radiance_image(bad), IoError);
+    CHECK_THROWS_WITH(read_radiance_image(bad), Contains(bad.string()) && Contains("cannot read the OpenEXR pixels"));
+  }
+  CHECK(read_radiance_image(exr).data == original.data);
 }
 
 TEST_CASE("EXR output records lens, f-number, focus, model, version and extra keys as lensmith: attributes", "[render][image_io]") {
