@@ -188,9 +188,14 @@ std::atomic<int> codec_threads{-1};
 
 // OpenEXR's global pool sized as asked (by default, the machine's hardware threads): zlib is the
 // cost of reading and writing float images, and blocks of scanlines compress independently.
+// The codec threads asked for (set_image_codec_threads), else the machine's hardware threads.
+int codec_thread_count() {
+  const int asked = codec_threads.load();
+  return asked >= 0 ? asked : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+}
+
 void size_codec_pool() {
-  int wanted = codec_threads.load();
-  if (wanted < 0) wanted = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  int wanted = codec_thread_count();
   if (wanted == 1) wanted = 0;  // the caller alone
   if (Imf::globalThreadCount() != wanted) Imf::setGlobalThreadCount(wanted);
 }
@@ -449,8 +454,7 @@ bool read_exr_chunks(const fs::path& path, const Imf::MultiPartInputFile& file, 
       }
     }
   };
-  const int threads = std::clamp(codec_threads.load() < 0 ? static_cast<int>(std::thread::hardware_concurrency()) : codec_threads.load(), 1,
-                                 std::max(1, chunks));
+  const int threads = std::clamp(codec_thread_count(), 1, std::max(1, chunks));
   std::vector<std::thread> pool;
   for (int t = 1; t < threads; ++t) pool.emplace_back(work);
   work();
@@ -481,10 +485,7 @@ Raster read_exr(const fs::path& path, const RasterInfo& info, std::span<const in
                  Imf::Slice::Make(Imf::FLOAT, raster.samples.data() + i, header.dataWindow(), stride * sizeof(float),
                                   static_cast<std::size_t>(info.width) * stride * sizeof(float)));
   }
-  // Where each of the file's channels goes in a pixel (its first position), -1 where not asked for.
-  std::vector<int> slot(info.channels.size(), -1);
-  for (std::size_t c = 0; c < first_position.size(); ++c) slot[c] = first_position[c];
-  const bool read = read_exr_chunks(path, *file, info, slot, raster.samples.data(), stride);
+  const bool read = read_exr_chunks(path, *file, info, first_position, raster.samples.data(), stride);
   if (!read) {
     try {
       Imf::InputPart part(*file, 0);

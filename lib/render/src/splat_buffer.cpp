@@ -97,22 +97,21 @@ struct SubrowTent {
   int upper_offset[kMaxSubrows + 1][kMaxSubrows];
   double lower_weight[kMaxSubrows + 1][kMaxSubrows];
 };
-const SubrowTent& subrow_tent() {
-  static const SubrowTent table = [] {
-    SubrowTent t{};
-    for (int s = 1; s <= kMaxSubrows; ++s) {
-      for (int m = 0; m < s; ++m) {
-        // Sub-row centre relative to its pixel row's centre, in (-0.5, 0.5).
-        const double offset = (m + 0.5) / s - 0.5;
-        const int upper = offset < 0.0 ? -1 : 0;
-        t.upper_offset[s][m] = upper;
-        t.lower_weight[s][m] = offset - upper;
-      }
+// Made at compile time: read per sub-row of every polygon, it needs no guard of a lazy static.
+constexpr SubrowTent make_subrow_tent() {
+  SubrowTent t{};
+  for (int s = 1; s <= kMaxSubrows; ++s) {
+    for (int m = 0; m < s; ++m) {
+      // Sub-row centre relative to its pixel row's centre, in (-0.5, 0.5).
+      const double offset = (m + 0.5) / s - 0.5;
+      const int upper = offset < 0.0 ? -1 : 0;
+      t.upper_offset[s][m] = upper;
+      t.lower_weight[s][m] = offset - upper;
     }
-    return t;
-  }();
-  return table;
+  }
+  return t;
 }
+constexpr SubrowTent kSubrowTent = make_subrow_tent();
 
 // floor(a / b) for b > 0.
 inline std::int64_t floor_div(std::int64_t a, std::int64_t b) {
@@ -273,9 +272,8 @@ inline __attribute__((always_inline)) void SplatBuffer::deposit_span(int pixel_r
   const EndWeights a = end_weights(clamp_end(x_enter, w));
   const EndWeights b = end_weights(clamp_end(x_leave, w));
   const double minus_qb[3] = {-b.q[0], -b.q[1], -b.q[2]};
-  const SubrowTent& tent = subrow_tent();
-  const int upper = pixel_row + tent.upper_offset[subrows][m];
-  const double lower_weight = tent.lower_weight[subrows][m];
+  const int upper = pixel_row + kSubrowTent.upper_offset[subrows][m];
+  const double lower_weight = kSubrowTent.lower_weight[subrows][m];
   for (int r = 0; r < 2; ++r) {
     const int row = upper + r;
     const double row_weight = r == 0 ? 1.0 - lower_weight : lower_weight;
