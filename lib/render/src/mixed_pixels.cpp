@@ -60,17 +60,28 @@ struct Decision {
   Group near, far;
 };
 
-// Per pixel: 1 where a 4-neighbour's blur differs by kMinBlurDifferencePx or more.
-LargeVector<std::uint8_t> next_to_step_map(const ScatterSources& sources, int width, int height) {
-  LargeVector<std::uint8_t> m(static_cast<std::size_t>(width) * height, 0);
-  for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * width + x;
-      if (x + 1 < width && std::abs(sources[i].coc_px - sources[i + 1].coc_px) >= kMinBlurDifferencePx) m[i] = m[i + 1] = 1;
-      if (y + 1 < height && std::abs(sources[i].coc_px - sources[i + width].coc_px) >= kMinBlurDifferencePx) m[i] = m[i + width] = 1;
+// Whether a 4-neighbour of pixel (x, y) differs in blur (`coc`, px per pixel) by kMinBlurDifferencePx
+// or more: such a pixel may be mixed itself, and decide() prefers neighbours that are not.
+bool next_to_step_at(const double* coc, int width, int height, int x, int y) {
+  const std::size_t i = static_cast<std::size_t>(y) * width + x;
+  const double c = coc[i];
+  return (x > 0 && std::abs(c - coc[i - 1]) >= kMinBlurDifferencePx) || (x + 1 < width && std::abs(c - coc[i + 1]) >= kMinBlurDifferencePx) ||
+         (y > 0 && std::abs(c - coc[i - width]) >= kMinBlurDifferencePx) ||
+         (y + 1 < height && std::abs(c - coc[i + width]) >= kMinBlurDifferencePx);
+}
+
+// Whether the blur of pixel (x, y)'s 3 x 3 neighbourhood spans kMinBlurDifferencePx or more: only
+// there can decide() change anything.
+bool spans_step_at(const double* coc, int width, int height, int x, int y) {
+  double lo = kInfinity, hi = -kInfinity;
+  for (int qy = std::max(0, y - 1); qy <= std::min(height - 1, y + 1); ++qy) {
+    for (int qx = std::max(0, x - 1); qx <= std::min(width - 1, x + 1); ++qx) {
+      const double c = coc[static_cast<std::size_t>(qy) * width + qx];
+      lo = std::min(lo, c);
+      hi = std::max(hi, c);
     }
   }
-  return m;
+  return hi - lo >= kMinBlurDifferencePx;
 }
 
 Decision decide(const ScatterSources& sources, const LargeVector<std::uint8_t>& next_to_step, int width, int height,
@@ -184,18 +195,41 @@ void apply(ScatterSources& sources, std::size_t i, const Decision& d, const Came
 
 void split_mixed_pixels(ScatterSources& sources, int width, int height, const Camera& camera, int threads,
                         BokehStatistics& stats) {
+  const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  // The pixels' blurs packed, and per pixel whether it is next to a depth step and whether its
+  // neighbourhood spans one. Only the pixels that span one are decided (a few per cent of a
+  // frame); after each pass the flags are brought up to date around the pixels it moved.
+  LargeVector<double> coc(pixels);
+  LargeVector<std::uint8_t> next_to_step(pixels), spans(pixels);
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * width + x;
+      coc[i] = sources[i].coc_px;
+    }
+  }
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * width + x;
+      next_to_step[i] = next_to_step_at(coc.data(), width, height, x, y) ? 1 : 0;
+      spans[i] = spans_step_at(coc.data(), width, height, x, y) ? 1 : 0;
+    }
+  }
   // Each pass decides from the sources as they were at its start, so decisions do not depend on
   // the order of the pixels; each row keeps those that change something, applied in row order.
   std::vector<std::vector<std::pair<std::size_t, Decision>>> rows(static_cast<std::size_t>(height));
+  std::vector<std::size_t> moved;
   for (int pass = 0; pass <= kMovePasses; ++pass) {
     const bool last = pass == kMovePasses;
     std::size_t changes = 0;
-    const LargeVector<std::uint8_t> next_to_step = next_to_step_map(sources, width, height);
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 16) reduction(+ : changes)
     for (int y = 0; y < height; ++y) {
       auto& row = rows[static_cast<std::size_t>(y)];
       row.clear();
+      const std::uint8_t* span_row = spans.data() + static_cast<std::size_t>(y) * width;
       for (int x = 0; x < width; ++x) {
+        if (!span_row[x]) continue;  // decide() would keep it
         Decision d = decide(sources, next_to_step, width, height, x, y);
         if (d.kind == Decision::Kind::Keep || (!last && d.kind != Decision::Kind::Move)) continue;
         row.emplace_back(static_cast<std::size_t>(y) * width + x, d);
@@ -204,10 +238,27 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
     }
     // One growth for all the split pixels' second parts (none while the reserve lasts).
     if (sources.capacity() < sources.size() + changes) sources.reserve(sources.size() + changes);
+    moved.clear();
     for (const auto& row : rows) {
-      for (const auto& [i, d] : row) apply(sources, i, d, camera, stats);
+      for (const auto& [i, d] : row) {
+        apply(sources, i, d, camera, stats);
+        if (!last && sources[i].coc_px != coc[i]) moved.push_back(i);
+      }
     }
-    if (!last && changes == 0) pass = kMovePasses - 1;  // nothing moved: go to the split
+    if (last) break;
+    for (const std::size_t i : moved) coc[i] = sources[i].coc_px;
+    // A moved pixel's blur enters its 4-neighbours' step flags and its 3 x 3 neighbours' spans.
+    for (const std::size_t i : moved) {
+      const int x = static_cast<int>(i % static_cast<std::size_t>(width)), y = static_cast<int>(i / static_cast<std::size_t>(width));
+      for (int qy = std::max(0, y - 1); qy <= std::min(height - 1, y + 1); ++qy) {
+        for (int qx = std::max(0, x - 1); qx <= std::min(width - 1, x + 1); ++qx) {
+          const std::size_t q = static_cast<std::size_t>(qy) * width + qx;
+          next_to_step[q] = next_to_step_at(coc.data(), width, height, qx, qy) ? 1 : 0;
+          spans[q] = spans_step_at(coc.data(), width, height, qx, qy) ? 1 : 0;
+        }
+      }
+    }
+    if (changes == 0) pass = kMovePasses - 1;  // nothing moved: go to the split
   }
 }
 
