@@ -653,6 +653,15 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
       static constexpr std::array<PupilPoint, 3> kBasis{{{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}}};
       std::array<SensorHit, 3> basis;
       model_.map_passing(point, lambdas[l], kBasis, basis);
+      if (l == 0) {
+        const PixelPoint o = camera_.output_pixel(basis[0].x_mm, basis[0].y_mm);
+        const PixelPoint ex = camera_.output_pixel(basis[1].x_mm, basis[1].y_mm);
+        const PixelPoint ey = camera_.output_pixel(basis[2].x_mm, basis[2].y_mm);
+        p.affine_px = {static_cast<float>(o.x),        static_cast<float>(o.y),        static_cast<float>(ex.x - o.x),
+                       static_cast<float>(ex.y - o.y), static_cast<float>(ey.x - o.x), static_cast<float>(ey.y - o.y)};
+        p.centre_weight = static_cast<float>(basis[0].weight);
+        p.mapped = basis[0].ok;
+      }
       for (std::size_t i = 0; i < 9; ++i) {
         SensorHit& h = hits[i];
         h = basis[0];
@@ -828,6 +837,15 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
     std::array<float, 4> value{};
     for (std::size_t c = 0; c < 3; ++c) value[c] = share * (g.m[c][0] * s.rgb[0] + g.m[c][1] * s.rgb[1] + g.m[c][2] * s.rgb[2]);
     value[3] = share * g.alpha * s.coverage;
+    // A single group's rays are the plan's, at the reference wavelength.
+    const bool planned = p.mapped && p.groups == 1 && p.blend == 1.0f;
+    if (p.outline == FootprintPlan::kPoint && planned) {
+      std::array<float, 4> v = lit(value, p.centre_weight);
+      const auto light = static_cast<float>(options_.vignetting ? passing : 1.0);
+      for (std::size_t k = 0; k < 3; ++k) v[k] *= light;
+      buffer.add_point({p.affine_px[0], p.affine_px[1]}, v);
+      return;
+    }
     if (p.outline == FootprintPlan::kPoint) {
       static constexpr std::array<PupilPoint, 1> kCentre{{{0.0, 0.0}}};
       hits.resize(1);
@@ -849,12 +867,21 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
       // Affine model, uniform convex aperture: the outline, less what first-order vignetting cuts
       // off, mapped by the affine map of three rays; it keeps the share of the light that passes.
       static constexpr std::array<PupilPoint, 3> kBasis{{{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}}};
-      hits.resize(3);
-      model_.map_passing(point, g.wavelength_nm, kBasis, std::span<SensorHit>(hits.data(), 3));
-      const PixelPoint o = camera_.output_pixel(hits[0].x_mm, hits[0].y_mm);
-      const PixelPoint ex = camera_.output_pixel(hits[1].x_mm, hits[1].y_mm);
-      const PixelPoint ey = camera_.output_pixel(hits[2].x_mm, hits[2].y_mm);
-      std::array<float, 4> v = lit(value, hits[0].weight);
+      PixelPoint o, ex, ey;
+      double centre_weight = p.centre_weight;
+      if (planned) {
+        o = {p.affine_px[0], p.affine_px[1]};
+        ex = {o.x + p.affine_px[2], o.y + p.affine_px[3]};
+        ey = {o.x + p.affine_px[4], o.y + p.affine_px[5]};
+      } else {
+        hits.resize(3);
+        model_.map_passing(point, g.wavelength_nm, kBasis, std::span<SensorHit>(hits.data(), 3));
+        o = camera_.output_pixel(hits[0].x_mm, hits[0].y_mm);
+        ex = camera_.output_pixel(hits[1].x_mm, hits[1].y_mm);
+        ey = camera_.output_pixel(hits[2].x_mm, hits[2].y_mm);
+        centre_weight = hits[0].weight;
+      }
+      std::array<float, 4> v = lit(value, centre_weight);
       const auto light = static_cast<float>(options_.vignetting ? passing : 1.0);
       for (std::size_t c = 0; c < 3; ++c) v[c] *= light;
       if (p.level == 0 && outline == &meshes_.outline(p.outline)) {

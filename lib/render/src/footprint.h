@@ -42,6 +42,14 @@ struct FootprintPlan {
   // Share of a uniform convex aperture that passes those discs, measured on an outline of at least
   // PupilMeshTable::kShareSectorStep's vertices (1 without discs; 0: the whole beam is stopped).
   float passing = 1.0f;
+  // An affine footprint's rays at the reference wavelength, kept for the deposit of a single
+  // wavelength group (whose wavelength that is), which would map them again: where the pupil's
+  // centre lands (output px, x and y), where its points (1, 0) and (0, 1) land relative to it (px,
+  // x and y each: differences of floats near 1000 would be off by 1e-4 px, beyond the stamps'
+  // tolerances), and the centre ray's radiometric weight. `mapped` says whether they are set.
+  bool mapped = false;
+  std::array<float, 6> affine_px{};
+  float centre_weight = 1.0f;
 };
 
 // Per-thread scratch space, so planning and deposits allocate nothing once warm.
