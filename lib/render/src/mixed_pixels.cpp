@@ -29,8 +29,9 @@ constexpr double kFitResidualHigh = 0.6;
 // alpha within this of 0 or 1 is a pure pixel of one surface (noise of the colour estimate).
 constexpr double kPureAlpha = 0.03;
 // Passes that move pixels wholly to the surface their colour shows, before the split: a depth edge
-// up to this many pixels off the colour edge (nearest-surface, farthest-surface or filtered depth)
-// comes back to it, a pixel per pass.
+// up to this many pixels beyond the colour edge (a grown or filtered depth) comes back to it, a pixel
+// per pass. One stopping 2 px or more inside it does not: those pixels have only the subject's colour
+// around them (tests/render/bokeh_edges_test.cpp measures both).
 constexpr int kMovePasses = 3;
 
 struct Group {
