@@ -48,11 +48,21 @@ struct Scene {
   std::vector<float> coverage;  // of the near surface, per pixel
 };
 
+// disc_over_wall's subject is centred this far from the frame's centre (px): off the pixel grid.
+constexpr double kDiscOffsetX = 0.3;
+constexpr double kDiscOffsetY = -0.2;
+
+// How far pixel (x, y)'s centre lies outside the silhouette of disc_over_wall's subject (px, < 0
+// inside) in a w x h frame.
+double outside_silhouette_px(int x, int y, int w, int h, double radius_px) {
+  return std::hypot(x + 0.5 - (0.5 * w + kDiscOffsetX), y + 0.5 - (0.5 * h + kDiscOffsetY)) - radius_px;
+}
+
 // A disc of colour `near_rgb` at near_m over a wall of colour far_rgb (with a texture in green and
 // blue only) at far_m, anti-aliased by 8 x 8 supersampling of each pixel.
 Scene disc_over_wall(int w, int h, double radius_px, std::array<float, 3> near_rgb, double near_m, double far_m, EdgeDepth edge) {
   Scene s{Image(w, h, 3), DepthMap(w, h, static_cast<float>(far_m)), std::vector<float>(static_cast<std::size_t>(w) * h)};
-  const double cx = 0.5 * w + 0.3, cy = 0.5 * h - 0.2;  // off the pixel grid
+  const double cx = 0.5 * w + kDiscOffsetX, cy = 0.5 * h + kDiscOffsetY;
   constexpr int kSuper = 8;
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
@@ -112,7 +122,7 @@ TEST_CASE("A sharp subject sends no light beyond its silhouette into the blurred
       int count = 0, worst_x = 0, worst_y = 0;
       for (int y = 0; y < h; ++y) {
         for (int x = 0; x < w; ++x) {
-          const double d = std::hypot(x + 0.5 - (0.5 * w + 0.3), y + 0.5 - (0.5 * h - 0.2)) - radius_px;
+          const double d = outside_silhouette_px(x, y, w, h, radius_px);
           if (d < 2.0 || d > 14.0) continue;
           const double leak = out.at(x, y, 0) / 0.8;
           sum += leak;
@@ -174,7 +184,7 @@ TEST_CASE("A depth edge up to 2 px inside or 3 px outside the silhouette renders
     int count = 0;
     for (int y = 0; y < h; ++y) {
       for (int x = 0; x < w; ++x) {
-        const double d = std::hypot(x + 0.5 - (0.5 * w + 0.3), y + 0.5 - (0.5 * h - 0.2)) - radius_px;
+        const double d = outside_silhouette_px(x, y, w, h, radius_px);
         if (std::abs(d) > 8.0) continue;
         for (int c = 0; c < 3; ++c) sum += std::abs(out.at(x, y, c) - reference.at(x, y, c));
         count += 3;
@@ -199,7 +209,7 @@ TEST_CASE("Kept whole at the wall's depth, mixed edge pixels would carry the sub
   double worst = 0.0;
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      const double d = std::hypot(x + 0.5 - (0.5 * w + 0.3), y + 0.5 - (0.5 * h - 0.2)) - 22.0;
+      const double d = outside_silhouette_px(x, y, w, h, 22.0);
       if (d >= 2.0 && d <= 14.0) worst = std::max(worst, out.at(x, y, 0) / 0.8);
     }
   }

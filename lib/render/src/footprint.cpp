@@ -846,25 +846,23 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
     value[3] = share * g.alpha * s.coverage;
     // A single group's rays are the plan's, at the reference wavelength.
     const bool planned = p.mapped && p.groups == 1 && p.blend == 1.0f;
-    if (p.outline == FootprintPlan::kPoint && planned) {
-      std::array<float, 4> v = lit(value, p.centre_weight);
-      const auto light = static_cast<float>(options_.vignetting ? passing : 1.0);
-      for (std::size_t k = 0; k < 3; ++k) v[k] *= light;
-      buffer.add_point({p.affine_px[0], p.affine_px[1]}, v);
-      return;
-    }
     if (p.outline == FootprintPlan::kPoint) {
-      static constexpr std::array<PupilPoint, 1> kCentre{{{0.0, 0.0}}};
-      hits.resize(1);
-      // With discs the passing share is known (a cat's eye may leave the chief ray out).
-      if (!p.discs) {
-        model_.map(point, g.wavelength_nm, kCentre, std::span<SensorHit>(hits.data(), 1));
-      } else {
-        model_.map_passing(point, g.wavelength_nm, kCentre, std::span<SensorHit>(hits.data(), 1));
+      PixelPoint c{p.affine_px[0], p.affine_px[1]};
+      double centre_weight = p.centre_weight;
+      if (!planned) {
+        static constexpr std::array<PupilPoint, 1> kCentre{{{0.0, 0.0}}};
+        hits.resize(1);
+        // With discs the passing share is known (a cat's eye may leave the chief ray out).
+        if (!p.discs) {
+          model_.map(point, g.wavelength_nm, kCentre, std::span<SensorHit>(hits.data(), 1));
+        } else {
+          model_.map_passing(point, g.wavelength_nm, kCentre, std::span<SensorHit>(hits.data(), 1));
+        }
+        if (!hits[0].ok) return;
+        c = camera_.output_pixel(hits[0].x_mm, hits[0].y_mm);
+        centre_weight = hits[0].weight;
       }
-      if (!hits[0].ok) return;
-      const PixelPoint c = camera_.output_pixel(hits[0].x_mm, hits[0].y_mm);
-      std::array<float, 4> v = lit(value, hits[0].weight);
+      std::array<float, 4> v = lit(value, centre_weight);
       const auto light = static_cast<float>(options_.vignetting ? passing : 1.0);
       for (std::size_t k = 0; k < 3; ++k) v[k] *= light;
       buffer.add_point({static_cast<float>(c.x), static_cast<float>(c.y)}, v);

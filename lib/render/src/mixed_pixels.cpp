@@ -177,9 +177,8 @@ Decision decide(const ScatterSources& sources, const LargeVector<std::uint8_t>& 
     std::array<double, 3> miss{};
     for (std::size_t c = 0; c < 3; ++c) miss[c] = offset[c] - alpha_colour * span[c];
     const double residual = norm(miss) / std::sqrt(span2);
-    const double contrast = std::sqrt(span2) / (norm(d.near.rgb) + norm(d.far.rgb));
     const double trust =
-        std::clamp((contrast - kColourContrastLow) / (kColourContrastHigh - kColourContrastLow), 0.0, 1.0) *
+        std::clamp((contrast(d.near, d.far) - kColourContrastLow) / (kColourContrastHigh - kColourContrastLow), 0.0, 1.0) *
         std::clamp((kFitResidualHigh - residual) / (kFitResidualHigh - kFitResidualLow), 0.0, 1.0);
     alpha = trust * alpha_colour + (1.0 - trust) * alpha_depth;
   }
