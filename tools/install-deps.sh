@@ -11,7 +11,7 @@ export DEBIAN_FRONTEND=noninteractive
 apt-get update -qq
 apt-get install -y -qq --no-install-recommends \
   ca-certificates cmake ninja-build g++ pkg-config \
-  libeigen3-dev libceres-dev libopenexr-dev libimath-dev libtiff-dev libpng-dev libstb-dev libopencolorio-dev libdeflate-dev zlib1g-dev \
+  libeigen3-dev libceres-dev libopenexr-dev libimath-dev libtiff-dev libpng-dev libjpeg62-turbo-dev libstb-dev libopencolorio-dev libdeflate-dev zlib1g-dev \
   nlohmann-json3-dev libcli11-dev catch2 libbenchmark-dev \
   clang libclang-rt-14-dev fonts-dejavu-core \
   python3 python3-dev pybind11-dev python3-numpy python3-matplotlib python3-pytest python3-pandas \

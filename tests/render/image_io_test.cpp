@@ -2,7 +2,8 @@
 // round trips through OpenEXR, depth conventions (planar z, Euclidean distance, inverse depth) against
 // their defining formulas, and the errors a user sees for bad files. Inputs in the formats lensmith
 // reads are made here with OpenEXR, libpng and libtiff directly, or byte by byte from the format's
-// specification (PFM, Radiance RGBE), never with the code under test.
+// specification (PFM, Radiance RGBE), never with the code under test; JPEG inputs with libjpeg's
+// compressor, which lensmith does not use (it writes JPEG with stb_image_write).
 #include "lensmith/render/image_io.h"
 
 #include <OpenEXR/ImfChannelList.h>
@@ -18,11 +19,16 @@
 #include <png.h>
 #include <tiffio.h>
 
+#include <cstdio>
+// jpeglib.h needs size_t and FILE declared before it.
+#include <jpeglib.h>
+
 #include <Imath/half.h>
 
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <bit>
 #include <cmath>
@@ -36,6 +42,7 @@
 #include <string>
 
 #include "lensmith/core/errors.h"
+#include "lensmith/core/text_file.h"
 #include "lensmith/imageio/image_file.h"
 #include "lensmith/render/deep_image.h"
 #include "deep_exr_writer.h"
@@ -176,12 +183,13 @@ bool write_png_directly(const fs::path& path, png_uint_32 width, png_uint_32 for
   return png_image_write_to_file(&image, path.c_str(), 0, samples, 0, nullptr) != 0;
 }
 
-std::string little_endian_float(float v) {
-  const auto bits = std::bit_cast<std::uint32_t>(v);
+std::string little_endian_u32(std::uint32_t bits) {
   std::string out;
   for (int shift = 0; shift < 32; shift += 8) out += static_cast<char>((bits >> shift) & 0xFFu);
   return out;
 }
+
+std::string little_endian_float(float v) { return little_endian_u32(std::bit_cast<std::uint32_t>(v)); }
 
 std::string big_endian_float(float v) {
   std::string out = little_endian_float(v);
@@ -346,6 +354,95 @@ TEST_CASE("16-bit TIFF, JPEG and HDR outputs read back within their quantisation
     CHECK_THAT(read.at(1, 1, 1), WithinRel(250.0, kRgbeMantissa));
     CHECK_THAT(read.at(2, 2, 2), WithinRel(static_cast<double>(bright.at(2, 2, 2)), kRgbeMantissa));
   }
+}
+
+// A JPEG written by libjpeg's own compressor: `components` 8-bit samples a pixel in `space`
+// (JCS_GRAYSCALE or JCS_CMYK; libjpeg marks CMYK with Adobe's APP14 segment), at quality 100.
+void write_libjpeg(const fs::path& path, int width, int height, int components, J_COLOR_SPACE space,
+                   const std::vector<unsigned char>& samples) {
+  jpeg_compress_struct jpeg{};
+  jpeg_error_mgr errors{};
+  jpeg.err = jpeg_std_error(&errors);
+  jpeg_create_compress(&jpeg);
+  std::FILE* file = std::fopen(path.c_str(), "wb");
+  REQUIRE(file != nullptr);
+  jpeg_stdio_dest(&jpeg, file);
+  jpeg.image_width = static_cast<JDIMENSION>(width);
+  jpeg.image_height = static_cast<JDIMENSION>(height);
+  jpeg.input_components = components;
+  jpeg.in_color_space = space;
+  jpeg_set_defaults(&jpeg);
+  jpeg_set_quality(&jpeg, 100, TRUE);
+  jpeg_start_compress(&jpeg, TRUE);
+  while (jpeg.next_scanline < jpeg.image_height) {
+    auto* row = const_cast<JSAMPROW>(samples.data() + static_cast<std::size_t>(jpeg.next_scanline) * width * components);
+    jpeg_write_scanlines(&jpeg, &row, 1);
+  }
+  jpeg_finish_compress(&jpeg);
+  jpeg_destroy_compress(&jpeg);
+  std::fclose(file);
+}
+
+// Quality 100 on 8 x 8 blocks of one colour, or a gentle ramp, leaves a code value or two.
+constexpr double kJpeg100 = 2.0 / 255.0;
+
+TEST_CASE("a gray JPEG reads as one channel, a CMYK one as the RGB its inks leave", "[render][image_io]") {
+  TempDir dir;
+  SECTION("gray: one channel Y, the written ramp") {
+    std::vector<unsigned char> ramp(32 * 16);
+    for (std::size_t i = 0; i < ramp.size(); ++i) ramp[i] = static_cast<unsigned char>(4 * (i % 32) + 60);
+    write_libjpeg(dir / "gray.jpg", 32, 16, 1, JCS_GRAYSCALE, ramp);
+    const RasterInfo info = read_raster_info(dir / "gray.jpg");
+    REQUIRE(info.channels.size() == 1);
+    CHECK(info.channels[0].name == "Y");
+    const Raster raster = read_raster(dir / "gray.jpg", info, std::vector<int>{0});
+    for (std::size_t i = 0; i < ramp.size(); ++i) {
+      INFO("sample " << i);
+      CHECK_THAT(raster.samples[i], WithinAbs(ramp[i] / 255.0, kJpeg100));
+    }
+  }
+  SECTION("CMYK, stored inverted as Adobe's are: light = (1 - ink) x (1 - black ink)") {
+    // Four 8 x 8 patches, as inks (0 none, 255 full): cyan; half black; magenta + yellow; a mix.
+    const unsigned char inks[4][4] = {{255, 0, 0, 0}, {0, 0, 0, 128}, {0, 255, 255, 0}, {64, 128, 192, 32}};
+    std::vector<unsigned char> stored(32 * 8 * 4);
+    for (int x = 0; x < 32; ++x) {
+      for (int y = 0; y < 8; ++y) {
+        for (int c = 0; c < 4; ++c) stored[static_cast<std::size_t>((y * 32 + x) * 4 + c)] = static_cast<unsigned char>(255 - inks[x / 8][c]);
+      }
+    }
+    write_libjpeg(dir / "cmyk.jpg", 32, 8, 4, JCS_CMYK, stored);
+    const RasterInfo info = read_raster_info(dir / "cmyk.jpg");
+    REQUIRE(info.channels.size() == 3);
+    const Raster raster = read_raster(dir / "cmyk.jpg", info, std::vector<int>{0, 1, 2});
+    for (int patch = 0; patch < 4; ++patch) {
+      for (int c = 0; c < 3; ++c) {
+        const double light = (1.0 - inks[patch][c] / 255.0) * (1.0 - inks[patch][3] / 255.0);
+        INFO("patch " << patch << ", channel " << c);
+        CHECK_THAT(raster.samples[static_cast<std::size_t>((4 * 32 + 8 * patch + 4) * 3 + c)], WithinAbs(light, kJpeg100));
+      }
+    }
+  }
+}
+
+TEST_CASE("a JPEG with a damaged Huffman table or cut short is an IoError naming the file, never a picture", "[render][image_io]") {
+  TempDir dir;
+  // Found by lensmith's fuzzer: a DHT segment declaring more than 256 codes, on which Debian 12's
+  // stb_image (which decoded JPEG before libjpeg-turbo) wrote past its table.
+  const unsigned char huffman[] = {0xff, 0xd8, 0xff, 0xff, 0xc4, 0xff, 0x0a, 0x00, 0x00, 0x00,
+                                   0x00, 0x00, 0x00, 0xfb, 0xff, 0x8f, 0x2b, 0x20};
+  const fs::path damaged = dir / "huffman.jpg";
+  std::ofstream(damaged, std::ios::binary).write(reinterpret_cast<const char*>(huffman), sizeof huffman);
+  CHECK_THROWS_AS(read_radiance_image(damaged), IoError);
+  CHECK_THROWS_WITH(read_radiance_image(damaged), Contains(damaged.string()) && Contains("cannot read the JPEG image"));
+
+  std::vector<unsigned char> ramp(64 * 64);
+  for (std::size_t i = 0; i < ramp.size(); ++i) ramp[i] = static_cast<unsigned char>((i * 7) % 251);
+  write_libjpeg(dir / "whole.jpg", 64, 64, 1, JCS_GRAYSCALE, ramp);
+  const std::string bytes = read_file_bytes((dir / "whole.jpg").string());
+  const fs::path cut = dir / "cut.jpg";
+  std::ofstream(cut, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  CHECK_NOTHROW(read_radiance_image(dir / "whole.jpg"));
+  CHECK_THROWS_WITH(read_radiance_image(cut), Contains(cut.string()) && Contains("Premature end of JPEG file"));
 }
 
 TEST_CASE("RGB channels are found by name wherever they sit, and alpha is ignored", "[render][image_io]") {
@@ -1115,6 +1212,51 @@ TEST_CASE("a float TIFF reads its samples as stored, as a picture and as depth",
     const DepthMap read = read_depth(DepthSource{dir / "depth.tif", ""}, {}, small_frame());
     CHECK(read.at(2, 1) == 0.75f);
     CHECK(read.at(0, 0) == 4.0f);
+  }
+}
+
+// A little-endian TIFF of one directory, byte by byte (TIFF 6.0, section 2): header, the entries
+// (tag, type 3 SHORT or 4 LONG, count 1, value), no next directory, then `padding` zero bytes.
+std::string tiff_bytes(std::vector<std::array<std::uint32_t, 3>> entries, std::size_t padding) {
+  std::sort(entries.begin(), entries.end());
+  std::string bytes = std::string("II*\0", 4) + little_endian_u32(8);
+  bytes += static_cast<char>(entries.size() & 0xFF);
+  bytes += static_cast<char>(entries.size() >> 8);
+  for (const auto& [tag, type, value] : entries) {
+    bytes += static_cast<char>(tag & 0xFF);
+    bytes += static_cast<char>(tag >> 8);
+    bytes += static_cast<char>(type);
+    bytes += '\0';
+    bytes += little_endian_u32(1) + little_endian_u32(value);
+  }
+  return bytes + little_endian_u32(0) + std::string(padding, '\0');
+}
+
+TEST_CASE("a TIFF claiming tiles far larger than its picture, or thousands of samples a pixel, is refused before decoding", "[render][image_io]") {
+  TempDir dir;
+  // 16 x 16 pixels of 8-bit RGB, uncompressed; the pixel data (zeros) from byte 200 on.
+  const std::vector<std::array<std::uint32_t, 3>> rgb16 = {{256, 4, 16}, {257, 4, 16}, {258, 3, 8}, {259, 3, 1}, {262, 3, 2}, {284, 3, 1}};
+  SECTION("tiles of 825104 x 1024 pixels (found by the fuzzer: libtiff took 2.5 GB for one)") {
+    auto entries = rgb16;
+    entries.insert(entries.end(), {{277, 3, 3}, {322, 4, 825104}, {323, 4, 1024}, {324, 4, 200}, {325, 4, 100}});
+    std::ofstream(dir / "tiles.tif", std::ios::binary) << tiff_bytes(entries, 300);
+    CHECK_THROWS_AS(read_radiance_image(dir / "tiles.tif"), ImageFileError);
+    CHECK_THROWS_WITH(read_radiance_image(dir / "tiles.tif"),
+                      Contains((dir / "tiles.tif").string()) && Contains("tiles of 825104 x 1024 pixels for a picture of 16 x 16"));
+  }
+  SECTION("60000 samples a pixel") {
+    auto entries = rgb16;
+    entries.insert(entries.end(), {{277, 3, 60000}, {273, 4, 200}, {278, 4, 16}, {279, 4, 100}});
+    std::ofstream(dir / "samples.tif", std::ios::binary) << tiff_bytes(entries, 300);
+    CHECK_THROWS_WITH(read_radiance_image(dir / "samples.tif"), Contains("60000 samples per pixel"));
+  }
+  SECTION("while tiles of 512 x 512 on the same small picture, as some writers make, are read") {
+    auto entries = rgb16;
+    entries.insert(entries.end(), {{277, 3, 3}, {322, 4, 512}, {323, 4, 512}, {324, 4, 200}, {325, 4, 512 * 512 * 3}});
+    std::ofstream(dir / "small.tif", std::ios::binary) << tiff_bytes(entries, 200 + 512 * 512 * 3);
+    const Image read = read_radiance_image(dir / "small.tif");
+    CHECK(read.width == 16);
+    CHECK(read.at(15, 15, 2) == 0.0f);
   }
 }
 

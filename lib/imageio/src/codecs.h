@@ -54,7 +54,11 @@ PngChunks read_png_chunks(const fs::path& path);
 void write_png_file(const fs::path& path, const std::string& file, const PixelsView<std::uint8_t>& pixels,
                     const std::vector<ImageAttribute>& attributes);
 
-// Formats decoded by stb_image: PNG, JPEG, HDR, TGA, BMP, PNM (stb_codecs.cpp).
+// JPEG through libjpeg-turbo (jpeg_codec.cpp): gray, RGB, and CMYK converted to RGB.
+RasterInfo read_jpeg_info(const fs::path& path);
+Decoded read_jpeg(const fs::path& path);
+
+// Formats decoded by stb_image: PNG, HDR, TGA, BMP, PNM (stb_codecs.cpp); JPEG metadata and output.
 bool stb_can_decode(const fs::path& path);  // stb recognises the header (the test for TGA, which has no magic bytes)
 RasterInfo read_stb_info(const fs::path& path, ImageFormat format);
 Decoded read_stb(const fs::path& path, ImageFormat format);

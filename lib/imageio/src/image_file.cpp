@@ -121,7 +121,7 @@ RasterInfo read_format_info(const fs::path& path) {
       info.integers_are_linear = codecs::read_png_chunks(path).linear;
       return info;
     }
-    case ImageFormat::Jpeg:
+    case ImageFormat::Jpeg: return codecs::read_jpeg_info(path);
     case ImageFormat::Hdr:
     case ImageFormat::Bmp:
     case ImageFormat::Tga:
@@ -160,6 +160,7 @@ codecs::Decoded decode_all(const fs::path& path, const RasterInfo& info) {
   switch (info.format) {
     case ImageFormat::Tiff: decoded = codecs::read_tiff(path); break;
     case ImageFormat::Pfm: decoded = codecs::read_pfm(path); break;
+    case ImageFormat::Jpeg: decoded = codecs::read_jpeg(path); break;
     default: decoded = codecs::read_stb(path, info.format); break;
   }
   if (decoded.info.width != info.width || decoded.info.height != info.height ||

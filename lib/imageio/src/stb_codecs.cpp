@@ -1,10 +1,12 @@
-// Decoding PNG, JPEG, Radiance HDR, TGA, BMP and binary PNM with stb_image, and writing JPEG and
+// Decoding PNG, Radiance HDR, TGA, BMP and binary PNM with stb_image, and writing JPEG and
 // HDR with stb_image_write; the metadata those libraries skip is read and written here: a JPEG's
 // COM segment and the Software/ImageDescription tags of its Exif APP1 segment (JPEG File
 // Interchange Format 1.02; Exif 2.3, 4.5 and 4.6), and the NAME=value lines of a Radiance header
 // (Ward, "The RADIANCE Picture File Format").
 // The single definition of stb_image and stb_image_write in lensmith. GIF, PSD and PIC decoding is
-// left out, so stb's header test below recognises only the formats lensmith reads.
+// left out, so stb's header test below recognises only the formats lensmith reads; JPEG decoding
+// too: libjpeg-turbo reads JPEG (jpeg_codec.cpp says why).
+#define STBI_NO_JPEG
 #define STBI_NO_GIF
 #define STBI_NO_PSD
 #define STBI_NO_PIC

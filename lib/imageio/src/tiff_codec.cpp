@@ -76,6 +76,9 @@ struct TiffLayout {
   bool direct = true;  // contiguous gray/RGB with supported samples; else libtiff's RGBA reader
 };
 
+constexpr std::uint16_t kMaxTiffSamples = 64;
+constexpr std::uint32_t kMaxTiffTileSide = 1024;
+
 TiffLayout read_layout(const TiffFile& file, const fs::path& path) {
   TIFF* t = file.get();
   std::uint32_t width = 0, height = 0;
@@ -92,6 +95,27 @@ TiffLayout read_layout(const TiffFile& file, const fs::path& path) {
   if (width < 1 || height < 1 || width > (1u << 24) || height > (1u << 24)) {
     throw ImageFileError(path.string() + ": TIFF of " + std::to_string(width) + " x " + std::to_string(height) +
                          " pixels: not a picture lensmith can read");
+  }
+  // Gray or RGB with alpha and a few extra samples is what lensmith photographs; a count in the
+  // thousands (the field is 16-bit) is a damaged header that would size the decoded picture.
+  if (samples < 1 || samples > kMaxTiffSamples) {
+    throw ImageFileError(path.string() + ": a TIFF of " + std::to_string(samples) + " samples per pixel; lensmith reads 1 to " +
+                         std::to_string(kMaxTiffSamples) + " (gray or RGB, alpha and extra samples)");
+  }
+  if (TIFFIsTiled(t) != 0) {
+    // libtiff decodes a whole tile at once: a tile claiming 825104 x 1024 pixels on a 16 x 16
+    // picture took 2.5 GB (found by tests/fuzz's exr_image target). TIFF 6.0 (section 15) asks
+    // for sides that are multiples of 16; writers use 16 to 1024, or the picture's own size.
+    std::uint32_t tile_width = 0, tile_height = 0;
+    TIFFGetField(t, TIFFTAG_TILEWIDTH, &tile_width);
+    TIFFGetField(t, TIFFTAG_TILELENGTH, &tile_height);
+    const auto largest = [](std::uint32_t side) { return std::max<std::uint32_t>((side + 15) / 16 * 16, kMaxTiffTileSide); };
+    if (tile_width < 1 || tile_height < 1 || tile_width > largest(width) || tile_height > largest(height)) {
+      throw ImageFileError(path.string() + ": TIFF tiles of " + std::to_string(tile_width) + " x " + std::to_string(tile_height) +
+                           " pixels for a picture of " + std::to_string(width) + " x " + std::to_string(height) +
+                           ": a damaged file (tiles are at most " + std::to_string(kMaxTiffTileSide) +
+                           " pixels a side or the picture's size)");
+    }
   }
   TiffLayout layout;
   layout.bits = bits;
@@ -172,7 +196,6 @@ void read_direct(const TiffFile& file, const TiffLayout& layout, std::vector<flo
     std::uint32_t tile_width = 0, tile_height = 0;
     TIFFGetField(t, TIFFTAG_TILEWIDTH, &tile_width);
     TIFFGetField(t, TIFFTAG_TILELENGTH, &tile_height);
-    if (tile_width < 1 || tile_height < 1) file.fail("a tiled TIFF without a tile size");
     std::vector<unsigned char> tile(static_cast<std::size_t>(TIFFTileSize64(t)));
     const std::size_t tile_row_samples = static_cast<std::size_t>(tile_width) * channels;
     const std::size_t sample_bytes = layout.bits / 8u;

@@ -1,7 +1,8 @@
 // libFuzzer target: lensmith's OpenEXR reading, flat and deep (lensmith::imageio on OpenEXR, and the
 // renderer's checks of deep samples). The bytes go to a file, as the readers take paths. Pictures
-// that declare more than 2048 x 2048 pixels or 2^20 deep samples are read only as far as their
-// header: the sizes are the fuzzer's memory limit, not a bug.
+// that declare more than 2048 x 2048 pixels, 2^25 samples (pixels x channels: 128 MiB of floats)
+// or 2^20 deep samples are read only as far as their header: the sizes are the fuzzer's memory
+// limit, not a bug.
 #include <unistd.h>
 
 #include <cstdint>
@@ -17,6 +18,7 @@
 
 namespace {
 constexpr long kMaxPixels = 2048L * 2048L;
+constexpr long kMaxFlatSamples = 1L << 25;
 constexpr std::uint64_t kMaxSamples = std::uint64_t{1} << 20;
 }  // namespace
 
@@ -37,7 +39,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       (void)deep.flatten();
     } else {
       const lensmith::RasterInfo info = lensmith::read_raster_info(path);
-      if (static_cast<long>(info.width) * info.height > kMaxPixels) return 0;
+      const long pixels = static_cast<long>(info.width) * info.height;
+      if (pixels > kMaxPixels || pixels * static_cast<long>(info.channels.size()) > kMaxFlatSamples) return 0;
       std::vector<int> all(info.channels.size());
       for (std::size_t c = 0; c < all.size(); ++c) all[c] = static_cast<int>(c);
       (void)lensmith::read_raster(path, info, all);

@@ -1,5 +1,5 @@
 // Reading and writing picture files without a general imaging library: OpenEXR for EXR, libtiff for
-// TIFF, libpng for PNG output and PNG text chunks, stb_image for decoding PNG, JPEG, Radiance HDR,
+// TIFF, libpng for PNG output and PNG text chunks, libjpeg-turbo for JPEG, stb_image for decoding PNG, Radiance HDR,
 // TGA, BMP and PNM, stb_image_write for JPEG and HDR output, and a reader of its own for PFM.
 // The format of an input is found from its first bytes; writers write through a temporary file in
 // the same folder that is renamed onto the target (core's write_atomically).
