@@ -883,6 +883,24 @@ TEST_CASE("a tiled OpenEXR reads sample for sample like the scanline file, parti
   CHECK(read.data == ramp);
 }
 
+TEST_CASE("an OpenEXR whose tiles would take more than 256 MiB each is refused before OpenEXR decodes them", "[render][image_io]") {
+  TempDir dir;
+  // R, G, B and 77 more float channels (320 bytes a pixel) in 16 x 16 tiles, written by OpenEXR;
+  // then the tile description (the "tiles" attribute's two 32-bit sides) says 1024 x 1024: 320 MiB.
+  ExrChannels channels{{"R", "G", "B"}};
+  for (int c = 0; c < 77; ++c) channels.names.push_back("extra" + std::to_string(c));
+  write_exr_directly(dir / "tiles.exr", 16, 16, channels, std::vector<float>(16 * 16 * 80, 0.5f), 16);
+  CHECK_NOTHROW(read_radiance_image(dir / "tiles.exr"));
+  std::string bytes = read_file_bytes((dir / "tiles.exr").string());
+  const std::string attribute("tiles\0tiledesc\0", 15);
+  const std::size_t at = bytes.find(attribute);
+  REQUIRE(at != std::string::npos);
+  bytes.replace(at + attribute.size() + 4, 8, little_endian_u32(1024) + little_endian_u32(1024));
+  std::ofstream(dir / "big-tiles.exr", std::ios::binary) << bytes;
+  CHECK_THROWS_AS(read_radiance_image(dir / "big-tiles.exr"), ImageFileError);
+  CHECK_THROWS_WITH(read_radiance_image(dir / "big-tiles.exr"), Contains("tiles of 1024 x 1024 pixels of 80 channels take 335544320 bytes"));
+}
+
 TEST_CASE("half-float OpenEXR channels read as the IEEE 754 binary16 values they hold", "[render][image_io]") {
   TempDir dir;
   // binary16 has a 10-bit fraction: 0.1 is stored as 1638 / 16384 = 0.0999755859375; 65504 is its largest finite value.
@@ -1243,6 +1261,13 @@ TEST_CASE("a TIFF claiming tiles far larger than its picture, or thousands of sa
     CHECK_THROWS_AS(read_radiance_image(dir / "tiles.tif"), ImageFileError);
     CHECK_THROWS_WITH(read_radiance_image(dir / "tiles.tif"),
                       Contains((dir / "tiles.tif").string()) && Contains("tiles of 825104 x 1024 pixels for a picture of 16 x 16"));
+  }
+  SECTION("tiles of 4194304 x 1024 pixels on a picture as wide and one row tall") {
+    std::vector<std::array<std::uint32_t, 3>> entries = {{256, 4, 4194304}, {257, 4, 1},   {258, 3, 8},   {259, 3, 1},
+                                                         {262, 3, 2},       {284, 3, 1},   {277, 3, 3},   {322, 4, 4194304},
+                                                         {323, 4, 1024},    {324, 4, 200}, {325, 4, 100}};
+    std::ofstream(dir / "wide.tif", std::ios::binary) << tiff_bytes(entries, 300);
+    CHECK_THROWS_WITH(read_radiance_image(dir / "wide.tif"), Contains("lensmith reads tiles of up to 256 MiB"));
   }
   SECTION("60000 samples a pixel") {
     auto entries = rgb16;

@@ -78,6 +78,7 @@ struct TiffLayout {
 
 constexpr std::uint16_t kMaxTiffSamples = 64;
 constexpr std::uint32_t kMaxTiffTileSide = 1024;
+constexpr std::uint64_t kMaxTiffTileBytes = std::uint64_t{kMaxTiffTileSide} * kMaxTiffTileSide * kMaxTiffSamples * 4;
 
 TiffLayout read_layout(const TiffFile& file, const fs::path& path) {
   TIFF* t = file.get();
@@ -115,6 +116,13 @@ TiffLayout read_layout(const TiffFile& file, const fs::path& path) {
                            " pixels for a picture of " + std::to_string(width) + " x " + std::to_string(height) +
                            ": a damaged file (tiles are at most " + std::to_string(kMaxTiffTileSide) +
                            " pixels a side or the picture's size)");
+    }
+    // And at most 1024 x 1024 pixels of 64 float samples: a long thin picture's sides alone let a
+    // tile of its whole width x 1024 rows through.
+    if (TIFFTileSize64(t) > kMaxTiffTileBytes) {
+      throw ImageFileError(path.string() + ": TIFF tiles of " + std::to_string(tile_width) + " x " + std::to_string(tile_height) +
+                           " pixels of " + std::to_string(samples) + " samples take " + std::to_string(TIFFTileSize64(t)) +
+                           " bytes each; lensmith reads tiles of up to " + std::to_string(kMaxTiffTileBytes >> 20) + " MiB");
     }
   }
   TiffLayout layout;
