@@ -130,9 +130,7 @@ RasterInfo read_format_info(const fs::path& path) {
   throw IoError(path.string() + ": unknown image format");
 }
 
-}  // namespace
-
-RasterInfo read_raster_info(const fs::path& path) {
+RasterInfo read_raster_info_uncached(const fs::path& path) {
   RasterInfo info = read_format_info(path);
   if (info.data_window.width() < 1) {
     // A format without windows: both are the picture.
@@ -141,8 +139,6 @@ RasterInfo read_raster_info(const fs::path& path) {
   }
   return info;
 }
-
-namespace {
 
 // The cache read_raster uses on this thread, if any (innermost ImageReadCache).
 thread_local ImageReadCache* current_read_cache = nullptr;
@@ -198,9 +194,41 @@ struct ImageReadCache::Entry {
   codecs::Decoded decoded;
 };
 
+// A file's header as read_raster_info and read_image_metadata_pairs give it, each once read.
+struct ImageReadCache::Header {
+  FileStamp stamp;
+  std::optional<RasterInfo> info;
+  std::optional<std::vector<std::pair<std::string, std::string>>> metadata;
+};
+
 ImageReadCache::ImageReadCache() : previous_(current_read_cache) { current_read_cache = this; }
 
 ImageReadCache::~ImageReadCache() { current_read_cache = previous_; }
+
+namespace {
+
+// The cache's header entry for `path` on this thread, made if new; null without a cache or where
+// the file cannot be stamped (then it is read each time, and reports its own error).
+ImageReadCache::Header* cached_header(ImageReadCache* cache, std::vector<ImageReadCache::Header>& headers, const fs::path& path) {
+  if (cache == nullptr) return nullptr;
+  const std::optional<FileStamp> stamp = stamp_of(path);
+  if (!stamp) return nullptr;
+  for (ImageReadCache::Header& header : headers) {
+    if (header.stamp == *stamp) return &header;
+  }
+  headers.push_back({*stamp, std::nullopt, std::nullopt});
+  return &headers.back();
+}
+
+}  // namespace
+
+RasterInfo read_raster_info(const fs::path& path) {
+  ImageReadCache* cache = current_read_cache;
+  ImageReadCache::Header* header = cache ? cached_header(cache, cache->headers_, path) : nullptr;
+  if (header == nullptr) return read_raster_info_uncached(path);
+  if (!header->info) header->info = read_raster_info_uncached(path);
+  return *header->info;
+}
 
 Raster read_raster(const fs::path& path, const RasterInfo& info, std::span<const int> channels) {
   for (const int c : channels) {
@@ -226,7 +254,9 @@ Raster read_raster(const fs::path& path, const RasterInfo& info, std::span<const
   return codecs::select_channels(cache->entries_.back().decoded, channels);
 }
 
-std::vector<std::pair<std::string, std::string>> read_image_metadata_pairs(const fs::path& path) {
+namespace {
+
+std::vector<std::pair<std::string, std::string>> read_metadata_pairs_uncached(const fs::path& path) {
   switch (detect_image_format(path)) {
     case ImageFormat::Exr: return codecs::read_exr_metadata(path);
     case ImageFormat::Tiff: return codecs::read_tiff_metadata(path);
@@ -239,6 +269,16 @@ std::vector<std::pair<std::string, std::string>> read_image_metadata_pairs(const
     case ImageFormat::Pnm: return {};
   }
   return {};
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, std::string>> read_image_metadata_pairs(const fs::path& path) {
+  ImageReadCache* cache = current_read_cache;
+  ImageReadCache::Header* header = cache ? cached_header(cache, cache->headers_, path) : nullptr;
+  if (header == nullptr) return read_metadata_pairs_uncached(path);
+  if (!header->metadata) header->metadata = read_metadata_pairs_uncached(path);
+  return *header->metadata;
 }
 
 void write_exr(const fs::path& path, const PixelsView<float>& pixels, const std::vector<std::string>& channel_names,
