@@ -4,6 +4,9 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <vector>
+
+#include <omp.h>
 
 #include "push_pull.h"
 
@@ -56,19 +59,32 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
   }
   LargeVector<std::uint8_t>& within = scratch.within;
   within.resize(static_cast<std::size_t>(bw) * bh);  // every entry is written below
-#pragma omp parallel for num_threads(threads) schedule(static)
-  for (int x = 0; x < bw; ++x) {
-    int last = far;
+  // Columns down and up, each thread a block of them walked row by row with one running distance
+  // per column: walked column by column, every step jumped a row.
+#pragma omp parallel num_threads(threads)
+  {
+    const int t = omp_get_thread_num(), n = omp_get_num_threads();
+    const int xa = static_cast<int>(static_cast<long long>(bw) * t / n), xb = static_cast<int>(static_cast<long long>(bw) * (t + 1) / n);
+    std::vector<int> last(static_cast<std::size_t>(std::max(0, xb - xa)));
+    std::fill(last.begin(), last.end(), far);
     for (int y = 0; y < bh; ++y) {
-      const std::size_t i = static_cast<std::size_t>(y) * bw + x;
-      last = row_distance[i] <= reach ? 0 : std::min(far, last + 1);
-      within[i] = last <= reach ? 1 : 0;  // the first write of this column
+      const int* d = row_distance.data() + static_cast<std::size_t>(y) * bw;
+      std::uint8_t* in = within.data() + static_cast<std::size_t>(y) * bw;
+      for (int x = xa; x < xb; ++x) {
+        int& l = last[static_cast<std::size_t>(x - xa)];
+        l = d[x] <= reach ? 0 : std::min(far, l + 1);
+        in[x] = l <= reach ? 1 : 0;  // the first write of this entry
+      }
     }
-    last = far;
+    std::fill(last.begin(), last.end(), far);
     for (int y = bh - 1; y >= 0; --y) {
-      const std::size_t i = static_cast<std::size_t>(y) * bw + x;
-      last = row_distance[i] <= reach ? 0 : std::min(far, last + 1);
-      within[i] = (within[i] || last <= reach) ? 1 : 0;
+      const int* d = row_distance.data() + static_cast<std::size_t>(y) * bw;
+      std::uint8_t* in = within.data() + static_cast<std::size_t>(y) * bw;
+      for (int x = xa; x < xb; ++x) {
+        int& l = last[static_cast<std::size_t>(x - xa)];
+        l = d[x] <= reach ? 0 : std::min(far, l + 1);
+        in[x] = (in[x] || l <= reach) ? 1 : 0;
+      }
     }
   }
   std::vector<std::size_t>& targets = scratch.targets;
