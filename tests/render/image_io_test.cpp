@@ -689,7 +689,7 @@ TEST_CASE("within an ImageReadCache a file read for picture, alpha, passes and d
   CHECK(read_other_channels(exr).samples == other.samples);
 }
 
-TEST_CASE("an ImageReadCache decodes a file anew once it has changed, and reads nothing stale after its scope",
+TEST_CASE("an ImageReadCache decodes a file and reads its header anew once it has changed, and reads nothing stale after its scope",
           "[render][image_io]") {
   TempDir dir;
   const fs::path exr = dir / "changing.exr";
@@ -705,6 +705,13 @@ TEST_CASE("an ImageReadCache decodes a file anew once it has changed, and reads 
     write_float_exr(exr, second, {"R", "G", "B"});
     fs::last_write_time(exr, fs::last_write_time(exr) + std::chrono::seconds(2));
     CHECK(read_radiance_image(exr).at(1, 1, 0) == 2.0f);
+    // Its header too: the cache serves read_raster_info, which the readers above ask first.
+    write_float_exr(exr, Image(6, 2, 4, 3.0f), {"R", "G", "B", "A"});
+    fs::last_write_time(exr, fs::last_write_time(exr) + std::chrono::seconds(4));
+    const RasterInfo info = read_raster_info(exr);
+    CHECK(info.width == 6);
+    CHECK(info.channels.size() == 4);
+    CHECK(read_radiance_image(exr).at(5, 1, 0) == 3.0f);
   }
   write_float_exr(exr, first, {"R", "G", "B"});
   CHECK(read_radiance_image(exr).at(1, 1, 0) == 1.0f);
