@@ -18,3 +18,30 @@ file(READ ${WORK}/out.ppm head LIMIT 15)
 if(NOT head STREQUAL "P6\n240 160\n255\n" OR NOT bytes EQUAL 115215)
   message(FATAL_ERROR "${WORK}/out.ppm: ${bytes} bytes, header '${head}': expected a 240 x 160 binary PPM")
 endif()
+
+# Every library the package exports, linked by one more consumer: a static library carries its
+# private dependencies (OpenEXR, libjpeg, Ceres, ...), so each must be found by lensmithConfig.cmake
+# or configuring fails ("target JPEG::JPEG not found" once imageio took libjpeg and the config did not
+# look for it; lens_camera links lensmith::camera only and did not see it).
+file(MAKE_DIRECTORY ${WORK}/all)
+file(WRITE ${WORK}/all/CMakeLists.txt [=[
+cmake_minimum_required(VERSION 3.22)
+project(every_lensmith_library LANGUAGES CXX)
+find_package(lensmith REQUIRED)
+get_property(imported DIRECTORY PROPERTY IMPORTED_TARGETS)
+list(FILTER imported INCLUDE REGEX "^lensmith::")
+if(NOT imported MATCHES "lensmith::render")
+  message(FATAL_ERROR "the package exports no lensmith::render (it has: ${imported})")
+endif()
+add_executable(every_library main.cpp)
+target_link_libraries(every_library PRIVATE ${imported})
+]=])
+file(WRITE ${WORK}/all/main.cpp "int main() { return 0; }\n")
+foreach(step
+    "${CMAKE_COMMAND};-S;${WORK}/all;-B;${WORK}/all/build;-G;${GENERATOR};-DCMAKE_BUILD_TYPE=Release;-DCMAKE_CXX_COMPILER=${CXX};-DCMAKE_PREFIX_PATH=${WORK}/prefix"
+    "${CMAKE_COMMAND};--build;${WORK}/all/build")
+  execute_process(COMMAND ${step} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "${step} failed (${rc}):\n${out}\n${err}")
+  endif()
+endforeach()
