@@ -1,16 +1,23 @@
 # Installs the build into a fresh prefix and builds examples/lens_camera against it with
 # find_package(lensmith), as a user of the installed package would, then runs it. Fails when any
 # step fails or the picture it writes is not a 240 x 160 binary PPM.
+
+# Runs one command (a list), failing with its output when it fails; its output in `out`.
+function(run_step)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "${ARGN} failed (${rc}):\n${out}\n${err}")
+  endif()
+  set(out "${out}" PARENT_SCOPE)
+endfunction()
+
 file(REMOVE_RECURSE ${WORK})
 foreach(step
     "${CMAKE_COMMAND};--install;${BUILD_DIR};--prefix;${WORK}/prefix"
     "${CMAKE_COMMAND};-S;${SOURCE};-B;${WORK}/build;-G;${GENERATOR};-DCMAKE_BUILD_TYPE=Release;-DCMAKE_CXX_COMPILER=${CXX};-DCMAKE_PREFIX_PATH=${WORK}/prefix"
     "${CMAKE_COMMAND};--build;${WORK}/build"
     "${WORK}/build/lens_camera_example;${WORK}/out.ppm")
-  execute_process(COMMAND ${step} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "${step} failed (${rc}):\n${out}\n${err}")
-  endif()
+  run_step(${step})
 endforeach()
 message(STATUS "${out}")
 file(SIZE ${WORK}/out.ppm bytes)
@@ -40,8 +47,5 @@ file(WRITE ${WORK}/all/main.cpp "int main() { return 0; }\n")
 foreach(step
     "${CMAKE_COMMAND};-S;${WORK}/all;-B;${WORK}/all/build;-G;${GENERATOR};-DCMAKE_BUILD_TYPE=Release;-DCMAKE_CXX_COMPILER=${CXX};-DCMAKE_PREFIX_PATH=${WORK}/prefix"
     "${CMAKE_COMMAND};--build;${WORK}/all/build")
-  execute_process(COMMAND ${step} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "${step} failed (${rc}):\n${out}\n${err}")
-  endif()
+  run_step(${step})
 endforeach()

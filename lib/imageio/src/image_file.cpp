@@ -2,6 +2,7 @@
 // the codec that reads or writes it, and the temporary-file-and-rename of core for every writer.
 #include "lensmith/imageio/image_file.h"
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <charconv>
@@ -207,27 +208,26 @@ ImageReadCache::~ImageReadCache() { current_read_cache = previous_; }
 
 namespace {
 
-// The cache's header entry for `path` on this thread, made if new; null without a cache or where
-// the file cannot be stamped (then it is read each time, and reports its own error).
-ImageReadCache::Header* cached_header(ImageReadCache* cache, std::vector<ImageReadCache::Header>& headers, const fs::path& path) {
-  if (cache == nullptr) return nullptr;
-  const std::optional<FileStamp> stamp = stamp_of(path);
-  if (!stamp) return nullptr;
-  for (ImageReadCache::Header& header : headers) {
-    if (header.stamp == *stamp) return &header;
-  }
-  headers.push_back({*stamp, std::nullopt, std::nullopt});
-  return &headers.back();
+// `field` of path's header entry in `headers` (the current cache's; null without one), read by
+// `read` the first time. Without a cache, or where the file cannot be stamped, read each time (and
+// `read` reports the error).
+template <typename T, typename Read>
+T cached_header_field(std::vector<ImageReadCache::Header>* headers, const fs::path& path, std::optional<T> ImageReadCache::Header::*field,
+                      Read&& read) {
+  const std::optional<FileStamp> stamp = headers ? stamp_of(path) : std::nullopt;
+  if (!stamp) return read(path);
+  auto header = std::find_if(headers->begin(), headers->end(), [&](const ImageReadCache::Header& h) { return h.stamp == *stamp; });
+  if (header == headers->end()) header = headers->insert(headers->end(), {*stamp, std::nullopt, std::nullopt});
+  std::optional<T>& value = (*header).*field;
+  if (!value) value = read(path);
+  return *value;
 }
 
 }  // namespace
 
 RasterInfo read_raster_info(const fs::path& path) {
   ImageReadCache* cache = current_read_cache;
-  ImageReadCache::Header* header = cache ? cached_header(cache, cache->headers_, path) : nullptr;
-  if (header == nullptr) return read_raster_info_uncached(path);
-  if (!header->info) header->info = read_raster_info_uncached(path);
-  return *header->info;
+  return cached_header_field(cache ? &cache->headers_ : nullptr, path, &ImageReadCache::Header::info, read_raster_info_uncached);
 }
 
 Raster read_raster(const fs::path& path, const RasterInfo& info, std::span<const int> channels) {
@@ -275,10 +275,7 @@ std::vector<std::pair<std::string, std::string>> read_metadata_pairs_uncached(co
 
 std::vector<std::pair<std::string, std::string>> read_image_metadata_pairs(const fs::path& path) {
   ImageReadCache* cache = current_read_cache;
-  ImageReadCache::Header* header = cache ? cached_header(cache, cache->headers_, path) : nullptr;
-  if (header == nullptr) return read_metadata_pairs_uncached(path);
-  if (!header->metadata) header->metadata = read_metadata_pairs_uncached(path);
-  return *header->metadata;
+  return cached_header_field(cache ? &cache->headers_ : nullptr, path, &ImageReadCache::Header::metadata, read_metadata_pairs_uncached);
 }
 
 void write_exr(const fs::path& path, const PixelsView<float>& pixels, const std::vector<std::string>& channel_names,

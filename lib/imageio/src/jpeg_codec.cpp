@@ -59,7 +59,7 @@ void limit_scans(j_common_ptr jpeg) {
   }
 }
 
-// One decompression: libjpeg's state and the bytes of the file it reads from.
+// One decompression: libjpeg's state, its error manager and its scan limit.
 struct JpegReader {
   jpeg_decompress_struct jpeg{};
   JpegErrors errors;
@@ -67,9 +67,11 @@ struct JpegReader {
   bool created = false;
 };
 
-// Reads the header and starts decompression: after it, jpeg.output_width/height/components say
-// what read_jpeg_rows fills. False, with errors.message set, when libjpeg failed.
-bool start_jpeg(JpegReader* reader, const unsigned char* bytes, std::size_t size) {
+// Reads the header and chooses the output colour space: after it, jpeg.output_width/height/components
+// say what read_jpeg_rows fills. Only the header: a progressive file's scans are all decoded by
+// jpeg_start_decompress, which read_jpeg_rows calls, so asking for the size costs no decoding.
+// False, with errors.message set, when libjpeg failed.
+bool read_jpeg_header(JpegReader* reader, const unsigned char* bytes, std::size_t size) {
   j_decompress_ptr jpeg = &reader->jpeg;
   jpeg->err = jpeg_std_error(&reader->errors.manager);
   reader->errors.manager.error_exit = keep_error_and_jump;
@@ -88,7 +90,7 @@ bool start_jpeg(JpegReader* reader, const unsigned char* bytes, std::size_t size
     case JCS_YCCK: jpeg->out_color_space = JCS_CMYK; break;
     default: jpeg->out_color_space = JCS_RGB; break;
   }
-  jpeg_start_decompress(jpeg);
+  jpeg_calc_output_dimensions(jpeg);
   return true;
 }
 
@@ -96,6 +98,7 @@ bool start_jpeg(JpegReader* reader, const unsigned char* bytes, std::size_t size
 bool read_jpeg_rows(JpegReader* reader, unsigned char* pixels) {
   j_decompress_ptr jpeg = &reader->jpeg;
   if (setjmp(reader->errors.jump) != 0) return false;
+  jpeg_start_decompress(jpeg);
   const std::size_t row_bytes = static_cast<std::size_t>(jpeg->output_width) * static_cast<std::size_t>(jpeg->output_components);
   while (jpeg->output_scanline < jpeg->output_height) {
     JSAMPROW row = pixels + static_cast<std::size_t>(jpeg->output_scanline) * row_bytes;
@@ -105,13 +108,13 @@ bool read_jpeg_rows(JpegReader* reader, unsigned char* pixels) {
   return true;
 }
 
-// The header of `bytes`, started for decoding; throws IoError naming the file when libjpeg refuses it.
-std::unique_ptr<JpegReader, void (*)(JpegReader*)> started_reader(const fs::path& path, const std::string& bytes) {
+// A reader of `bytes` past their header; throws IoError naming the file when libjpeg refuses it.
+std::unique_ptr<JpegReader, void (*)(JpegReader*)> reader_past_header(const fs::path& path, const std::string& bytes) {
   std::unique_ptr<JpegReader, void (*)(JpegReader*)> reader(new JpegReader, [](JpegReader* r) {
     if (r->created) jpeg_destroy_decompress(&r->jpeg);
     delete r;
   });
-  if (!start_jpeg(reader.get(), reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size())) {
+  if (!read_jpeg_header(reader.get(), reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size())) {
     throw IoError(path.string() + ": cannot read the JPEG image: " + reader->errors.message);
   }
   const int components = reader->jpeg.output_components;
@@ -138,12 +141,12 @@ RasterInfo info_of(const JpegReader& reader) {
 
 RasterInfo read_jpeg_info(const fs::path& path) {
   const std::string bytes = read_file_bytes(path.string());
-  return info_of(*started_reader(path, bytes));
+  return info_of(*reader_past_header(path, bytes));
 }
 
 Decoded read_jpeg(const fs::path& path) {
   const std::string bytes = read_file_bytes(path.string());
-  const auto reader = started_reader(path, bytes);
+  const auto reader = reader_past_header(path, bytes);
   Decoded decoded{info_of(*reader), {}};
   const std::size_t pixels = static_cast<std::size_t>(decoded.info.width) * static_cast<std::size_t>(decoded.info.height);
   const auto components = static_cast<std::size_t>(reader->jpeg.output_components);

@@ -65,27 +65,22 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
   {
     const int t = omp_get_thread_num(), n = omp_get_num_threads();
     const int xa = static_cast<int>(static_cast<long long>(bw) * t / n), xb = static_cast<int>(static_cast<long long>(bw) * (t + 1) / n);
-    std::vector<int> last(static_cast<std::size_t>(std::max(0, xb - xa)));
-    std::fill(last.begin(), last.end(), far);
-    for (int y = 0; y < bh; ++y) {
-      const int* d = row_distance.data() + static_cast<std::size_t>(y) * bw;
-      std::uint8_t* in = within.data() + static_cast<std::size_t>(y) * bw;
-      for (int x = xa; x < xb; ++x) {
-        int& l = last[static_cast<std::size_t>(x - xa)];
-        l = d[x] <= reach ? 0 : std::min(far, l + 1);
-        in[x] = l <= reach ? 1 : 0;  // the first write of this entry
+    std::vector<int> last;
+    // Rows from y_first by `step` (+1 down, -1 up); the first pass writes `within`, the second adds to it.
+    auto pass = [&](int y_first, int step, bool first) {
+      last.assign(static_cast<std::size_t>(std::max(0, xb - xa)), far);
+      for (int y = y_first; y >= 0 && y < bh; y += step) {
+        const int* d = row_distance.data() + static_cast<std::size_t>(y) * bw;
+        std::uint8_t* in = within.data() + static_cast<std::size_t>(y) * bw;
+        for (int x = xa; x < xb; ++x) {
+          int& l = last[static_cast<std::size_t>(x - xa)];
+          l = d[x] <= reach ? 0 : std::min(far, l + 1);
+          in[x] = ((!first && in[x]) || l <= reach) ? 1 : 0;
+        }
       }
-    }
-    std::fill(last.begin(), last.end(), far);
-    for (int y = bh - 1; y >= 0; --y) {
-      const int* d = row_distance.data() + static_cast<std::size_t>(y) * bw;
-      std::uint8_t* in = within.data() + static_cast<std::size_t>(y) * bw;
-      for (int x = xa; x < xb; ++x) {
-        int& l = last[static_cast<std::size_t>(x - xa)];
-        l = d[x] <= reach ? 0 : std::min(far, l + 1);
-        in[x] = (in[x] || l <= reach) ? 1 : 0;
-      }
-    }
+    };
+    pass(0, 1, true);
+    pass(bh - 1, -1, false);
   }
   std::vector<std::size_t>& targets = scratch.targets;
   targets.clear();
