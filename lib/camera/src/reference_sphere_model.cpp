@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "lensmith/core/units.h"
@@ -11,6 +12,23 @@ namespace {
 // Field angle of the chief ray traced to learn the apertures' chief-ray heights per unit slope
 // (paraxial optics is linear: any small angle gives the same ratio).
 constexpr double kChiefProbeAngleDeg = 1.0;
+
+// Pupil points mapped per call of seidel_sensor_points: the renderer maps 9 to about 100 at a time.
+constexpr std::size_t kRayChunk = 16;
+
+// The Seidel rays' sensor points (mm) of `count` <= kRayChunk pupil points, into arrays: a loop
+// the compiler vectorises across rays (the SensorHit records, with their flags, it cannot), built
+// for AVX2+FMA too and chosen at load time, like SplatBuffer::add_polygon. The per-ray arithmetic
+// was 3/4 of the Seidel model's time and 13 % of a 1080p Seidel render's.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+__attribute__((target_clones("arch=x86-64-v3", "default")))
+#endif
+void seidel_sensor_points(const SeidelRayGeometry& geometry, const FieldTerms& terms, const PupilPoint* __restrict pupil,
+                          std::size_t count, double* __restrict x_mm, double* __restrict y_mm) {
+  const SeidelRayGeometry g = geometry;  // copies: the loop reads them as registers, not through aliases
+  const FieldTerms t = terms;
+  for (std::size_t i = 0; i < count; ++i) g.sensor_point(pupil[i], t, x_mm[i], y_mm[i]);
+}
 }  // namespace
 
 ReferenceSphereModel::ReferenceSphereModel(RayModelKind kind, const Camera& camera, const RayModelOptions& options)
@@ -185,11 +203,15 @@ void ReferenceSphereModel::map_with(const ScenePoint& point, double wavelength_n
   FieldTerms terms = FieldTerms::at(c, geometry.y0);
   // Fitted: the real lens's terms, and its light relative to the first-order weights and clipping.
   const double light = fitted_ ? fitted_->fitted_terms(wavelength_nm, std::max(object_distance_mm, 1.0), geometry.y0, terms) : 1.0;
-  for (std::size_t i = 0; i < pupil.size(); ++i) {
-    double x_mm, y_mm;
-    geometry.sensor_point(pupil[i], terms, x_mm, y_mm);
-    hits[i] = hit(x_mm, y_mm, pupil[i]);
-    hits[i].weight *= light;
+  std::array<double, kRayChunk> x_mm, y_mm;
+  for (std::size_t start = 0; start < pupil.size(); start += kRayChunk) {
+    const std::size_t count = std::min(kRayChunk, pupil.size() - start);
+    seidel_sensor_points(geometry, terms, pupil.data() + start, count, x_mm.data(), y_mm.data());
+    for (std::size_t k = 0; k < count; ++k) {
+      SensorHit& h = hits[start + k];
+      h = hit(x_mm[k], y_mm[k], pupil[start + k]);
+      h.weight *= light;
+    }
   }
 }
 
