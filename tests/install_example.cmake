@@ -1,6 +1,7 @@
 # Installs the build into a fresh prefix and builds examples/lens_camera against it with
-# find_package(lensmith), as a user of the installed package would, then runs it. Fails when any
-# step fails or the picture it writes is not a 240 x 160 binary PPM.
+# find_package(lensmith), as a user of the installed package would, then runs it, and runs the installed
+# command line's optimiser (its Ceres module). Fails when any step fails or the picture it writes is not
+# a 240 x 160 binary PPM.
 
 # Runs one command (a list), failing with its output when it fails; its output in `out`.
 function(run_step)
@@ -20,6 +21,13 @@ foreach(step
   run_step(${step})
 endforeach()
 message(STATUS "${out}")
+# The installed command line finds its Ceres module (lib/solve/src/ceres_module.h) in <libdir>/lensmith
+# relative to itself: one optimiser iteration needs it.
+run_step(${WORK}/prefix/bin/lensmith optimize ${SOURCE}/../optimize/rough-triplet.json --merit ${SOURCE}/../optimize/triplet-merit.json
+         --iterations 1 --threads 2 -o ${WORK}/optimised.json)
+if(NOT EXISTS ${WORK}/optimised.json)
+  message(FATAL_ERROR "the installed lensmith optimize wrote no ${WORK}/optimised.json")
+endif()
 file(SIZE ${WORK}/out.ppm bytes)
 file(READ ${WORK}/out.ppm head LIMIT 15)
 if(NOT head STREQUAL "P6\n240 160\n255\n" OR NOT bytes EQUAL 115215)

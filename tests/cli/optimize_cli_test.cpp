@@ -1,6 +1,7 @@
 // `lensmith optimize` as a user runs it: the shipped example from a rough start, the optimised lens read back
 // and measured independently by `lensmith spot`, the JSON report, the picture, and refused inputs.
 #include <catch2/catch.hpp>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -74,4 +75,23 @@ TEST_CASE("lensmith optimize refuses a bad merit file with its line, and never w
   r = run_lensmith("optimize " + kExamples + "rough-triplet.json --merit " + kExamples + "triplet-merit.json -o " + kExamples + "triplet-merit.json");
   CHECK(r.exit_code == 2);
   CHECK(std::filesystem::file_size(kExamples + "triplet-merit.json") == size);
+}
+
+TEST_CASE("lensmith optimize without its Ceres module says where it looked and how to point to it, and writes nothing", "[cli][optimize]") {
+  // The command line loads Ceres from liblensmith_ceres.so when a command first solves something
+  // (lib/solve/src/ceres_module.h); LENSMITH_MODULE_DIR, where set, is the only place it looks.
+  const ScratchFolder folder("lensmith_optimize_module_");
+  const std::string modules = (folder.dir / "modules").string();
+  std::filesystem::create_directories(modules);
+  struct ModuleDir {
+    explicit ModuleDir(const std::string& dir) { ::setenv("LENSMITH_MODULE_DIR", dir.c_str(), 1); }
+    ~ModuleDir() { ::unsetenv("LENSMITH_MODULE_DIR"); }
+  } module_dir(modules);
+  const std::string out = folder.file("out.json");
+  const auto r = run_lensmith("optimize " + kExamples + "rough-triplet.json --merit " + kExamples + "triplet-merit.json -o " + out);
+  CHECK(r.exit_code == 5);
+  CHECK_THAT(r.err, Catch::Contains(modules + "/liblensmith_ceres.so") && Catch::Contains("LENSMITH_MODULE_DIR"));
+  CHECK_FALSE(std::filesystem::exists(out));
+  // Commands that solve nothing do not need it.
+  CHECK(run_lensmith("info sasian-triplet").exit_code == 0);
 }

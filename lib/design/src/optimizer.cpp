@@ -8,7 +8,7 @@
 #include <limits>
 #include <sstream>
 
-#include <ceres/ceres.h>
+#include "lensmith/solve/ceres_solvers.h"
 #include <omp.h>
 
 #include "lensmith/core/errors.h"
@@ -63,16 +63,15 @@ bool is_glass(const DesignVariable& v) {
   return v.kind == DesignVariable::Kind::GlassIndex || v.kind == DesignVariable::Kind::GlassAbbe;
 }
 
-// The merit function as Ceres sees it: one parameter block (the scaled variables), the residuals of
+// The merit function as the least-squares solver sees it: the scaled variables, the residuals of
 // evaluate_merit, and a Jacobian by central differences computed in parallel.
-class MeritCost final : public ceres::CostFunction {
+class MeritCost final {
  public:
   MeritCost(const Prescription& lens, const MeritFunction& merit, std::vector<double> scales, int residuals, int threads,
             std::atomic<std::size_t>& evaluations)
-      : lens_(lens), merit_(merit), scales_(std::move(scales)), threads_(threads), evaluations_(evaluations) {
-    set_num_residuals(residuals);
-    mutable_parameter_block_sizes()->push_back(static_cast<int>(scales_.size()));
-  }
+      : lens_(lens), merit_(merit), scales_(std::move(scales)), residuals_(residuals), threads_(threads), evaluations_(evaluations) {}
+
+  int num_residuals() const { return residuals_; }
 
   Prescription lens_at(const double* x) const {
     Prescription lens = lens_;
@@ -98,14 +97,14 @@ class MeritCost final : public ceres::CostFunction {
     return true;
   }
 
-  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    const double* x = parameters[0];
+  // BoundedLeastSquares::evaluate: the residuals at x and, where `jacobian` is not null, their Jacobian.
+  bool evaluate(const double* x, double* residuals, double* jacobian) const {
     const int n = static_cast<int>(scales_.size());
     const int m = num_residuals();
     std::vector<double> centre;
     if (!evaluate_at(x, centre)) return false;
     std::copy(centre.begin(), centre.end(), residuals);
-    if (jacobians == nullptr || jacobians[0] == nullptr) return true;
+    if (jacobian == nullptr) return true;
     // Columns j: residuals at x +- h e_j (h in scaled units: the variable's step). Where one side leaves the
     // region where the merit can be computed, the other side and the centre make a one-sided difference.
     const double h = 1.0 / kScalePerStep;
@@ -120,7 +119,7 @@ class MeritCost final : public ceres::CostFunction {
       auto& ok = k % 2 == 0 ? plus_ok[static_cast<std::size_t>(j)] : minus_ok[static_cast<std::size_t>(j)];
       ok = evaluate_at(shifted.data(), out) ? 1 : 0;
     }
-    double* J = jacobians[0];
+    double* J = jacobian;
     for (int j = 0; j < n; ++j) {
       const auto u = static_cast<std::size_t>(j);
       for (int i = 0; i < m; ++i) {
@@ -145,45 +144,35 @@ class MeritCost final : public ceres::CostFunction {
   const Prescription& lens_;
   const MeritFunction& merit_;
   std::vector<double> scales_;
+  int residuals_;
   int threads_;
   std::atomic<std::size_t>& evaluations_;
 };
 
-class ProgressCallback final : public ceres::IterationCallback {
- public:
-  // `merit_per_cost`: 2 for the least-squares solver (its cost is half the sum of squares), 1 for the line search.
-  ProgressCallback(const OptimizeOptions& options, std::string stage, double merit_per_cost)
-      : options_(options), stage_(std::move(stage)), merit_per_cost_(merit_per_cost) {}
-  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
-    if (options_.progress) {
-      OptimizeProgress p;
-      p.iteration = summary.iteration;
-      p.merit = merit_per_cost_ * summary.cost;
-      p.step_norm = summary.step_norm;
-      p.step_accepted = summary.step_is_successful;
-      p.stage = stage_;
-      options_.progress(p);
-    }
-    return ceres::SOLVER_CONTINUE;
-  }
-
- private:
-  const OptimizeOptions& options_;
-  std::string stage_;
-  double merit_per_cost_;
-};
+// The solvers' iterations as OptimizeProgress; `merit_per_cost`: 2 for the least-squares solver (its
+// cost is half the sum of squares), 1 for the line search.
+SolverProgress progress_of(const OptimizeOptions& options, const std::string& stage, double merit_per_cost) {
+  if (!options.progress) return {};
+  return [&options, stage, merit_per_cost](const SolverIteration& i) {
+    OptimizeProgress p;
+    p.iteration = i.iteration;
+    p.merit = merit_per_cost * i.cost;
+    p.step_norm = i.step_norm;
+    p.step_accepted = i.step_accepted;
+    p.stage = stage;
+    options.progress(p);
+  };
+}
 
 // The merit itself (the sum of squares) and its gradient 2 J^T r over the variables not held at a bound, for
-// Ceres' line-search minimiser. Damped least squares (Gauss-Newton's J^T J) knows nothing of the residuals'
+// the line-search minimiser. Damped least squares (Gauss-Newton's J^T J) knows nothing of the residuals'
 // own curvature, which is all there is where the optimum leaves residuals that cannot vanish: a singlet's
 // spherical aberration is smallest at the best form, where dS_I/dX = 0 and J^T J is singular along the
 // bending, so Levenberg-Marquardt crawls there. BFGS builds that curvature from successive gradients.
-class MeritGradient final : public ceres::FirstOrderFunction {
+class MeritGradient final {
  public:
   MeritGradient(const MeritCost& cost, std::vector<double> x, std::vector<int> free, std::vector<double> lower, std::vector<double> upper)
       : cost_(cost), x_(std::move(x)), free_(std::move(free)), lower_(std::move(lower)), upper_(std::move(upper)) {}
-
-  int NumParameters() const override { return static_cast<int>(free_.size()); }
 
   // The full scaled vector with the free variables from `parameters`.
   std::vector<double> full(const double* parameters) const {
@@ -192,7 +181,8 @@ class MeritGradient final : public ceres::FirstOrderFunction {
     return x;
   }
 
-  bool Evaluate(const double* parameters, double* merit, double* gradient) const override {
+  // LineSearchMinimisation::evaluate over the free variables.
+  bool evaluate(const double* parameters, double* merit, double* gradient) const {
     const std::vector<double> x = full(parameters);
     // Outside a bound the evaluation fails: the line search then shortens its step.
     for (std::size_t j = 0; j < x.size(); ++j) {
@@ -201,9 +191,7 @@ class MeritGradient final : public ceres::FirstOrderFunction {
     const auto m = static_cast<std::size_t>(cost_.num_residuals());
     const std::size_t n = x.size();
     std::vector<double> r(m), J(gradient != nullptr ? m * n : 0);
-    const double* blocks[] = {x.data()};
-    double* jacobians[] = {J.data()};
-    if (!cost_.Evaluate(blocks, r.data(), gradient != nullptr ? jacobians : nullptr)) return false;
+    if (!cost_.evaluate(x.data(), r.data(), gradient != nullptr ? J.data() : nullptr)) return false;
     double sum = 0.0;
     for (double v : r) sum += v * v;
     *merit = sum;
@@ -251,58 +239,46 @@ StageResult run_stage(const Prescription& lens, const MeritFunction& merit, cons
     }
   }
   const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
-  auto* cost = new MeritCost(lens, merit, scales, static_cast<int>(start.residuals.size()), threads, evaluations);
-  ceres::Problem problem;
-  problem.AddResidualBlock(cost, nullptr, x.data());
-  for (std::size_t j = 0; j < n; ++j) {
-    const DesignVariable& v = merit.variables[j];
-    if (v.min) problem.SetParameterLowerBound(x.data(), static_cast<int>(j), *v.min / scales[j]);
-    if (v.max) problem.SetParameterUpperBound(x.data(), static_cast<int>(j), *v.max / scales[j]);
-  }
-  ceres::Solver::Options so;
-  so.minimizer_type = ceres::TRUST_REGION;
-  so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  so.linear_solver_type = ceres::DENSE_QR;
-  so.max_num_iterations = options.max_iterations;
-  so.function_tolerance = options.merit_tolerance;
-  so.gradient_tolerance = 1e-14;
-  so.parameter_tolerance = 1e-12;
-  so.num_threads = 1;
-  so.logging_type = ceres::SILENT;
-  ProgressCallback callback(options, stage, 2.0);
-  so.callbacks.push_back(&callback);
-  ceres::Solver::Summary summary;
-  ceres::Solve(so, &problem, &summary);
-  StageResult out{cost->lens_at(x.data()), static_cast<int>(summary.iterations.size()) - 1, summary.message};
-
-  // Then BFGS on the merit over the variables Levenberg-Marquardt left off their bounds (MeritGradient says why).
+  const MeritCost cost(lens, merit, scales, static_cast<int>(start.residuals.size()), threads, evaluations);
+  // Levenberg-Marquardt within the variables' bounds, then BFGS on the merit over the variables it left
+  // off their bounds (MeritGradient says why).
   std::vector<double> lower(n, -std::numeric_limits<double>::infinity()), upper(n, std::numeric_limits<double>::infinity());
-  std::vector<int> free;
   for (std::size_t j = 0; j < n; ++j) {
     const DesignVariable& v = merit.variables[j];
     if (v.min) lower[j] = *v.min / scales[j];
     if (v.max) upper[j] = *v.max / scales[j];
-    if (!on_bound(v, x[j] * scales[j])) free.push_back(static_cast<int>(j));
+  }
+  SolverLimits limits;
+  limits.max_iterations = options.max_iterations;
+  limits.function_tolerance = options.merit_tolerance;
+  limits.gradient_tolerance = 1e-14;
+  limits.parameter_tolerance = 1e-12;
+  BoundedLeastSquares problem;
+  problem.residuals = cost.num_residuals();
+  problem.evaluate = [&cost](const double* at, double* residuals, double* jacobian) { return cost.evaluate(at, residuals, jacobian); };
+  problem.lower = lower;
+  problem.upper = upper;
+  problem.limits = limits;
+  problem.progress = progress_of(options, stage, 2.0);
+  const SolverReport summary = solve_bounded_least_squares(problem, x);
+  StageResult out{cost.lens_at(x.data()), summary.iterations - 1, summary.message};
+
+  std::vector<int> free;
+  for (std::size_t j = 0; j < n; ++j) {
+    if (!on_bound(merit.variables[j], x[j] * scales[j])) free.push_back(static_cast<int>(j));
   }
   if (!free.empty()) {
-    auto* gradient = new MeritGradient(*cost, x, free, lower, upper);
+    const MeritGradient gradient(cost, x, free, lower, upper);
     std::vector<double> p;
     for (int j : free) p.push_back(x[static_cast<std::size_t>(j)]);
-    ceres::GradientProblem polish_problem(gradient);
-    ceres::GradientProblemSolver::Options go;
-    go.line_search_direction_type = ceres::BFGS;
-    go.max_num_iterations = options.max_iterations;
-    go.function_tolerance = options.merit_tolerance;
-    go.gradient_tolerance = 1e-14;
-    go.parameter_tolerance = 1e-12;
-    go.logging_type = ceres::SILENT;
-    ProgressCallback polish_callback(options, stage + ", BFGS", 1.0);
-    go.callbacks.push_back(&polish_callback);
-    ceres::GradientProblemSolver::Summary polish;
-    ceres::Solve(go, polish_problem, p.data(), &polish);
-    const std::vector<double> polished = gradient->full(p.data());
-    out.lens = cost->lens_at(polished.data());
-    out.iterations += static_cast<int>(polish.iterations.size()) - 1;
+    LineSearchMinimisation polish_problem;
+    polish_problem.evaluate = [&gradient](const double* at, double* value, double* g) { return gradient.evaluate(at, value, g); };
+    polish_problem.limits = limits;
+    polish_problem.progress = progress_of(options, stage + ", BFGS", 1.0);
+    const SolverReport polish = minimise_bfgs(polish_problem, p);
+    const std::vector<double> polished = gradient.full(p.data());
+    out.lens = cost.lens_at(polished.data());
+    out.iterations += polish.iterations - 1;
     out.termination += " Then BFGS: " + polish.message;
   }
   return out;

@@ -5,13 +5,10 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "lensmith/polyfit/polynomial_fit.h"
-
-namespace ceres {
-class LossFunction;
-}
 
 namespace lensmith {
 
@@ -33,10 +30,10 @@ std::vector<std::size_t> select_columns(std::size_t pool_size, const ColumnFunct
 std::vector<std::vector<double>> solve_least_squares(const std::vector<double>& design, int num_terms,
                                                      const std::vector<std::vector<double>>& targets);
 
-// Least squares design * c ~ targets: without `loss`, solve_least_squares (returns 1); with `loss` (e.g.
-// Huber) by Ceres (dense QR, one residual block per row), in place from the current coefficients,
-// returning its iterations. Throws FitError when Ceres fails.
+// Least squares design * c ~ targets: without `huber_scale`, solve_least_squares (returns 1); with it,
+// under Huber's loss of that scale by Ceres (solve_huber_linear: dense QR, one residual per row), in
+// place from the current coefficients, returning its iterations. Throws FitError when Ceres fails.
 int solve_coefficients(const std::vector<double>& design, const std::vector<double>& targets, int num_terms,
-                       ceres::LossFunction* loss, std::vector<double>& coefficients);
+                       std::optional<double> huber_scale, std::vector<double>& coefficients);
 
 }  // namespace lensmith

@@ -5,9 +5,8 @@
 #include "lensmith/polyfit/polynomial_fit.h"
 
 #include "least_squares.h"
+#include "lensmith/solve/ceres_solvers.h"
 #include "power_table.h"
-
-#include <ceres/ceres.h>
 
 #include <Eigen/QR>
 
@@ -150,32 +149,6 @@ std::vector<std::size_t> select_columns(std::size_t p, const ColumnFunction& col
   return chosen;
 }
 
-namespace {
-
-// One residual per sample: r = sum_j row[j] c[j] - target. Linear, so the Jacobian is the row.
-class SampleResidual final : public ceres::CostFunction {
- public:
-  SampleResidual(const double* row, int num_terms, double target) : row_(row), num_terms_(num_terms), target_(target) {
-    set_num_residuals(1);
-    mutable_parameter_block_sizes()->push_back(num_terms);
-  }
-  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    const double* c = parameters[0];
-    double s = -target_;
-    for (int j = 0; j < num_terms_; ++j) s += row_[j] * c[j];
-    residuals[0] = s;
-    if (jacobians != nullptr && jacobians[0] != nullptr) std::copy(row_, row_ + num_terms_, jacobians[0]);
-    return true;
-  }
-
- private:
-  const double* row_;
-  int num_terms_;
-  double target_;
-};
-
-}  // namespace
-
 std::vector<std::vector<double>> solve_least_squares(const std::vector<double>& design, int num_terms,
                                                      const std::vector<std::vector<double>>& targets) {
   const auto n = static_cast<Eigen::Index>(num_terms);
@@ -197,43 +170,26 @@ std::vector<std::vector<double>> solve_least_squares(const std::vector<double>& 
 }
 
 int solve_coefficients(const std::vector<double>& design, const std::vector<double>& targets, int num_terms,
-                       ceres::LossFunction* loss, std::vector<double>& coefficients) {
-  if (loss == nullptr) {
+                       std::optional<double> huber_scale, std::vector<double>& coefficients) {
+  if (!huber_scale) {
     coefficients = solve_least_squares(design, num_terms, {targets}).front();
     return 1;
   }
-  ceres::Problem::Options problem_options;
-  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(problem_options);
-  // A robust loss acts on each residual block's squared norm: one block per sample.
-  for (std::size_t i = 0; i < targets.size(); ++i) {
-    problem.AddResidualBlock(new SampleResidual(&design[i * num_terms], num_terms, targets[i]), loss, coefficients.data());
-  }
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_QR;  // QR: the normal equations would square the condition number
-  solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  // The problem is linear: a vanishing LM damping makes the first step the Gauss-Newton solution.
-  solver_options.initial_trust_region_radius = 1e16;
-  solver_options.max_trust_region_radius = 1e32;
   // The first step is the exact least-squares solution; later steps only move by rounding, which these
   // tolerances recognise (tighter ones made Ceres repeat QR factorisations for nothing).
-  solver_options.function_tolerance = 1e-12;
-  solver_options.parameter_tolerance = 1e-12;
-  solver_options.gradient_tolerance = 1e-20;
-  solver_options.max_num_iterations = 100;
-  solver_options.logging_type = ceres::SILENT;
-  solver_options.max_num_consecutive_invalid_steps = 2;  // see below: rounding, not a real failure
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver_options, &problem, &summary);
+  SolverLimits limits;
+  limits.function_tolerance = 1e-12;
+  limits.parameter_tolerance = 1e-12;
+  limits.gradient_tolerance = 1e-20;
+  limits.max_iterations = 100;
+  const SolverReport report = solve_huber_linear(design, targets, *huber_scale, limits, coefficients);
   // On an ill-conditioned design (high-degree terms, nearly dependent columns) the first step already
   // holds the least-squares solution and later steps can only fail on rounding: Ceres then reports
   // FAILURE after its run of invalid steps but keeps the best parameters, which are usable when the
   // cost fell.
-  const bool fell = std::isfinite(summary.final_cost) && summary.final_cost < summary.initial_cost;
-  if (!summary.IsSolutionUsable() && !(summary.termination_type == ceres::FAILURE && fell)) {
-    throw FitError("fit_polynomial: Ceres failed: " + summary.BriefReport());
-  }
-  return static_cast<int>(summary.iterations.size());
+  const bool fell = std::isfinite(report.final_cost) && report.final_cost < report.initial_cost;
+  if (!report.usable && !(report.failed && fell)) throw FitError("fit_polynomial: Ceres failed: " + report.brief);
+  return report.iterations;
 }
 
 void FitOptions::validate() const {
@@ -318,11 +274,10 @@ FitResult fit_polynomial(const std::vector<PolyPoint>& inputs, const std::vector
     for (std::size_t i = 0; i < inputs.size(); ++i) {
       for (std::size_t j = 0; j < k; ++j) design[i * k + j] = powers.monomial(i, terms[j]);
     }
-    result.solver_iterations = solve_coefficients(design, targets, static_cast<int>(k), nullptr, coefficients);
+    result.solver_iterations = solve_coefficients(design, targets, static_cast<int>(k), std::nullopt, coefficients);
     if (options.huber_scale) {
       // Start the robust solve at the least-squares optimum, where Huber's weights are meaningful.
-      const auto huber = std::make_unique<ceres::HuberLoss>(*options.huber_scale);
-      result.solver_iterations += solve_coefficients(design, targets, static_cast<int>(k), huber.get(), coefficients);
+      result.solver_iterations += solve_coefficients(design, targets, static_cast<int>(k), options.huber_scale, coefficients);
     }
   }
   result.polynomial = SparsePolynomial(std::move(terms), std::move(coefficients));
