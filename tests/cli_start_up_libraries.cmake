@@ -1,7 +1,8 @@
-# The command line must not load Ceres and the shared libraries it brings when it starts: they are
-# loaded from lensmith's Ceres module when a command first solves something (lib/solve/src/ceres_module.h;
-# about 5 ms of every process otherwise, docs/performance.md). Reads the binary's DT_NEEDED entries
-# with readelf and fails naming any of them; also fails when the module is not beside the binary.
+# The command line must not load Ceres, OpenColorIO and the shared libraries they bring when it starts:
+# they are loaded from lensmith's modules when a command first solves something or converts colour
+# spaces (lensmith/core/module_loader.h; about 8 ms of every process otherwise, docs/performance.md).
+# Reads the binary's DT_NEEDED entries with readelf and fails naming any of them; also fails when a
+# module is not beside the binary.
 execute_process(COMMAND ${READELF} -d ${BINARY} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "${READELF} -d ${BINARY} failed (${rc}): ${err}")
@@ -10,16 +11,18 @@ string(REGEX MATCHALL "\\(NEEDED\\)[^\n]*\\[[^]\n]+\\]" needed "${out}")
 if(NOT needed)
   message(FATAL_ERROR "no NEEDED entries read from ${BINARY}:\n${out}")
 endif()
-foreach(library glog gflags cholmod spqr cxsparse lapack blas ceres)
+foreach(library glog gflags cholmod spqr cxsparse lapack blas ceres OpenColorIO yaml-cpp pystring expat)
   foreach(entry ${needed})
     if(entry MATCHES "\\[lib${library}[.-]")
-      message(FATAL_ERROR "${BINARY} loads ${entry} at start-up; Ceres' libraries belong to its module")
+      message(FATAL_ERROR "${BINARY} loads ${entry} at start-up; it belongs to a module")
     endif()
   endforeach()
 endforeach()
 get_filename_component(folder ${BINARY} DIRECTORY)
-if(NOT EXISTS ${folder}/liblensmith_ceres.so)
-  message(FATAL_ERROR "no ${folder}/liblensmith_ceres.so beside ${BINARY}")
-endif()
+foreach(module liblensmith_ceres.so liblensmith_ocio.so)
+  if(NOT EXISTS ${folder}/${module})
+    message(FATAL_ERROR "no ${folder}/${module} beside ${BINARY}")
+  endif()
+endforeach()
 list(LENGTH needed count)
-message(STATUS "${count} shared libraries at start-up, none of Ceres'")
+message(STATUS "${count} shared libraries at start-up, none of Ceres' or OpenColorIO's")

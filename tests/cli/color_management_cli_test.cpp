@@ -146,6 +146,17 @@ TEST_CASE("colour management refuses what it cannot do right, saying why", "[cli
     CHECK(r.exit_code == 2);
     CHECK(r.err.find("uint8") != std::string::npos);
   }
+  SECTION("without its OpenColorIO module (lensmith/core/module_loader.h): exit 5, saying where it looked, nothing written") {
+    const fs::path modules = scratch("no-modules");
+    fs::create_directories(modules);
+    ::setenv("LENSMITH_MODULE_DIR", modules.c_str(), 1);
+    const auto r = run_lensmith("bokeh --image " + kScene + out + " --input-colorspace ACEScg --ocio " + kConfig + kCamera);
+    ::unsetenv("LENSMITH_MODULE_DIR");
+    CHECK(r.exit_code == 5);
+    CHECK(r.err.find((modules / "liblensmith_ocio.so").string()) != std::string::npos);
+    CHECK(r.err.find("LENSMITH_MODULE_DIR") != std::string::npos);
+    CHECK_FALSE(fs::exists(scratch("bad.exr")));
+  }
   SECTION("--ocio alone converts nothing: exit 2") {
     CHECK(run_lensmith("bokeh --image " + kScene + out + " --ocio " + kConfig + kCamera).exit_code == 2);
   }

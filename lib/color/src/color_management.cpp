@@ -1,8 +1,8 @@
-// OpenColorIO 2.1 behind lensmith's working space (color_management.h).
+// Colour management (color_management.h): the config and the options checked here, the conversions
+// made and applied by OpenColorIO through ocio_backend.h.
 #include "lensmith/color/color_management.h"
 
-#include <OpenColorIO/OpenColorIO.h>
-
+#include <array>
 #include <cstdlib>
 #include <filesystem>
 #include <sstream>
@@ -10,60 +10,31 @@
 
 #include "lensmith/color/rgb_primaries.h"
 #include "lensmith/core/errors.h"
-
-namespace OCIO = OCIO_NAMESPACE;
+#include "ocio_backend.h"
 
 namespace lensmith {
 
 struct ColorManagement::Processors {
-  OCIO::ConstCPUProcessorRcPtr to_working;    // input colour space -> working (null: none asked)
-  OCIO::ConstCPUProcessorRcPtr from_working;  // working -> output colour space
+  const color_detail::OcioBackend* backend = nullptr;
+  color_detail::OcioConversions* conversions = nullptr;
+  Processors() = default;
+  Processors(const Processors&) = delete;
+  Processors& operator=(const Processors&) = delete;
+  ~Processors() {
+    if (conversions != nullptr) backend->close(conversions);
+  }
 };
 
 namespace {
 
-constexpr const char* kAcesInterchange = "aces_interchange";
-
-// A few of the config's colour space names, for an error message.
-std::string some_colorspaces(const OCIO::ConstConfigRcPtr& config) {
-  std::string names;
-  const int n = config->getNumColorSpaces();
-  for (int i = 0; i < n && i < 12; ++i) names += std::string(i ? ", " : "") + config->getColorSpaceNameByIndex(i);
-  if (n > 12) names += ", ... (" + std::to_string(n) + " in all)";
-  return names;
-}
-
-void require_colorspace(const OCIO::ConstConfigRcPtr& config, const std::string& path, const std::string& name, const std::string& flag) {
-  if (!config->getColorSpace(name.c_str())) {
-    throw OptionsError(flag + " " + name + ": no colour space or role of that name in the OCIO config " + path + " (it has " +
-                       some_colorspaces(config) + ")");
-  }
-}
-
-// OCIO's 4x4 row-major matrix of a 3x3.
-OCIO::MatrixTransformRcPtr matrix_transform(const Matrix3& m) {
-  double m44[16] = {};
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) m44[4 * i + j] = m.m[i][j];
-  m44[15] = 1.0;
-  OCIO::MatrixTransformRcPtr t = OCIO::MatrixTransform::Create();
-  t->setMatrix(m44);
-  return t;
-}
-
-void apply(const OCIO::ConstCPUProcessorRcPtr& processor, std::span<float> pixels, int channels) {
-  if (!processor || pixels.empty()) return;
+void apply(const color_detail::OcioBackend& backend, const color_detail::OcioConversions& conversions, bool to_working,
+           std::span<float> pixels, int channels) {
+  if (pixels.empty()) return;
   if (channels < 3 || pixels.size() % static_cast<std::size_t>(channels) != 0) {
     throw OptionsError("colour management: " + std::to_string(pixels.size()) + " floats are not pixels of " + std::to_string(channels) +
                        " channels (at least R, G, B)");
   }
-  // One row of all the pixels, R, G, B read at a stride of `channels` floats: the other channels
-  // (alpha, depth, passes) are left as they are.
-  const auto count = static_cast<long>(pixels.size() / static_cast<std::size_t>(channels));
-  const auto stride = static_cast<std::ptrdiff_t>(channels * sizeof(float));
-  OCIO::PackedImageDesc image(pixels.data(), count, 1, OCIO::CHANNEL_ORDERING_RGB, OCIO::BIT_DEPTH_F32, sizeof(float), stride,
-                              stride * count);
-  processor->apply(image);
+  backend.apply(conversions, to_working, pixels.data(), static_cast<long>(pixels.size() / static_cast<std::size_t>(channels)), channels);
 }
 
 }  // namespace
@@ -91,59 +62,30 @@ ColorManagement::ColorManagement(const ColorManagementOptions& options) : option
   if (!std::filesystem::is_regular_file(config_path_, ec)) {
     throw IoError(config_path_ + ": no such OpenColorIO config file" + (options.config.empty() ? " (from $OCIO)" : ""));
   }
-  OCIO::ConstConfigRcPtr config;
-  try {
-    config = OCIO::Config::CreateFromFile(config_path_.c_str());
-    config->validate();
-  } catch (const OCIO::Exception& e) {
-    throw IoError(config_path_ + ": not a valid OpenColorIO config: " + e.what());
+  // The aces_interchange role's way to the working space: ACES AP0 -> linear Rec.709, Bradford.
+  const Matrix3 m = rgb_conversion(kAcesAp0Primaries, kRec709Primaries);
+  std::array<double, 9> ap0_to_rec709{};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) ap0_to_rec709[static_cast<std::size_t>(3 * i + j)] = m.m[i][j];
+  processors_->backend = &color_detail::ocio_backend();
+  color_detail::OcioFailure failure;
+  processors_->conversions = processors_->backend->open(options, config_path_, ap0_to_rec709, working_route_, failure);
+  if (processors_->conversions == nullptr) {
+    if (failure.options_error) throw OptionsError(failure.message);
+    throw IoError(failure.message);
   }
-  if (!options.input_colorspace.empty()) require_colorspace(config, config_path_, options.input_colorspace, "--input-colorspace");
-  if (!options.output_colorspace.empty()) require_colorspace(config, config_path_, options.output_colorspace, "--output-colorspace");
-
-  // Working space = `working` colour space of the config, then `tail` (a matrix, or nothing).
-  std::string working;
-  OCIO::MatrixTransformRcPtr tail;
-  if (!options.working_colorspace.empty()) {
-    require_colorspace(config, config_path_, options.working_colorspace, "--working-colorspace");
-    working = options.working_colorspace;
-    working_route_ = "colour space " + working + " (--working-colorspace)";
-  } else if (config->getColorSpace(kAcesInterchange)) {
-    working = kAcesInterchange;
-    tail = matrix_transform(rgb_conversion(kAcesAp0Primaries, kRec709Primaries));
-    working_route_ = std::string("the config's aces_interchange role (") + config->getColorSpace(kAcesInterchange)->getName() +
-                     ") and the ACES AP0 -> linear Rec.709 Bradford matrix";
-  } else {
-    throw OptionsError(config_path_ + " has no aces_interchange role (an OCIO 1 config?): name its linear Rec.709 (sRGB primaries) "
-                       "colour space with --working-colorspace, e.g. \"Utility - Linear - sRGB\" in ACES 1.x configs");
-  }
-  const auto processor = [&](const std::string& from_space, bool to_working) -> OCIO::ConstCPUProcessorRcPtr {
-    OCIO::GroupTransformRcPtr group = OCIO::GroupTransform::Create();
-    OCIO::ColorSpaceTransformRcPtr space = OCIO::ColorSpaceTransform::Create();
-    space->setSrc(from_space.c_str());
-    space->setDst(working.c_str());
-    group->appendTransform(space);
-    if (tail) group->appendTransform(tail);
-    try {
-      return config
-          ->getProcessor(group, to_working ? OCIO::TRANSFORM_DIR_FORWARD : OCIO::TRANSFORM_DIR_INVERSE)
-          ->getOptimizedCPUProcessor(OCIO::BIT_DEPTH_F32, OCIO::BIT_DEPTH_F32, OCIO::OPTIMIZATION_DEFAULT);
-    } catch (const OCIO::Exception& e) {
-      throw OptionsError(config_path_ + ": cannot convert between " + from_space + " and the working space: " + e.what());
-    }
-  };
-  if (!options.input_colorspace.empty()) processors_->to_working = processor(options.input_colorspace, true);
-  if (!options.output_colorspace.empty()) processors_->from_working = processor(options.output_colorspace, false);
 }
 
 ColorManagement::~ColorManagement() = default;
 ColorManagement::ColorManagement(ColorManagement&&) noexcept = default;
 ColorManagement& ColorManagement::operator=(ColorManagement&&) noexcept = default;
 
-void ColorManagement::input_to_working(std::span<float> pixels, int channels) const { apply(processors_->to_working, pixels, channels); }
+void ColorManagement::input_to_working(std::span<float> pixels, int channels) const {
+  apply(*processors_->backend, *processors_->conversions, true, pixels, channels);
+}
 
 void ColorManagement::working_to_output(std::span<float> pixels, int channels) const {
-  apply(processors_->from_working, pixels, channels);
+  apply(*processors_->backend, *processors_->conversions, false, pixels, channels);
 }
 
 }  // namespace lensmith

@@ -1,7 +1,7 @@
 // The command line's Ceres module (liblensmith_ceres.so): ceres_solvers.cpp and Ceres in a shared
-// object of their own, which the command line loads with dlopen the first time a command solves
-// something (ceres_module_client.cpp), so that a process that solves nothing does not load Ceres'
-// 17 shared libraries (ceres_solvers.h says why).
+// object of their own, which the command line loads the first time a command solves something
+// (ceres_module_client.cpp, lensmith/core/module_loader.h), so that a process that solves nothing
+// does not load Ceres' 17 shared libraries (ceres_solvers.h says why).
 //
 // Module and program are built together by the same compiler from the same sources: the table
 // passes C++ types (spans, strings, std::function) as they are, and an exception a callback throws
@@ -18,7 +18,7 @@ namespace lensmith {
 inline constexpr int kCeresModuleAbi = 1;
 
 struct CeresModuleApi {
-  int abi = kCeresModuleAbi;
+  int abi = kCeresModuleAbi;  // first: load_module checks it
   SolverReport (*solve_huber_linear)(std::span<const double>, std::span<const double>, double, const SolverLimits&,
                                      std::span<double>) = nullptr;
   SolverReport (*solve_bounded_least_squares)(const BoundedLeastSquares&, std::span<double>) = nullptr;
