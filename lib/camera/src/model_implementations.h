@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -277,6 +278,7 @@ class ReferenceSphereModel final : public RayModel {
   double z_entrance_pupil_mm_ = 0.0;          // reference wavelength
   double entrance_pupil_radius_mm_ = 0.0;
   double axial_passing_share_ = 1.0;          // of the pupil, on the axis at the focus distance
+  std::uint64_t id_ = 0;                      // this model's key in map_with's per-thread cache
 };
 
 // exact: rays traced through the prescription (stop at the camera's f-number), aimed at the stop.

@@ -1,6 +1,8 @@
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
+#include <cstdint>
 
 #include "lensmith/core/units.h"
 #include "lensmith/paraxial/paraxial_system.h"
@@ -33,6 +35,8 @@ void seidel_sensor_points(const SeidelRayGeometry& geometry, const FieldTerms& t
 
 ReferenceSphereModel::ReferenceSphereModel(RayModelKind kind, const Camera& camera, const RayModelOptions& options)
     : RayModel(camera), kind_(kind) {
+  static std::atomic<std::uint64_t> models{0};
+  id_ = ++models;
   if (kind_ == RayModelKind::Thin) return;
   // First-order vignetting: any paraxial ray is a combination of the marginal ray of an object at
   // infinity (height h at the entrance pupil, slope 0) and a chief ray (height 0 there, slope u_c),
@@ -136,21 +140,44 @@ void ReferenceSphereModel::map_passing(const ScenePoint& point, double wavelengt
 
 void ReferenceSphereModel::map_with(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
                                     std::span<SensorHit> hits, bool with_clearance) const {
-  const FirstOrderSample fo = camera_.first_order(wavelength_nm);
-  const double r_exit = fo.exit_pupil_radius_mm * camera_.pupil_orientation();
-  const double z_exit = fo.z_exit_pupil_mm;
-  const double z_sensor = camera_.z_sensor_mm();
   // Radiometric weights from the paraxial entrance pupil: the solid angle each pupil element
   // subtends at the scene point, relative to the on-axis point of the focus plane (SensorHit).
   // The ideal thin lens has none.
   const bool weighted = kind_ != RayModelKind::Thin;
   const double z_persp = camera_.z_perspective_mm();
+  // The first-order data and the weights' scale at this wavelength: the renderer maps at a few
+  // wavelengths only, one point after another, so this thread's last few are kept.
+  struct AtWavelength {
+    std::uint64_t model = 0;  // 0: empty
+    double wavelength_nm = 0.0;
+    FirstOrderSample fo;
+    double weight_scale = 1.0;
+  };
+  constexpr std::size_t kKept = 4;
+  thread_local std::array<AtWavelength, kKept> kept;
+  thread_local std::size_t next_kept = 0;
+  const AtWavelength* at = nullptr;
+  for (const AtWavelength& k : kept) {
+    if (k.model == id_ && k.wavelength_nm == wavelength_nm) at = &k;
+  }
+  if (at == nullptr) {
+    AtWavelength& k = kept[next_kept];
+    next_kept = (next_kept + 1) % kKept;
+    k.model = id_;
+    k.wavelength_nm = wavelength_nm;
+    k.fo = camera_.first_order(wavelength_nm);
+    k.weight_scale = weighted ? 1.0 / (mean_axial_patch_solid_angle(inverse_per_mm(camera_.focus_distance_mm()), z_persp,
+                                                                    k.fo.entrance_pupil_radius_mm, k.fo.z_entrance_pupil_mm) *
+                                       axial_passing_share_)
+                              : 1.0;
+    at = &k;
+  }
+  const FirstOrderSample fo = at->fo;  // copied: the slot is the thread's to reuse
+  const double r_exit = fo.exit_pupil_radius_mm * camera_.pupil_orientation();
+  const double z_exit = fo.z_exit_pupil_mm;
+  const double z_sensor = camera_.z_sensor_mm();
   const double r_entrance = fo.entrance_pupil_radius_mm;
-  const double weight_scale =
-      weighted ? 1.0 / (mean_axial_patch_solid_angle(inverse_per_mm(camera_.focus_distance_mm()), z_persp, r_entrance,
-                                                     fo.z_entrance_pupil_mm) *
-                        axial_passing_share_)
-               : 1.0;
+  const double weight_scale = at->weight_scale;
   // The weight varies across a pupil by its solid angle's cos^3 over a few degrees at most: a
   // plane through its values at the pupil's centre and at (1, 0) and (0, 1) is within 1e-4 of it
   // for every lens the renderer serves, at a third of the cost per ray.
