@@ -1,5 +1,6 @@
-// Damped least squares with Ceres (Levenberg-Marquardt trust region), central-difference derivatives of
-// the merit function's residuals, bounds by Ceres' projection, glass substitution and a polishing stage.
+// Damped least squares with Ceres (Levenberg-Marquardt trust region, through lensmith/solve), central-
+// difference derivatives of the merit function's residuals, bounds by Ceres' projection, glass
+// substitution and a polishing stage.
 #include "lensmith/design/optimizer.h"
 
 #include <atomic>
@@ -8,13 +9,13 @@
 #include <limits>
 #include <sstream>
 
-#include "lensmith/solve/ceres_solvers.h"
 #include <omp.h>
 
 #include "lensmith/core/errors.h"
 #include "lensmith/core/number_parsing.h"
 #include "lensmith/glass/glass_catalog.h"
 #include "lensmith/paraxial/paraxial_system.h"
+#include "lensmith/solve/ceres_solvers.h"
 
 namespace lensmith {
 
