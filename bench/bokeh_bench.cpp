@@ -81,6 +81,7 @@ void run(benchmark::State& state, RayModelKind kind) {
   const double pixels = static_cast<double>(kWidth) * kHeight;
   state.counters["footprints/px"] = static_cast<double>(stats.footprints) / pixels;
   state.counters["triangles/px"] = static_cast<double>(stats.triangles) / pixels;
+  state.counters["reused/px"] = static_cast<double>(stats.reused_shapes) / pixels;
 }
 
 // Yu et al.'s light-field synthesis on the same scene (36 views, their default): its cost is the

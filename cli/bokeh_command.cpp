@@ -745,6 +745,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   options.hidden = parse_hidden_surfaces(o.hidden);
   options.split_edge_pixels = o.edge_pixels == "split";
   options.vignetting = !o.no_vignetting;
+  options.reuse_shapes = !o.no_shape_reuse;
   options.spectral = !o.no_spectral;
   options.spectral_samples = o.spectral_samples;
   options.layer_spacing_px = o.layer_spacing_px;
@@ -797,6 +798,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
        << " aperture\n  " << stats.layers << " depth layers " << format_rounded(stats.layer_spacing_px, 3) << " px apart, largest blur "
        << format_rounded(stats.max_abs_coc_px, 3) << " px; " << stats.footprints << " footprints";
   if (stats.triangles > 0) what << " (" << stats.triangles << " triangles)";
+  if (stats.reused_shapes > 0) what << ", " << stats.reused_shapes << " drawn from a neighbour's mapped shape";
   if (layered) {
     what << "; layered input: " << stats.deep_samples << " deep samples";
     if (stats.volume_slabs > 0) what << " (volumes cut into " << stats.volume_slabs << " slabs)";

@@ -214,6 +214,7 @@ struct BokehCommandOptions {
   std::string edge_pixels = "split";         // --edge-pixels split|keep
   bool no_vignetting = false;                // --no-vignetting: every point as bright as on the axis
   bool no_spectral = false;                  // --no-spectral
+  bool no_shape_reuse = false;               // --no-shape-reuse (BokehOptions::reuse_shapes)
   int spectral_samples = 16;                 // --spectral-samples
   double highlight_gain = 1.0;               // --highlight-gain (8-bit inputs)
   double highlight_threshold = 0.98;         // --highlight-threshold

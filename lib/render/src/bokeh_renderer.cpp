@@ -59,6 +59,8 @@ struct BandBuffers {
 // 8 on the 600 x 400 street scene (whose bands' memory, first touched per thread, doubles).
 constexpr int kBandsPerThreadAffine = 4;
 constexpr int kBandsPerThreadMapped = 2;
+// Sources planned together (FootprintScatter::plan_range): neighbours share mapped shapes within one.
+constexpr std::size_t kPlanRange = 256;
 // Hidden sources reach half the blur of the layer and of the nearer ones, plus this margin (px): the
 // 2 px tent.
 constexpr double kHiddenMarginPx = 2.0;
@@ -85,7 +87,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   LargeVector<double> result(static_cast<std::size_t>(w) * h * 4, 0.0);  // premultiplied RGB + coverage
   const int bands = std::max(1, std::min(h, threads * (model.affine_in_pupil() ? kBandsPerThreadAffine : kBandsPerThreadMapped)));
   std::size_t done = 0;
-  std::atomic<std::size_t> footprints{0}, triangles{0};
+  std::atomic<std::size_t> footprints{0}, triangles{0}, reused{0};
   // Per thread, its splat buffers, kept from band to band and layer to layer.
   std::vector<BandBuffers> pools(static_cast<std::size_t>(threads));
   // A layer's sources and their plans, kept from layer to layer (their memory is faulted in once).
@@ -99,6 +101,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   // faster than its whole plan.
   LargeVector<std::array<float, 2>> plan_rows;
   plan_rows.reserve(layer.capacity());
+  std::vector<std::size_t> range_begin;  // of the plan ranges of a layer
   render_detail::MergeScratch merge_scratch;
   render_detail::HiddenScratch hidden_scratch;
 
@@ -119,13 +122,24 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
 
     plans.resize(layer.size());
     plan_rows.resize(layer.size());
+    // In ranges of about kPlanRange sources, each beginning where a run of neighbours that may share
+    // a mapped shape begins: which neighbours share one depends neither on the threads nor on where
+    // the ranges are cut.
+    range_begin.clear();
+    for (std::size_t i = 0; i < layer.size(); i += kPlanRange) {
+      while (!render_detail::starts_run(layer, i)) ++i;
+      if (i < layer.size()) range_begin.push_back(i);
+    }
+    range_begin.push_back(layer.size());
+    const std::size_t ranges = range_begin.size() - 1;
 #pragma omp parallel num_threads(threads)
     {
       FootprintScratch scratch;
-#pragma omp for schedule(dynamic, 256)
-      for (std::size_t i = 0; i < layer.size(); ++i) {
-        plans[i] = scatter.plan(layer[i], scratch);
-        plan_rows[i] = {plans[i].y_min, plans[i].y_max};
+#pragma omp for schedule(dynamic, 1)
+      for (std::size_t r = 0; r < ranges; ++r) {
+        const std::size_t begin = range_begin[r], end = range_begin[r + 1];
+        scatter.plan_range(layer, plans, begin, end, scratch);
+        for (std::size_t i = begin; i < end; ++i) plan_rows[i] = {plans[i].y_min, plans[i].y_max};
       }
     }
 
@@ -135,7 +149,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
 #pragma omp parallel num_threads(threads)
     {
       FootprintScratch scratch;
-      std::size_t local_footprints = 0, local_triangles = 0;
+      std::size_t local_footprints = 0, local_triangles = 0, local_reused = 0;
 #pragma omp for schedule(dynamic, 1)
       for (int b = 0; b < bands; ++b) {
         const int row_begin = b * h / bands, row_end = (b + 1) * h / bands;
@@ -145,6 +159,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
         BandBuffers& buffers = pools[static_cast<std::size_t>(omp_get_thread_num())];
         for (auto& set : buffers.used) set.fill(false);
         const float band_top = static_cast<float>(row_begin) - 1.0f, band_bottom = static_cast<float>(row_end) + 1.0f;
+        scratch.forget_shape();
         for (std::size_t i = 0; i < layer.size(); ++i) {
           if (plan_rows[i][1] < band_top || plan_rows[i][0] > band_bottom) continue;
           const int level = plans[i].level;
@@ -160,7 +175,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
             slot->reset(row_begin, row_end);
           }
           used = true;
-          scatter.deposit(layer[i], plans[i], *slot, scratch, local_triangles);
+          scatter.deposit(layer[i], plans[i], i, *slot, scratch, local_triangles, local_reused);
           // A footprint cross-faded between two group counts deposits both splits.
           local_footprints += static_cast<std::size_t>(plans[i].groups + (plans[i].blend < 1.0f ? plans[i].groups - 1 : 0));
         }
@@ -187,12 +202,14 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
       }
       footprints += local_footprints;
       triangles += local_triangles;
+      reused += local_reused;
     }
     done += layers.members[u].size();
     if (options.progress) options.progress(static_cast<double>(done) / static_cast<double>(sources.size()));
   }
   stats.footprints = footprints;
   stats.triangles = triangles;
+  stats.reused_shapes = reused;
   stats.unaimed_rays = model.unaimed_rays() - unaimed_before;
   return render_detail::finish_composite(result, w, h, threads, hidden_scratch.cells, hidden_scratch.push_pull);
 }
@@ -280,7 +297,7 @@ std::string BokehOptions::to_string() const {
   os << "BokehOptions(threads " << threads << ", " << splat.to_string() << ", layer spacing " << layer_spacing_px
      << " px, max layers " << max_layers << ", hidden " << lensmith::to_string(hidden) << ", spectral "
      << (spectral ? std::to_string(spectral_samples) + " nodes" : std::string("off")) << ", chromatic tolerance "
-     << chromatic_tolerance_px << " px, max blur " << max_blur_px << " px)";
+     << chromatic_tolerance_px << " px, max blur " << max_blur_px << " px" << (reuse_shapes ? "" : ", shapes not reused") << ")";
   return os.str();
 }
 
@@ -288,7 +305,7 @@ std::string BokehStatistics::to_string() const {
   std::ostringstream os;
   os << "BokehStatistics(" << layers << " layers at " << layer_spacing_px << " px, " << source_pixels << " pixels, "
      << hidden_sources << " hidden sources, " << split_edge_pixels << " edge pixels split, " << redepthed_edge_pixels
-     << " moved, " << footprints << " footprints, " << triangles << " triangles, "
+     << " moved, " << footprints << " footprints, " << triangles << " triangles, " << reused_shapes << " shapes reused, "
      << clamped_depths << " clamped depths, max |CoC| " << max_abs_coc_px << " px";
   if (deep_samples > 0) os << ", " << deep_samples << " deep samples, " << volume_slabs << " volume slabs";
   if (unaimed_rays > 0) os << ", " << unaimed_rays << " rays not aimed";

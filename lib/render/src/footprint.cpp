@@ -51,6 +51,14 @@ constexpr double kUntangleTolerancePx = 0.25;
 // their mapped points, and from kEdgeKeptPx their outermost ring's edge (deposit_nested_rings).
 constexpr double kCentroidKeptPx = 4.0;
 constexpr double kEdgeKeptPx = 8.0;
+// Reusing a mapped shape along a row (FootprintScatter::plan_range): pixels probed at least every
+// kShapeStride; those between draw the first's shape where every probe ray of both ends lies within
+// kShapeTolerancePx of where the other's puts it (relative to their chief rays: a sixteenth of a pixel,
+// below the quarter-pixel sub-rows a footprint's own polygons are scanned at), and where the depth
+// varies along the run, their passing shares agree to kShapePassingTolerance (of the whole beam).
+constexpr std::size_t kShapeStride = 8;
+constexpr double kShapeTolerancePx = 1.0 / 16.0;
+constexpr float kShapePassingTolerance = 0.004f;
 // Grid cells of an aperture-picture mesh per pixel of footprint size.
 constexpr double kPxPerGridCell = 1.5;
 // Footprint heights (grid cells, with margins) from which half and a quarter of the sub-rows are used
@@ -333,7 +341,7 @@ bool polygon_centroid(std::span<const Point2f> ring, double& cx, double& cy) {
 template <typename LightCentroid>
 bool deposit_nested_rings(const std::vector<std::span<const Point2f>>& rings, const std::vector<double>& pupil_areas,
                           const std::vector<double>& ring_weights, double full_pupil_area, const std::array<float, 4>& value,
-                          bool weighted, LightCentroid&& light_centroid, SplatBuffer& buffer, int subrows, bool shapes_checked,
+                          bool weighted, LightCentroid&& light_centroid, FootprintShape& out, int subrows, bool shapes_checked,
                           FootprintScratch& scratch) {
   std::vector<double>& areas = scratch.areas;
   if (!rings_nest(rings, areas, shapes_checked)) return false;
@@ -421,7 +429,7 @@ bool deposit_nested_rings(const std::vector<std::span<const Point2f>>& rings, co
     }
     const auto f = static_cast<float>(d.light);
     const auto c = static_cast<float>(d.coverage);
-    buffer.add_polygon(ring, {value[0] * f, value[1] * f, value[2] * f, value[3] * c}, subrows);
+    out.add(ring, {value[0] * f, value[1] * f, value[2] * f, value[3] * c}, subrows);
   }
   return true;
 }
@@ -461,7 +469,7 @@ bool mesh_ring_spans(const PupilMesh& mesh, const std::vector<SensorHit>& hits, 
 }
 
 bool deposit_ring_polygons(const PupilMesh& mesh, const std::vector<SensorHit>& hits, const std::vector<Point2f>& points,
-                           const std::array<float, 4>& value, bool weighted, SplatBuffer& buffer, int subrows, bool shapes_checked,
+                           const std::array<float, 4>& value, bool weighted, FootprintShape& out, int subrows, bool shapes_checked,
                            FootprintScratch& scratch) {
   if (!mesh_ring_spans(mesh, hits, points, scratch)) return false;
   const auto sectors = static_cast<std::size_t>(mesh.sectors);
@@ -470,7 +478,7 @@ bool deposit_ring_polygons(const PupilMesh& mesh, const std::vector<SensorHit>& 
                               [sectors](int k) { return 1 + static_cast<std::size_t>(k - 1) * sectors; }, weighted, cx, cy);
   };
   return deposit_nested_rings(scratch.ring_spans, scratch.pupil_areas, scratch.ring_weights, 1.0, value, weighted, centroid,
-                              buffer, subrows, shapes_checked, scratch);
+                              out, subrows, shapes_checked, scratch);
 }
 
 }  // namespace
@@ -555,7 +563,7 @@ void FootprintScatter::map_clipped_rings(const ScenePoint& point, double wavelen
 
 void FootprintScatter::deposit_clipped_rings(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p, double passing,
                                              bool allow_rings, bool shapes_checked, const std::array<float, 4>& value,
-                                             SplatBuffer& buffer, int ring_subrows, FootprintScratch& scratch,
+                                             FootprintShape& out, int ring_subrows, FootprintScratch& scratch,
                                              std::size_t& triangles) const {
   const int rings = meshes_.mesh(p.mesh).rings;
   const std::vector<PupilPoint>& outline = meshes_.dense_outline(PupilMeshTable::sector_step_of_mesh(p.mesh));
@@ -573,7 +581,7 @@ void FootprintScatter::deposit_clipped_rings(const ScenePoint& point, double wav
     return fan_light_centroid(pupil, points, hits, rings, outline.size(), ring_begin, options_.vignetting, cx, cy);
   };
   if (allow_rings && deposit_nested_rings(scratch.ring_spans, scratch.pupil_areas, scratch.ring_weights, full_pupil_area,
-                                          value, options_.vignetting, centroid, buffer, ring_subrows, shapes_checked, scratch)) {
+                                          value, options_.vignetting, centroid, out, ring_subrows, shapes_checked, scratch)) {
     return;
   }
   // The same clipped rings as triangles (for_each_ring_triangle; every ring has the outline's vertex
@@ -589,7 +597,8 @@ void FootprintScatter::deposit_clipped_rings(const ScenePoint& point, double wav
     const double weight = options_.vignetting ? (hits[a].weight + hits[b].weight + hits[c].weight) / 3.0 : 1.0;
     const auto f = static_cast<float>(area / light_area * weight);
     const auto cover = static_cast<float>(area / pupil_total);
-    buffer.add_triangle(points[a], points[b], points[c], {value[0] * f, value[1] * f, value[2] * f, value[3] * cover});
+    const std::array<Point2f, 3> corners{points[a], points[b], points[c]};
+    out.add(corners, {value[0] * f, value[1] * f, value[2] * f, value[3] * cover}, 0);
     ++triangles;
   });
 }
@@ -627,16 +636,17 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
   pupil.assign(probe_.begin(), probe_.end());
   hits.resize(pupil.size());
   const std::array<double, 3> lambdas{camera_.reference_wavelength_nm(), groups_.lowest_nm(), groups_.highest_nm()};
-  // Read only where `ok` (not value-initialised: zeroing its 432 bytes was a tenth of a thin-lens
-  // plan's time).
-  struct ProbePixel {
-    double x, y;  // no initialisers
-  };
-  std::array<std::array<ProbePixel, 9>, 3> px;
-  std::array<std::array<bool, 9>, 3> ok{};  // where the ray lands is known (it passes, or would)
+  // Kept in scratch.probe for plan_range. `px` is read only where `ok` (not value-initialised:
+  // zeroing its 432 bytes was a tenth of a thin-lens plan's time).
+  FootprintProbe& probe = scratch.probe;
+  auto& px = probe.px;
+  auto& ok = probe.ok;  // where the ray lands is known (it passes, or would)
+  ok = {};
+  probe.chief_passes = false;
   double x_min = kInfinity, x_max = -kInfinity, y_min = kInfinity, y_max = -kInfinity;
   // Without dispersion (a thin lens, or colour off) one wavelength tells all.
   const std::size_t wavelengths = camera_.is_thin_lens() || !options_.spectral ? 1 : 3;
+  probe.wavelengths = wavelengths;
   // Where the model describes its clipping as pupil discs, those that cut the aperture say that the
   // beam is clipped, and the probe maps without clipping (cheaper).
   model_.clip_discs(point, scratch.discs);
@@ -678,6 +688,10 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
     } else {
       model_.map_passing(point, lambdas[l], pupil, hits);
     }
+    if (l == 0 && hits[0].ok) {
+      p.centre_weight = static_cast<float>(hits[0].weight);
+      probe.chief_passes = true;
+    }
     for (std::size_t i = 0; i < 9; ++i) {
       ok[l][i] = hits[i].ok || hits[i].unclipped;
       any_clipped = any_clipped || !hits[i].ok;
@@ -690,6 +704,7 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
       y_max = std::max(y_max, px[l][i].y);
     }
   }
+  if (probe.chief_passes) p.chief_px = {static_cast<float>(px[0][0].x), static_cast<float>(px[0][0].y)};
   if (!(y_min <= y_max)) {
     // No probe ray got through (the exact model, fully vignetted): plan a small mesh around the
     // pixel so the rays that do pass are still found.
@@ -766,46 +781,192 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
   return p;
 }
 
+namespace {
+
+// A run of plan_range: whole pixels (not the parts of a split edge pixel) of one row, one after the
+// other, from a column that is a multiple of kShapeStride (or where one is cut off) to the next.
+bool whole_pixel(const ScatterSource& s) { return s.offset_x_px == 0.0f && s.offset_y_px == 0.0f; }
+
+bool joins_run(std::span<const ScatterSource> sources, std::size_t i) {
+  const ScatterSource& p = sources[i - 1];
+  const ScatterSource& q = sources[i];
+  return q.y == p.y && q.x == p.x + 1 && q.coverage_only == p.coverage_only && whole_pixel(p) && whole_pixel(q);
+}
+
+}  // namespace
+
+bool starts_run(std::span<const ScatterSource> sources, std::size_t i) {
+  constexpr auto stride = static_cast<int>(kShapeStride);
+  return i == 0 || i >= sources.size() || ((sources[i].x % stride) + stride) % stride == 0 || !joins_run(sources, i);
+}
+
+bool FootprintScatter::shares_shape(std::span<const ScatterSource> sources, std::span<const FootprintPlan> plans, std::size_t a,
+                                    std::size_t b, const FootprintProbe& pa, const FootprintProbe& pb) const {
+  const FootprintPlan& A = plans[a];
+  const FootprintPlan& B = plans[b];
+  // The same kind of deposit: a mesh (the single polygon and the point are cheap already), the same
+  // mesh, grid and wavelength-group splits, both keeping light, both planned from their own probe.
+  if (A.mesh < 0 || A.mesh != B.mesh || A.level != B.level || A.groups != B.groups || (A.blend < 1.0f) != (B.blend < 1.0f) ||
+      A.discs != B.discs || A.shape_source >= 0 || B.shape_source >= 0 || !(A.passing > 0.0f && B.passing > 0.0f)) {
+    return false;
+  }
+  if (!pa.chief_passes || !pb.chief_passes || pa.wavelengths != pb.wavelengths) return false;
+  // The sources between lie at depths between theirs, so that their shapes lie between a's and b's
+  // (a footprint changes monotonically with depth over so short a run); at one depth all along, the
+  // passing share is interpolated to second order, else a's and b's must agree.
+  const double da = sources[a].inverse_depth_per_mm, db = sources[b].inverse_depth_per_mm;
+  const double lo = std::min(da, db), hi = std::max(da, db);
+  bool one_depth = da == db;
+  for (std::size_t m = a + 1; m < b; ++m) {
+    const double d = sources[m].inverse_depth_per_mm;
+    if (!(d >= lo && d <= hi)) return false;
+    one_depth = one_depth && d == da;
+  }
+  if (!one_depth && std::abs(A.passing - B.passing) > kShapePassingTolerance) return false;
+  // Every probe ray, at every probed wavelength, where a's and b's chief rays put it, within the
+  // tolerance of each other.
+  const double tolerance2 = kShapeTolerancePx * kShapeTolerancePx;
+  for (std::size_t l = 0; l < pa.wavelengths; ++l) {
+    for (std::size_t i = 0; i < 9; ++i) {
+      if (pa.ok[l][i] != pb.ok[l][i]) return false;
+      if (!pa.ok[l][i]) continue;
+      const double dx = (pb.px[l][i].x - pb.px[0][0].x) - (pa.px[l][i].x - pa.px[0][0].x);
+      const double dy = (pb.px[l][i].y - pb.px[0][0].y) - (pa.px[l][i].y - pa.px[0][0].y);
+      if (dx * dx + dy * dy > tolerance2) return false;
+    }
+  }
+  return true;
+}
+
+bool FootprintScatter::follow(const ScatterSource& s, const FootprintPlan& a, const FootprintPlan& b, double along,
+                              std::int32_t a_index, FootprintPlan& out) const {
+  // Its own chief ray (exact: distortion and lateral colour move a footprint by up to 1/16 px per
+  // pixel along a row), a's shape, the rest interpolated between a and b.
+  const Tangents t = camera_.frame().tangents_at(source_centre(s));
+  const ScenePoint point{t.x, t.y, s.inverse_depth_per_mm};
+  static constexpr std::array<PupilPoint, 1> kCentre{{{0.0, 0.0}}};
+  std::array<SensorHit, 1> hit;
+  if (a.discs) {
+    model_.map_passing(point, camera_.reference_wavelength_nm(), kCentre, hit);
+  } else {
+    model_.map(point, camera_.reference_wavelength_nm(), kCentre, hit);
+  }
+  if (!hit[0].ok) return false;
+  const PixelPoint c = camera_.output_pixel(hit[0].x_mm, hit[0].y_mm);
+  out = a;
+  out.chief_px = {static_cast<float>(c.x), static_cast<float>(c.y)};
+  out.centre_weight = static_cast<float>(hit[0].weight);
+  const float dy = out.chief_px[1] - a.chief_px[1];
+  out.y_min = a.y_min + dy;
+  out.y_max = a.y_max + dy;
+  const auto f = static_cast<float>(along);
+  out.blend = a.blend + f * (b.blend - a.blend);
+  out.passing = a.passing + f * (b.passing - a.passing);
+  out.shape_source = a_index;
+  return true;
+}
+
+void FootprintScatter::plan_range(std::span<const ScatterSource> sources, std::span<FootprintPlan> plans, std::size_t begin,
+                                  std::size_t end, FootprintScratch& scratch) const {
+  // Models that clip by pupil discs alone (paraxial, Seidel): the exact and poly models clip ray by
+  // ray, and a beam's clipped edge can move faster along a row than their probe shows. An affine
+  // model through a uniform convex aperture has no mesh footprints to share.
+  const bool meshes = !(model_.affine_in_pupil() && aperture_.is_uniform_convex());
+  const bool reuse = options_.reuse_shapes && meshes &&
+                     (model_.kind() == RayModelKind::Paraxial || model_.kind() == RayModelKind::Seidel);
+  if (!reuse) {
+    for (std::size_t i = begin; i < end; ++i) plans[i] = plan(sources[i], scratch);
+    return;
+  }
+  std::vector<FootprintProbe>& probes = scratch.range_probes;
+  probes.resize(end - begin);
+  auto full = [&](std::size_t i) {
+    plans[i] = plan(sources[i], scratch);
+    probes[i - begin] = scratch.probe;
+  };
+  // Between planned a and b: all follow a where they may, else the middle is planned and each half
+  // tried in turn.
+  auto fill = [&](auto& self, std::size_t a, std::size_t b) -> void {
+    if (b - a < 2) return;
+    if (shares_shape(sources, plans, a, b, probes[a - begin], probes[b - begin])) {
+      for (std::size_t m = a + 1; m < b; ++m) {
+        const double along = static_cast<double>(m - a) / static_cast<double>(b - a);
+        if (!follow(sources[m], plans[a], plans[b], along, static_cast<std::int32_t>(a), plans[m])) full(m);
+      }
+      return;
+    }
+    const std::size_t mid = a + (b - a) / 2;
+    full(mid);
+    self(self, a, mid);
+    self(self, mid, b);
+  };
+  if (begin >= end) return;
+  full(begin);
+  std::size_t i = begin;
+  while (i < end) {
+    std::size_t last = i;
+    // To the next column that is a multiple of kShapeStride, so that which pixels are probed depends
+    // on where they are, not on where the frame or the range begins.
+    while (last + 1 < end && joins_run(sources, last + 1)) {
+      if (starts_run(sources, ++last)) break;
+    }
+    if (last == i) {
+      if (++i < end) full(i);
+      continue;
+    }
+    full(last);
+    fill(fill, i, last);
+    i = last;
+  }
+}
+
 int footprint_subrows(const FootprintPlan& p, int buffer_subrows) {
   const float height = (p.y_max - p.y_min) / static_cast<float>(1 << p.level);
   const int divisor = height < kMediumFootprintPx ? 1 : height < kTallFootprintPx ? 2 : 4;
   return std::max(1, buffer_subrows / divisor);
 }
 
-void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, SplatBuffer& buffer, FootprintScratch& scratch,
-                               std::size_t& triangles) const {
-  const int own_subrows = footprint_subrows(p, buffer.options().subrows);
+void FootprintShape::clear() {
+  valid = false;
+  points.clear();
+  polygons.clear();
+  group_end.clear();
+  group_triangles.clear();
+}
+
+void FootprintShape::add(std::span<const Point2f> vertices, const std::array<float, 4>& unit_value, int subrows) {
+  polygons.push_back({static_cast<std::uint32_t>(points.size()), static_cast<std::uint32_t>(vertices.size()), unit_value[0],
+                      unit_value[3], subrows});
+  points.insert(points.end(), vertices.begin(), vertices.end());
+}
+
+namespace {
+
+// A wavelength group's share of a source's light (RGB) and coverage (alpha).
+std::array<float, 4> group_value(const ScatterSource& s, const SpectralGroup& g, float share) {
+  std::array<float, 4> value{};
+  for (std::size_t c = 0; c < 3; ++c) value[c] = share * (g.m[c][0] * s.rgb[0] + g.m[c][1] * s.rgb[1] + g.m[c][2] * s.rgb[2]);
+  value[3] = share * g.alpha * s.coverage;
+  return value;
+}
+
+}  // namespace
+
+void FootprintScatter::map_shape(const ScatterSource& s, const FootprintPlan& p, int buffer_subrows, FootprintScratch& scratch) const {
+  const int own_subrows = footprint_subrows(p, buffer_subrows);
   std::vector<SensorHit>& hits = scratch.hits;
   std::vector<Point2f>& points = scratch.points;
   const Tangents t = camera_.frame().tangents_at(source_centre(s));
   const ScenePoint point{t.x, t.y, s.inverse_depth_per_mm};
-  // First-order vignetting (the model's pupil discs, the same at every wavelength): the share of the
-  // aperture that passes was planned; the point path needs nothing more, the single polygon the
-  // outline less what the discs cut off.
   const double passing = p.passing;
-  if (!(passing > 0.0)) return;  // the whole beam is stopped
-  if (p.discs && p.outline != FootprintPlan::kPoint) {
+  if (p.discs) {
     model_.clip_discs(point, scratch.discs);
   } else {
     scratch.discs.clear();
   }
-  const std::vector<PupilPoint>* outline = p.outline >= 0 ? &meshes_.outline(p.outline) : nullptr;
-  if (!scratch.discs.empty() && aperture_.is_uniform_convex() && p.mesh < 0 && p.outline >= 0) {
-    // The outline less what the discs cut off: with the chief ray inside every disc the cut is
-    // radial (cheap); otherwise the polygon is clipped disc by disc.
-    const std::vector<PupilPoint>& own = meshes_.dense_outline(p.outline);
-    if (centre_passes(scratch.discs)) {
-      disc_reach(meshes_.dense_directions(p.outline), scratch.discs, scratch.reach);
-      reach_clip(own, 1.0, scratch.reach, scratch.clipped);
-    } else {
-      clip_pupil_polygon(own, scratch.discs, scratch.clipped, scratch.clip_work);
-    }
-    if (scratch.clipped.size() < 3) return;
-    outline = &scratch.clipped;
-  }
   // A polar mesh of a model that clips by discs: its rings clipped once for every wavelength.
-  const bool rings_clipped = p.mesh >= 0 && !scratch.discs.empty() && meshes_.mesh(p.mesh).sectors > 0 &&
-                             aperture_.is_uniform_convex() && clip_rings(p, scratch);
+  const PupilMesh& mesh = meshes_.mesh(p.mesh);
+  const bool rings_clipped = !scratch.discs.empty() && mesh.sectors > 0 && aperture_.is_uniform_convex() && clip_rings(p, scratch);
   // Rings or triangles: decided once for all the footprint's wavelengths. Each group's light and
   // coverage go down in its own shape, and a pixel's colour is their sum over its coverage: where
   // the rings nested at some wavelengths and not at others (a mapped ring turning back in y, which
@@ -814,8 +975,7 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
   bool allow_rings = true;
   scratch.cached_count = 0;
   const bool several = p.groups > 1 || p.blend < 1.0f;
-  if (several && p.mesh >= 0 && p.outline != FootprintPlan::kPoint) {
-    const PupilMesh& mesh = meshes_.mesh(p.mesh);
+  if (several) {
     auto nest_at = [&](double wavelength_nm) {
       if (rings_clipped) {
         map_clipped_rings(point, wavelength_nm, p, scratch, true);
@@ -838,12 +998,187 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
   }
   // Every group's rings found y-monotone and simple above: the deposits below map the same rays
   // (scratch.cached_maps) and need only their areas.
-  const bool rings_checked = several && allow_rings && p.mesh >= 0 && p.outline != FootprintPlan::kPoint;
+  const bool rings_checked = several && allow_rings;
+  FootprintShape& shape = scratch.shape;
+  shape.clear();
+  // One wavelength group's polygons, per unit of its value.
+  static constexpr std::array<float, 4> kUnit{1.0f, 1.0f, 1.0f, 1.0f};
+  auto record_group = [&](const SpectralGroup& g) {
+    std::size_t triangles = 0;
+    if (rings_clipped) {
+      deposit_clipped_rings(point, g.wavelength_nm, p, passing, allow_rings, rings_checked, kUnit, shape, own_subrows, scratch,
+                            triangles);
+    } else {
+      record_mesh(point, g.wavelength_nm, p, allow_rings, rings_checked, own_subrows, scratch, triangles);
+    }
+    shape.group_end.push_back(shape.polygons.size());
+    shape.group_triangles.push_back(triangles);
+  };
+  for (const SpectralGroup& g : groups_.split(p.groups)) record_group(g);
+  if (p.blend < 1.0f) {
+    for (const SpectralGroup& g : groups_.split(p.groups - 1)) record_group(g);
+  }
+  shape.valid = true;
+  shape.chief_px = p.chief_px;
+  shape.light_scale = static_cast<double>(p.centre_weight) * passing;
+}
+
+void FootprintScatter::record_mesh(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p, bool allow_rings,
+                                   bool rings_checked, int own_subrows, FootprintScratch& scratch, std::size_t& triangles) const {
+  std::vector<SensorHit>& hits = scratch.hits;
+  std::vector<Point2f>& points = scratch.points;
+  FootprintShape& shape = scratch.shape;
+  static constexpr std::array<float, 4> kUnit{1.0f, 1.0f, 1.0f, 1.0f};
+  const PupilMesh& mesh = meshes_.mesh(p.mesh);
+  map_cached(point, wavelength_nm, 0, mesh.points, hits, scratch, false);
+  points.resize(mesh.points.size());
+  for (std::size_t i = 0; i < mesh.points.size(); ++i) {
+    if (!hits[i].unclipped && !hits[i].ok) continue;
+    const PixelPoint q = camera_.output_pixel(hits[i].x_mm, hits[i].y_mm);
+    points[i] = {static_cast<float>(q.x), static_cast<float>(q.y)};
+  }
+  if (mesh.sectors > 0 && allow_rings &&
+      deposit_ring_polygons(mesh, hits, points, kUnit, options_.vignetting, shape, own_subrows, rings_checked, scratch)) {
+    return;
+  }
+  // A triangle whose corners a clear aperture partly stops (exact, poly) passes the part of its
+  // area where the linear interpolation of their clearances is >= 0, in place: the beam's edge
+  // falls inside it, to first order.
+  auto triangle_passing = [&hits](const PupilTriangle& tri) {
+    const SensorHit& a = hits[static_cast<std::size_t>(tri.a)];
+    const SensorHit& b = hits[static_cast<std::size_t>(tri.b)];
+    const SensorHit& c = hits[static_cast<std::size_t>(tri.c)];
+    if (!(a.ok || a.unclipped) || !(b.ok || b.unclipped) || !(c.ok || c.unclipped)) return 0.0;
+    return passing_share(a.clearance, b.clearance, c.clearance);
+  };
+  // Colour carries the transmitted fraction and the rays' radiometric weights (vignetting darkens);
+  // coverage is normalised over the light that passes, so a vignetted point is still an opaque
+  // surface. Without vignetting the colour is normalised the same way.
+  double passed = 0.0;
+  for (const PupilTriangle& tri : mesh.triangles) passed += tri.weight * triangle_passing(tri);
+  if (!(passed > 0.0)) return;
+  // Where the model describes its clipping as discs, the light that passes is known exactly (the
+  // outline less the discs); the triangles' linear interpolation only distributes it.
+  const double exact_share = !scratch.discs.empty() && aperture_.is_uniform_convex() ? static_cast<double>(p.passing) : passed;
+  const double unlit = options_.vignetting ? exact_share / passed : 1.0 / passed;
+  for (const PupilTriangle& tri : mesh.triangles) {
+    const double fraction = triangle_passing(tri);
+    if (fraction == 0.0) continue;
+    const double ray_weight = options_.vignetting ? (hits[tri.a].weight + hits[tri.b].weight + hits[tri.c].weight) / 3.0 : 1.0;
+    const auto w = static_cast<float>(tri.weight * fraction * ray_weight * unlit);
+    const std::array<float, 4> unit{w, w, w, static_cast<float>(tri.weight * fraction / passed)};
+    const std::array<std::size_t, 3> corner{static_cast<std::size_t>(tri.a), static_cast<std::size_t>(tri.b),
+                                            static_cast<std::size_t>(tri.c)};
+    if (fraction >= 1.0) {
+      const std::array<Point2f, 3> corners{points[corner[0]], points[corner[1]], points[corner[2]]};
+      shape.add(corners, unit, 0);
+    } else {
+      // Its passing part only, where the interpolated clearance is >= 0, mapped by interpolating
+      // the corners' landing points (first order): spread over the whole triangle's image, the
+      // stopped corners' unclipped landings drew a faint skirt around a vignetted point's bokeh
+      // (a highlight of radiance 200 showed it as a disc twice too wide, docs/bokeh.md "Brightness").
+      std::array<Point2f, 4> clipped{};
+      std::size_t count = 0;
+      for (std::size_t i = 0; i < 3; ++i) {
+        const std::size_t j = (i + 1) % 3;
+        const double ci = hits[corner[i]].clearance, cj = hits[corner[j]].clearance;
+        const Point2f& pi = points[corner[i]];
+        const Point2f& pj = points[corner[j]];
+        if (ci >= 0.0) clipped[count++] = pi;
+        if ((ci >= 0.0) != (cj >= 0.0) && count < clipped.size()) {
+          const auto along = static_cast<float>(ci / (ci - cj));
+          clipped[count++] = {pi.x + along * (pj.x - pi.x), pi.y + along * (pj.y - pi.y)};
+        }
+      }
+      if (count < 3) continue;
+      shape.add(std::span<const Point2f>(clipped.data(), count), unit, 0);
+    }
+    ++triangles;
+  }
+}
+
+void FootprintScatter::draw_shape(const ScatterSource& s, const FootprintPlan& p, SplatBuffer& buffer, FootprintScratch& scratch,
+                                  std::size_t& triangles) const {
+  const FootprintShape& shape = scratch.shape;
+  // A neighbour's shape carries its light: scaled by this source's chief-ray weight and passing
+  // share against the neighbour's (both change slowly along a row; 1 for the source's own shape).
+  double scale = 1.0;
+  if (options_.vignetting && shape.light_scale > 0.0) scale = static_cast<double>(p.centre_weight) * p.passing / shape.light_scale;
+  const float dx = p.chief_px[0] - shape.chief_px[0], dy = p.chief_px[1] - shape.chief_px[1];
+  std::size_t group = 0;
+  auto draw_group = [&](const SpectralGroup& g, float share) {
+    std::array<float, 4> value = group_value(s, g, share);
+    if (scale != 1.0) {
+      for (std::size_t c = 0; c < 3; ++c) value[c] = static_cast<float>(value[c] * scale);
+    }
+    const std::size_t begin = group == 0 ? 0 : shape.group_end[group - 1];
+    for (std::size_t k = begin; k < shape.group_end[group]; ++k) {
+      const FootprintShape::Polygon& q = shape.polygons[k];
+      std::span<const Point2f> vertices(shape.points.data() + q.begin, q.count);
+      if (dx != 0.0f || dy != 0.0f) {
+        scratch.moved_shape.resize(q.count);
+        for (std::size_t j = 0; j < q.count; ++j) scratch.moved_shape[j] = {vertices[j].x + dx, vertices[j].y + dy};
+        vertices = scratch.moved_shape;
+      }
+      buffer.add_polygon(vertices, {value[0] * q.light, value[1] * q.light, value[2] * q.light, value[3] * q.coverage}, q.subrows);
+    }
+    triangles += shape.group_triangles[group];
+    ++group;
+  };
+  for (const SpectralGroup& g : groups_.split(p.groups)) draw_group(g, p.blend);
+  if (p.blend < 1.0f) {
+    for (const SpectralGroup& g : groups_.split(p.groups - 1)) draw_group(g, 1.0f - p.blend);
+  }
+}
+
+void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, std::size_t index, SplatBuffer& buffer,
+                               FootprintScratch& scratch, std::size_t& triangles, std::size_t& reused) const {
+  // First-order vignetting (the model's pupil discs, the same at every wavelength): the share of the
+  // aperture that passes was planned; the point path needs nothing more, the single polygon the
+  // outline less what the discs cut off.
+  const double passing = p.passing;
+  if (!(passing > 0.0)) return;  // the whole beam is stopped
+  if (p.mesh >= 0) {
+    // A mesh footprint is mapped into its shape, or drawn from its neighbour's (plan_range).
+    const std::int64_t key = p.shape_source >= 0 ? p.shape_source : static_cast<std::int64_t>(index);
+    const std::size_t deposits = static_cast<std::size_t>(p.groups + (p.blend < 1.0f ? p.groups - 1 : 0));
+    const FootprintShape& shape = scratch.shape;
+    if (shape.valid && shape.key == key && shape.group_end.size() == deposits) {
+      ++reused;
+    } else {
+      map_shape(s, p, buffer.options().subrows, scratch);
+      scratch.shape.key = key;
+    }
+    draw_shape(s, p, buffer, scratch, triangles);
+    return;
+  }
+  const int own_subrows = footprint_subrows(p, buffer.options().subrows);
+  std::vector<SensorHit>& hits = scratch.hits;
+  std::vector<Point2f>& points = scratch.points;
+  const Tangents t = camera_.frame().tangents_at(source_centre(s));
+  const ScenePoint point{t.x, t.y, s.inverse_depth_per_mm};
+  if (p.discs && p.outline != FootprintPlan::kPoint) {
+    model_.clip_discs(point, scratch.discs);
+  } else {
+    scratch.discs.clear();
+  }
+  const std::vector<PupilPoint>* outline = p.outline >= 0 ? &meshes_.outline(p.outline) : nullptr;
+  if (!scratch.discs.empty() && aperture_.is_uniform_convex() && p.outline >= 0) {
+    // The outline less what the discs cut off: with the chief ray inside every disc the cut is
+    // radial (cheap); otherwise the polygon is clipped disc by disc.
+    const std::vector<PupilPoint>& own = meshes_.dense_outline(p.outline);
+    if (centre_passes(scratch.discs)) {
+      disc_reach(meshes_.dense_directions(p.outline), scratch.discs, scratch.reach);
+      reach_clip(own, 1.0, scratch.reach, scratch.clipped);
+    } else {
+      clip_pupil_polygon(own, scratch.discs, scratch.clipped, scratch.clip_work);
+    }
+    if (scratch.clipped.size() < 3) return;
+    outline = &scratch.clipped;
+  }
   // One wavelength group's share of the light.
   auto deposit_group = [&](const SpectralGroup& g, float share) {
-    std::array<float, 4> value{};
-    for (std::size_t c = 0; c < 3; ++c) value[c] = share * (g.m[c][0] * s.rgb[0] + g.m[c][1] * s.rgb[1] + g.m[c][2] * s.rgb[2]);
-    value[3] = share * g.alpha * s.coverage;
+    const std::array<float, 4> value = group_value(s, g, share);
     // A single group's rays are the plan's, at the reference wavelength.
     const bool planned = p.mapped && p.groups == 1 && p.blend == 1.0f;
     if (p.outline == FootprintPlan::kPoint) {
@@ -868,118 +1203,44 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, S
       buffer.add_point({static_cast<float>(c.x), static_cast<float>(c.y)}, v);
       return;
     }
-    if (p.mesh < 0) {
-      // Affine model, uniform convex aperture: the outline, less what first-order vignetting cuts
-      // off, mapped by the affine map of three rays; it keeps the share of the light that passes.
-      static constexpr std::array<PupilPoint, 3> kBasis{{{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}}};
-      PixelPoint o, ex, ey;
-      double centre_weight = p.centre_weight;
-      if (planned) {
-        o = {p.affine_px[0], p.affine_px[1]};
-        ex = {o.x + p.affine_px[2], o.y + p.affine_px[3]};
-        ey = {o.x + p.affine_px[4], o.y + p.affine_px[5]};
-      } else {
-        hits.resize(3);
-        model_.map_passing(point, g.wavelength_nm, kBasis, std::span<SensorHit>(hits.data(), 3));
-        o = camera_.output_pixel(hits[0].x_mm, hits[0].y_mm);
-        ex = camera_.output_pixel(hits[1].x_mm, hits[1].y_mm);
-        ey = camera_.output_pixel(hits[2].x_mm, hits[2].y_mm);
-        centre_weight = hits[0].weight;
-      }
-      std::array<float, 4> v = lit(value, centre_weight);
-      const auto light = static_cast<float>(options_.vignetting ? passing : 1.0);
-      for (std::size_t c = 0; c < 3; ++c) v[c] *= light;
-      if (p.level == 0 && outline == &meshes_.outline(p.outline)) {
-        // The outline scaled about the pixel's centre (no discs cut it): a stamp.
-        const double ax = std::floor(o.x), ay = std::floor(o.y);
-        const double off = std::abs(o.x - ax - 0.5) + std::abs(o.y - ay - 0.5) + std::abs(ex.y - o.y) + std::abs(ey.x - o.x);
-        if (off <= kStampPlacementPx && std::abs(ax) < 1e6 && std::abs(ay) < 1e6) {
-          if (const DifferenceStamp* stamp = stamps_.find(ex.x - o.x, ey.y - o.y)) {
-            buffer.add_stamp(*stamp, static_cast<int>(ax), static_cast<int>(ay), v);
-            return;
-          }
+    // Affine model, uniform convex aperture: the outline, less what first-order vignetting cuts
+    // off, mapped by the affine map of three rays; it keeps the share of the light that passes.
+    static constexpr std::array<PupilPoint, 3> kBasis{{{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}}};
+    PixelPoint o, ex, ey;
+    double centre_weight = p.centre_weight;
+    if (planned) {
+      o = {p.affine_px[0], p.affine_px[1]};
+      ex = {o.x + p.affine_px[2], o.y + p.affine_px[3]};
+      ey = {o.x + p.affine_px[4], o.y + p.affine_px[5]};
+    } else {
+      hits.resize(3);
+      model_.map_passing(point, g.wavelength_nm, kBasis, std::span<SensorHit>(hits.data(), 3));
+      o = camera_.output_pixel(hits[0].x_mm, hits[0].y_mm);
+      ex = camera_.output_pixel(hits[1].x_mm, hits[1].y_mm);
+      ey = camera_.output_pixel(hits[2].x_mm, hits[2].y_mm);
+      centre_weight = hits[0].weight;
+    }
+    std::array<float, 4> v = lit(value, centre_weight);
+    const auto light = static_cast<float>(options_.vignetting ? passing : 1.0);
+    for (std::size_t c = 0; c < 3; ++c) v[c] *= light;
+    if (p.level == 0 && outline == &meshes_.outline(p.outline)) {
+      // The outline scaled about the pixel's centre (no discs cut it): a stamp.
+      const double ax = std::floor(o.x), ay = std::floor(o.y);
+      const double off = std::abs(o.x - ax - 0.5) + std::abs(o.y - ay - 0.5) + std::abs(ex.y - o.y) + std::abs(ey.x - o.x);
+      if (off <= kStampPlacementPx && std::abs(ax) < 1e6 && std::abs(ay) < 1e6) {
+        if (const DifferenceStamp* stamp = stamps_.find(ex.x - o.x, ey.y - o.y)) {
+          buffer.add_stamp(*stamp, static_cast<int>(ax), static_cast<int>(ay), v);
+          return;
         }
       }
-      points.resize(outline->size());
-      for (std::size_t i = 0; i < outline->size(); ++i) {
-        const PupilPoint& q = (*outline)[i];
-        points[i] = {static_cast<float>(o.x + (ex.x - o.x) * q.x + (ey.x - o.x) * q.y),
-                     static_cast<float>(o.y + (ex.y - o.y) * q.x + (ey.y - o.y) * q.y)};
-      }
-      buffer.add_polygon(points, v, own_subrows);
-      return;
     }
-    const PupilMesh& mesh = meshes_.mesh(p.mesh);
-    if (rings_clipped) {
-      deposit_clipped_rings(point, g.wavelength_nm, p, passing, allow_rings, rings_checked, value, buffer, own_subrows, scratch,
-                            triangles);
-      return;
+    points.resize(outline->size());
+    for (std::size_t i = 0; i < outline->size(); ++i) {
+      const PupilPoint& q = (*outline)[i];
+      points[i] = {static_cast<float>(o.x + (ex.x - o.x) * q.x + (ey.x - o.x) * q.y),
+                   static_cast<float>(o.y + (ex.y - o.y) * q.x + (ey.y - o.y) * q.y)};
     }
-    map_cached(point, g.wavelength_nm, 0, mesh.points, hits, scratch, false);
-    points.resize(mesh.points.size());
-    for (std::size_t i = 0; i < mesh.points.size(); ++i) {
-      if (!hits[i].unclipped && !hits[i].ok) continue;
-      const PixelPoint q = camera_.output_pixel(hits[i].x_mm, hits[i].y_mm);
-      points[i] = {static_cast<float>(q.x), static_cast<float>(q.y)};
-    }
-    if (mesh.sectors > 0 && allow_rings &&
-        deposit_ring_polygons(mesh, hits, points, value, options_.vignetting, buffer, own_subrows, rings_checked, scratch)) {
-      return;
-    }
-    // A triangle whose corners a clear aperture partly stops (exact, poly) passes the part of its
-    // area where the linear interpolation of their clearances is >= 0, in place: the beam's edge
-    // falls inside it, to first order.
-    auto triangle_passing = [&hits](const PupilTriangle& tri) {
-      const SensorHit& a = hits[static_cast<std::size_t>(tri.a)];
-      const SensorHit& b = hits[static_cast<std::size_t>(tri.b)];
-      const SensorHit& c = hits[static_cast<std::size_t>(tri.c)];
-      if (!(a.ok || a.unclipped) || !(b.ok || b.unclipped) || !(c.ok || c.unclipped)) return 0.0;
-      return passing_share(a.clearance, b.clearance, c.clearance);
-    };
-    // Colour carries the transmitted fraction and the rays' radiometric weights (vignetting darkens);
-    // coverage is normalised over the light that passes, so a vignetted point is still an opaque
-    // surface. Without vignetting the colour is normalised the same way.
-    double passed = 0.0;
-    for (const PupilTriangle& tri : mesh.triangles) passed += tri.weight * triangle_passing(tri);
-    if (!(passed > 0.0)) return;
-    // Where the model describes its clipping as discs, the light that passes is known exactly (the
-    // outline less the discs); the triangles' linear interpolation only distributes it.
-    const double exact_share = !scratch.discs.empty() && aperture_.is_uniform_convex() ? passing : passed;
-    const double unlit = options_.vignetting ? exact_share / passed : 1.0 / passed;
-    for (const PupilTriangle& tri : mesh.triangles) {
-      const double fraction = triangle_passing(tri);
-      if (fraction == 0.0) continue;
-      const double ray_weight = options_.vignetting ? (hits[tri.a].weight + hits[tri.b].weight + hits[tri.c].weight) / 3.0 : 1.0;
-      const auto w = static_cast<float>(tri.weight * fraction * ray_weight * unlit);
-      const std::array<float, 4> lit_value{value[0] * w, value[1] * w, value[2] * w,
-                                           static_cast<float>(value[3] * tri.weight * fraction / passed)};
-      const std::array<std::size_t, 3> corner{static_cast<std::size_t>(tri.a), static_cast<std::size_t>(tri.b),
-                                              static_cast<std::size_t>(tri.c)};
-      if (fraction >= 1.0) {
-        buffer.add_triangle(points[corner[0]], points[corner[1]], points[corner[2]], lit_value);
-      } else {
-        // Its passing part only, where the interpolated clearance is >= 0, mapped by interpolating
-        // the corners' landing points (first order): spread over the whole triangle's image, the
-        // stopped corners' unclipped landings drew a faint skirt around a vignetted point's bokeh
-        // (a highlight of radiance 200 showed it as a disc twice too wide, docs/bokeh.md "Brightness").
-        std::array<Point2f, 4> clipped{};
-        std::size_t count = 0;
-        for (std::size_t i = 0; i < 3; ++i) {
-          const std::size_t j = (i + 1) % 3;
-          const double ci = hits[corner[i]].clearance, cj = hits[corner[j]].clearance;
-          const Point2f& pi = points[corner[i]];
-          const Point2f& pj = points[corner[j]];
-          if (ci >= 0.0) clipped[count++] = pi;
-          if ((ci >= 0.0) != (cj >= 0.0) && count < clipped.size()) {
-            const auto along = static_cast<float>(ci / (ci - cj));
-            clipped[count++] = {pi.x + along * (pj.x - pi.x), pi.y + along * (pj.y - pi.y)};
-          }
-        }
-        if (count < 3) continue;
-        buffer.add_polygon(std::span<const Point2f>(clipped.data(), count), lit_value);
-      }
-      ++triangles;
-    }
+    buffer.add_polygon(points, v, own_subrows);
   };
   for (const SpectralGroup& g : groups_.split(p.groups)) deposit_group(g, p.blend);
   if (p.blend < 1.0f) {

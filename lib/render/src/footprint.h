@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -49,7 +50,53 @@ struct FootprintPlan {
   // tolerances), and the centre ray's radiometric weight. `mapped` says whether they are set.
   bool mapped = false;
   std::array<float, 6> affine_px{};
-  float centre_weight = 1.0f;
+  float centre_weight = 1.0f;  // every plan whose chief ray passes: its weight at the reference wavelength
+  // A mesh footprint's chief ray at the reference wavelength (output px, x and y): where its shape is
+  // anchored when a neighbour draws it (FootprintShape).
+  std::array<float, 2> chief_px{};
+  // The layer index of the source whose mapped shape this footprint draws, moved to its own chief
+  // ray (FootprintScatter::plan_range), or -1: its own.
+  std::int32_t shape_source = -1;
+};
+
+// What the planner probed of a footprint: where the probe's rays land (output px) at up to three
+// wavelengths (the reference, the lowest, the highest) and which of them land at all.
+struct FootprintProbe {
+  struct Pixel {
+    double x, y;  // read only where `ok` (left uninitialised: see FootprintScatter::plan)
+  };
+  std::array<std::array<Pixel, 9>, 3> px;
+  std::array<std::array<bool, 9>, 3> ok{};
+  std::size_t wavelengths = 0;
+  bool chief_passes = false;  // the pupil centre's ray at the reference wavelength (FootprintPlan::chief_px)
+};
+
+// A mesh footprint as the polygons its wavelength groups' light goes down as, per unit of their
+// value (light in RGB, coverage in alpha), in output px: mapped once, then drawn at its own place and
+// at its neighbours' (FootprintScatter::deposit). `key` is the layer index of the source it stands
+// for; `light_scale` its chief ray's weight times its passing share, which a neighbour's light is
+// scaled against.
+struct FootprintShape {
+  struct Polygon {
+    std::uint32_t begin = 0;  // its vertices in `points`
+    std::uint32_t count = 0;
+    float light = 0.0f;
+    float coverage = 0.0f;
+    int subrows = 0;  // SplatBuffer::add_polygon's
+  };
+  bool valid = false;
+  std::int64_t key = -1;
+  std::array<float, 2> chief_px{};
+  double light_scale = 1.0;
+  std::vector<Point2f> points;
+  std::vector<Polygon> polygons;
+  // Per wavelength-group deposit, in the order FootprintScatter::deposit makes them: where its
+  // polygons end, and how many of them were mesh triangles.
+  std::vector<std::size_t> group_end;
+  std::vector<std::size_t> group_triangles;
+
+  void clear();
+  void add(std::span<const Point2f> vertices, const std::array<float, 4>& unit_value, int subrows);
 };
 
 // Per-thread scratch space, so planning and deposits allocate nothing once warm.
@@ -85,6 +132,14 @@ struct FootprintScratch {
   };
   std::vector<CachedMap> cached_maps;
   std::size_t cached_count = 0;
+  // Planning: the last plan's probe, and the probes of a range's planned sources (plan_range).
+  FootprintProbe probe;
+  std::vector<FootprintProbe> range_probes;
+  // Deposit: the mesh footprint drawn last, for its neighbours; forget_shape() before each band of
+  // rows, so that what a band draws does not depend on which thread drew which band before.
+  FootprintShape shape;
+  std::vector<Point2f> moved_shape;
+  void forget_shape() { shape.valid = false; }
 };
 
 // Sub-rows per pixel (of `buffer_subrows`, the buffer's) at which a footprint's own polygons (its
@@ -93,20 +148,52 @@ struct FootprintScratch {
 // see the y sampling; its mesh triangles keep every sub-row.
 int footprint_subrows(const FootprintPlan& p, int buffer_subrows);
 
+// Whether source i of a layer begins a run of FootprintScatter::plan_range (true past the end): a
+// range of sources planned together should begin at one, so that the plans do not depend on where
+// the ranges are cut.
+bool starts_run(std::span<const ScatterSource> sources, std::size_t i);
+
 // Everything a footprint depends on besides its source; one per render, shared by the threads.
 class FootprintScatter {
  public:
   FootprintScatter(const RayModel& model, const Aperture& aperture, const SpectralGroups& groups,
                    const PupilMeshTable& meshes, const BokehOptions& options);
 
+  // One source's plan; its probe is left in scratch.probe.
   FootprintPlan plan(const ScatterSource& s, FootprintScratch& scratch) const;
-  // Deposits the footprint into `buffer` (the plan's grid level): footprint-sized polygons at the
-  // plan's sub-rows (footprint_subrows), mesh triangles at every sub-row of the buffer. Adds the mesh
-  // triangles deposited to `triangles`.
-  void deposit(const ScatterSource& s, const FootprintPlan& p, SplatBuffer& buffer, FootprintScratch& scratch,
-               std::size_t& triangles) const;
+  // The plans of sources [begin, end) of a layer (indices into `sources` and `plans`). Where
+  // BokehOptions::reuse_shapes is on and the model clips by pupil discs (paraxial, Seidel), a run of
+  // neighbouring pixels of one row whose probes differ from the first's by under kShapeTolerancePx
+  // beyond the move of their chief rays draws the first's mapped shape (FootprintPlan::shape_source):
+  // only the pixels every kShapeStride apart and where that fails are probed, the others map their
+  // chief ray alone (see the .cpp). The result depends on [begin, end) alone, not on the thread.
+  void plan_range(std::span<const ScatterSource> sources, std::span<FootprintPlan> plans, std::size_t begin,
+                  std::size_t end, FootprintScratch& scratch) const;
+  // Deposits the footprint of layer source `index` into `buffer` (the plan's grid level):
+  // footprint-sized polygons at the plan's sub-rows (footprint_subrows), mesh triangles at every
+  // sub-row of the buffer. Adds the mesh triangles deposited to `triangles`, and to `reused` one
+  // where a mesh footprint drew a neighbour's shape from scratch.shape.
+  void deposit(const ScatterSource& s, const FootprintPlan& p, std::size_t index, SplatBuffer& buffer,
+               FootprintScratch& scratch, std::size_t& triangles, std::size_t& reused) const;
 
  private:
+  // The footprint's wavelength groups mapped into scratch.shape (its polygons per unit of each
+  // group's value), and drawn from there at the plan's chief ray with the source's value.
+  void map_shape(const ScatterSource& s, const FootprintPlan& p, int buffer_subrows, FootprintScratch& scratch) const;
+  void draw_shape(const ScatterSource& s, const FootprintPlan& p, SplatBuffer& buffer, FootprintScratch& scratch,
+                  std::size_t& triangles) const;
+  // One group of a mesh not clipped by discs into scratch.shape: its ring polygons where they nest
+  // (and `allow_rings`), else its triangles, each clipped by the interpolated clearances of its
+  // corners (exact, poly); adds those to `triangles`.
+  void record_mesh(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p, bool allow_rings, bool rings_checked,
+                   int own_subrows, FootprintScratch& scratch, std::size_t& triangles) const;
+  // plan_range: whether the sources strictly between planned sources a and b (a run of one row)
+  // may draw a's shape, and their plans when they do.
+  bool shares_shape(std::span<const ScatterSource> sources, std::span<const FootprintPlan> plans, std::size_t a, std::size_t b,
+                    const FootprintProbe& pa, const FootprintProbe& pb) const;
+  bool follow(const ScatterSource& s, const FootprintPlan& a, const FootprintPlan& b, double along, std::int32_t a_index,
+              FootprintPlan& out) const;
+
   // A polar mesh's rings clipped by scratch.discs (first-order vignetting), mapped and deposited as
   // nested rings (at `ring_subrows` sub-rows), or where they do not nest (a cat's eye mapped to a
   // crescent that turns back in y), as the triangles between them at every sub-row (adding them to
@@ -117,7 +204,7 @@ class FootprintScatter {
   // the triangles whether or not the rings nest (another wavelength of the footprint's did not);
   // `shapes_checked`: every ring was found y-monotone and simple at this wavelength already.
   void deposit_clipped_rings(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p, double passing,
-                             bool allow_rings, bool shapes_checked, const std::array<float, 4>& value, SplatBuffer& buffer,
+                             bool allow_rings, bool shapes_checked, const std::array<float, 4>& value, FootprintShape& out,
                              int ring_subrows, FootprintScratch& scratch, std::size_t& triangles) const;
   // model.map (set 0) or map_passing (set 1) of `pupil` at one wavelength into `hits`, from
   // scratch.cached_maps when this footprint mapped them there already, else mapped (and kept when

@@ -58,6 +58,11 @@ struct BokehOptions {
   int spectral_samples = 16;             // wavelength nodes of the quadrature (3..64)
   double chromatic_tolerance_px = 0.5;   // largest colour separation left unresolved within a pixel's bokeh
   double max_blur_px = 1000.0;           // nearer points are clamped to this blur diameter (output px)
+  // true: along a row of pixels, a footprint that differs from its neighbour's by under 1/16 px
+  // beyond the move of its chief ray draws that neighbour's mapped shape, at its own place and with
+  // its own light (paraxial and Seidel models; docs/bokeh.md). false: every footprint mapped on its
+  // own, slower, for checking.
+  bool reuse_shapes = true;
   // Called with the fraction done (0..1) after each band of rows of each layer, from the rendering
   // threads one at a time (never concurrently): it must not assume the calling thread.
   std::function<void(double)> progress;
@@ -74,6 +79,7 @@ struct BokehStatistics {
   std::size_t redepthed_edge_pixels = 0; // edge pixels whose colour is one surface's, moved to its depth
   std::size_t footprints = 0;       // (pixel, wavelength group) footprints deposited
   std::size_t triangles = 0;        // mesh triangles deposited (seidel, exact, masks)
+  std::size_t reused_shapes = 0;    // mesh footprints drawn from a neighbour's mapped shape (BokehOptions::reuse_shapes)
   std::size_t clamped_depths = 0;   // pixels brought back to max_blur_px or in front of the lens
   double max_abs_coc_px = 0.0;      // largest |signed CoC| among the source pixels
   std::size_t deep_samples = 0;     // samples of a layered (deep) input
