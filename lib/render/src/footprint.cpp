@@ -624,7 +624,7 @@ FootprintScatter::FootprintScatter(const RayModel& model, const Aperture& apertu
   }
 }
 
-FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& scratch) const {
+FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& scratch, bool keep_probe) const {
   std::vector<PupilPoint>& pupil = scratch.pupil;
   std::vector<SensorHit>& hits = scratch.hits;
   const PixelPoint centre = source_centre(s);
@@ -636,13 +636,12 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
   pupil.assign(probe_.begin(), probe_.end());
   hits.resize(pupil.size());
   const std::array<double, 3> lambdas{camera_.reference_wavelength_nm(), groups_.lowest_nm(), groups_.highest_nm()};
-  // Kept in scratch.probe for plan_range. `px` is read only where `ok` (not value-initialised:
+  // Copied to scratch.probe for plan_range where asked. On the stack (a thin-lens process took 4 %
+  // longer with it in the scratch space). `px` is read only where `ok` (not value-initialised:
   // zeroing its 432 bytes was a tenth of a thin-lens plan's time).
-  FootprintProbe& probe = scratch.probe;
+  FootprintProbe probe;
   auto& px = probe.px;
   auto& ok = probe.ok;  // where the ray lands is known (it passes, or would)
-  ok = {};
-  probe.chief_passes = false;
   double x_min = kInfinity, x_max = -kInfinity, y_min = kInfinity, y_max = -kInfinity;
   // Without dispersion (a thin lens, or colour off) one wavelength tells all.
   const std::size_t wavelengths = camera_.is_thin_lens() || !options_.spectral ? 1 : 3;
@@ -704,7 +703,10 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
       y_max = std::max(y_max, px[l][i].y);
     }
   }
-  if (probe.chief_passes) p.chief_px = {static_cast<float>(px[0][0].x), static_cast<float>(px[0][0].y)};
+  if (probe.chief_passes && !affine) {  // (an affine plan has them from its three rays)
+    p.affine_px[0] = static_cast<float>(px[0][0].x);
+    p.affine_px[1] = static_cast<float>(px[0][0].y);
+  }
   if (!(y_min <= y_max)) {
     // No probe ray got through (the exact model, fully vignetted): plan a small mesh around the
     // pixel so the rays that do pass are still found.
@@ -778,6 +780,7 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
     const int own_step = p.mesh >= 0 ? PupilMeshTable::sector_step_of_mesh(p.mesh) : p.outline;
     p.passing = static_cast<float>(disc_passing_share(scratch.discs, own_step, scratch));
   }
+  if (keep_probe) scratch.probe = probe;
   return p;
 }
 
@@ -854,9 +857,10 @@ bool FootprintScatter::follow(const ScatterSource& s, const FootprintPlan& a, co
   if (!hit[0].ok) return false;
   const PixelPoint c = camera_.output_pixel(hit[0].x_mm, hit[0].y_mm);
   out = a;
-  out.chief_px = {static_cast<float>(c.x), static_cast<float>(c.y)};
+  out.affine_px[0] = static_cast<float>(c.x);
+  out.affine_px[1] = static_cast<float>(c.y);
   out.centre_weight = static_cast<float>(hit[0].weight);
-  const float dy = out.chief_px[1] - a.chief_px[1];
+  const float dy = out.affine_px[1] - a.affine_px[1];
   out.y_min = a.y_min + dy;
   out.y_max = a.y_max + dy;
   const auto f = static_cast<float>(along);
@@ -881,7 +885,7 @@ void FootprintScatter::plan_range(std::span<const ScatterSource> sources, std::s
   std::vector<FootprintProbe>& probes = scratch.range_probes;
   probes.resize(end - begin);
   auto full = [&](std::size_t i) {
-    plans[i] = plan(sources[i], scratch);
+    plans[i] = plan(sources[i], scratch, true);
     probes[i - begin] = scratch.probe;
   };
   // Between planned a and b: all follow a where they may, else the middle is planned and each half
@@ -1019,7 +1023,7 @@ void FootprintScatter::map_shape(const ScatterSource& s, const FootprintPlan& p,
     for (const SpectralGroup& g : groups_.split(p.groups - 1)) record_group(g);
   }
   shape.valid = true;
-  shape.chief_px = p.chief_px;
+  shape.chief_px = {p.affine_px[0], p.affine_px[1]};
   shape.light_scale = static_cast<double>(p.centre_weight) * passing;
 }
 
@@ -1104,7 +1108,7 @@ void FootprintScatter::draw_shape(const ScatterSource& s, const FootprintPlan& p
   // share against the neighbour's (both change slowly along a row; 1 for the source's own shape).
   double scale = 1.0;
   if (options_.vignetting && shape.light_scale > 0.0) scale = static_cast<double>(p.centre_weight) * p.passing / shape.light_scale;
-  const float dx = p.chief_px[0] - shape.chief_px[0], dy = p.chief_px[1] - shape.chief_px[1];
+  const float dx = p.affine_px[0] - shape.chief_px[0], dy = p.affine_px[1] - shape.chief_px[1];
   std::size_t group = 0;
   auto draw_group = [&](const SpectralGroup& g, float share) {
     std::array<float, 4> value = group_value(s, g, share);

@@ -39,21 +39,20 @@ struct FootprintPlan {
   int mesh = -1;       // PupilMeshTable mesh index, or -1 for the single-polygon and point paths
   int outline = 0;     // PupilMeshTable sector step (single polygon), or kPoint
   int level = 0;       // the splat grid: 2^level output px per cell side (large footprints are coarse)
-  bool discs = false;  // the model clips this point's beam by pupil discs (RayModel::clip_discs)
   // Share of a uniform convex aperture that passes those discs, measured on an outline of at least
   // PupilMeshTable::kShareSectorStep's vertices (1 without discs; 0: the whole beam is stopped).
   float passing = 1.0f;
+  bool discs = false;  // the model clips this point's beam by pupil discs (RayModel::clip_discs)
   // An affine footprint's rays at the reference wavelength, kept for the deposit of a single
   // wavelength group (whose wavelength that is), which would map them again: where the pupil's
   // centre lands (output px, x and y), where its points (1, 0) and (0, 1) land relative to it (px,
   // x and y each: differences of floats near 1000 would be off by 1e-4 px, beyond the stamps'
   // tolerances), and the centre ray's radiometric weight. `mapped` says whether they are set.
+  // Every plan whose chief ray passes has the first two (where a mesh footprint's shape is anchored
+  // when a neighbour draws it: FootprintShape) and the weight.
   bool mapped = false;
   std::array<float, 6> affine_px{};
-  float centre_weight = 1.0f;  // every plan whose chief ray passes: its weight at the reference wavelength
-  // A mesh footprint's chief ray at the reference wavelength (output px, x and y): where its shape is
-  // anchored when a neighbour draws it (FootprintShape).
-  std::array<float, 2> chief_px{};
+  float centre_weight = 1.0f;
   // The layer index of the source whose mapped shape this footprint draws, moved to its own chief
   // ray (FootprintScatter::plan_range), or -1: its own.
   std::int32_t shape_source = -1;
@@ -68,7 +67,7 @@ struct FootprintProbe {
   std::array<std::array<Pixel, 9>, 3> px;
   std::array<std::array<bool, 9>, 3> ok{};
   std::size_t wavelengths = 0;
-  bool chief_passes = false;  // the pupil centre's ray at the reference wavelength (FootprintPlan::chief_px)
+  bool chief_passes = false;  // the pupil centre's ray at the reference wavelength (FootprintPlan::affine_px)
 };
 
 // A mesh footprint as the polygons its wavelength groups' light goes down as, per unit of their
@@ -86,7 +85,7 @@ struct FootprintShape {
   };
   bool valid = false;
   std::int64_t key = -1;
-  std::array<float, 2> chief_px{};
+  std::array<float, 2> chief_px{};  // where its source's chief ray lands (FootprintPlan::affine_px)
   double light_scale = 1.0;
   std::vector<Point2f> points;
   std::vector<Polygon> polygons;
@@ -159,8 +158,8 @@ class FootprintScatter {
   FootprintScatter(const RayModel& model, const Aperture& aperture, const SpectralGroups& groups,
                    const PupilMeshTable& meshes, const BokehOptions& options);
 
-  // One source's plan; its probe is left in scratch.probe.
-  FootprintPlan plan(const ScatterSource& s, FootprintScratch& scratch) const;
+  // One source's plan; its probe is left in scratch.probe where `keep_probe`.
+  FootprintPlan plan(const ScatterSource& s, FootprintScratch& scratch, bool keep_probe = false) const;
   // The plans of sources [begin, end) of a layer (indices into `sources` and `plans`). Where
   // BokehOptions::reuse_shapes is on and the model clips by pupil discs (paraxial, Seidel), a run of
   // neighbouring pixels of one row whose probes differ from the first's by under kShapeTolerancePx
