@@ -122,15 +122,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
 
     plans.resize(layer.size());
     plan_rows.resize(layer.size());
-    // In ranges of about kPlanRange sources, each beginning where a run of neighbours that may share
-    // a mapped shape begins: which neighbours share one depends neither on the threads nor on where
-    // the ranges are cut.
-    range_begin.clear();
-    for (std::size_t i = 0; i < layer.size(); i += kPlanRange) {
-      while (!render_detail::starts_run(layer, i)) ++i;
-      if (i < layer.size()) range_begin.push_back(i);
-    }
-    range_begin.push_back(layer.size());
+    render_detail::plan_range_starts(layer, kPlanRange, range_begin);
     const std::size_t ranges = range_begin.size() - 1;
 #pragma omp parallel num_threads(threads)
     {

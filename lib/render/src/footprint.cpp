@@ -61,6 +61,11 @@ constexpr double kShapeTolerancePx = 1.0 / 16.0;
 constexpr float kShapePassingTolerance = 0.004f;
 // Grid cells of an aperture-picture mesh per pixel of footprint size.
 constexpr double kPxPerGridCell = 1.5;
+// Pupil points: the centre (the chief ray), and the centre with the two axes' unit points (an affine
+// model's map); the unit value a footprint's shape is recorded at (FootprintShape).
+constexpr std::array<PupilPoint, 1> kCentre{{{0.0, 0.0}}};
+constexpr std::array<PupilPoint, 3> kBasis{{{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}}};
+constexpr std::array<float, 4> kUnit{1.0f, 1.0f, 1.0f, 1.0f};
 // Footprint heights (grid cells, with margins) from which half and a quarter of the sub-rows are used
 // for its own polygons (footprint_subrows).
 constexpr float kMediumFootprintPx = 10.0f;
@@ -423,9 +428,9 @@ bool deposit_nested_rings(const std::vector<std::span<const Point2f>>& rings, co
   for (const FootprintScratch::RingDeposit& d : deposits) {
     std::span<const Point2f> ring = rings[static_cast<std::size_t>(d.ring) - 1];
     if (fx != 0.0f || fy != 0.0f) {
-      scratch.moved_ring.resize(ring.size());
-      for (std::size_t j = 0; j < ring.size(); ++j) scratch.moved_ring[j] = {ring[j].x + fx, ring[j].y + fy};
-      ring = scratch.moved_ring;
+      scratch.moved.resize(ring.size());
+      for (std::size_t j = 0; j < ring.size(); ++j) scratch.moved[j] = {ring[j].x + fx, ring[j].y + fy};
+      ring = scratch.moved;
     }
     const auto f = static_cast<float>(d.light);
     const auto c = static_cast<float>(d.coverage);
@@ -664,7 +669,6 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
   for (std::size_t l = 0; l < wavelengths; ++l) {
     if (affine) {
       // An affine model (which clips by discs only) maps the probe through three rays.
-      static constexpr std::array<PupilPoint, 3> kBasis{{{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}}};
       std::array<SensorHit, 3> basis;
       model_.map_passing(point, lambdas[l], kBasis, basis);
       if (l == 0) {
@@ -796,11 +800,21 @@ bool joins_run(std::span<const ScatterSource> sources, std::size_t i) {
   return q.y == p.y && q.x == p.x + 1 && q.coverage_only == p.coverage_only && whole_pixel(p) && whole_pixel(q);
 }
 
-}  // namespace
-
+// Whether source i begins a run (true past the end).
 bool starts_run(std::span<const ScatterSource> sources, std::size_t i) {
   constexpr auto stride = static_cast<int>(kShapeStride);
   return i == 0 || i >= sources.size() || ((sources[i].x % stride) + stride) % stride == 0 || !joins_run(sources, i);
+}
+
+}  // namespace
+
+void plan_range_starts(std::span<const ScatterSource> sources, std::size_t target, std::vector<std::size_t>& starts) {
+  starts.clear();
+  for (std::size_t i = 0; i < sources.size(); i += target) {
+    while (!starts_run(sources, i)) ++i;
+    if (i < sources.size()) starts.push_back(i);
+  }
+  starts.push_back(sources.size());
 }
 
 bool FootprintScatter::shares_shape(std::span<const ScatterSource> sources, std::span<const FootprintPlan> plans, std::size_t a,
@@ -808,9 +822,9 @@ bool FootprintScatter::shares_shape(std::span<const ScatterSource> sources, std:
   const FootprintPlan& A = plans[a];
   const FootprintPlan& B = plans[b];
   // The same kind of deposit: a mesh (the single polygon and the point are cheap already), the same
-  // mesh, grid and wavelength-group splits, both keeping light, both planned from their own probe.
+  // mesh, grid and wavelength-group splits, some of the beam passing in both.
   if (A.mesh < 0 || A.mesh != B.mesh || A.level != B.level || A.groups != B.groups || (A.blend < 1.0f) != (B.blend < 1.0f) ||
-      A.discs != B.discs || A.shape_source >= 0 || B.shape_source >= 0 || !(A.passing > 0.0f && B.passing > 0.0f)) {
+      A.discs != B.discs || !(A.passing > 0.0f && B.passing > 0.0f)) {
     return false;
   }
   if (!pa.chief_passes || !pb.chief_passes || pa.wavelengths != pb.wavelengths) return false;
@@ -847,7 +861,6 @@ bool FootprintScatter::follow(const ScatterSource& s, const FootprintPlan& a, co
   // pixel along a row), a's shape, the rest interpolated between a and b.
   const Tangents t = camera_.frame().tangents_at(source_centre(s));
   const ScenePoint point{t.x, t.y, s.inverse_depth_per_mm};
-  static constexpr std::array<PupilPoint, 1> kCentre{{{0.0, 0.0}}};
   std::array<SensorHit, 1> hit;
   if (a.discs) {
     model_.map_passing(point, camera_.reference_wavelength_nm(), kCentre, hit);
@@ -1006,7 +1019,6 @@ void FootprintScatter::map_shape(const ScatterSource& s, const FootprintPlan& p,
   FootprintShape& shape = scratch.shape;
   shape.clear();
   // One wavelength group's polygons, per unit of its value.
-  static constexpr std::array<float, 4> kUnit{1.0f, 1.0f, 1.0f, 1.0f};
   auto record_group = [&](const SpectralGroup& g) {
     std::size_t triangles = 0;
     if (rings_clipped) {
@@ -1032,7 +1044,6 @@ void FootprintScatter::record_mesh(const ScenePoint& point, double wavelength_nm
   std::vector<SensorHit>& hits = scratch.hits;
   std::vector<Point2f>& points = scratch.points;
   FootprintShape& shape = scratch.shape;
-  static constexpr std::array<float, 4> kUnit{1.0f, 1.0f, 1.0f, 1.0f};
   const PupilMesh& mesh = meshes_.mesh(p.mesh);
   map_cached(point, wavelength_nm, 0, mesh.points, hits, scratch, false);
   points.resize(mesh.points.size());
@@ -1120,9 +1131,9 @@ void FootprintScatter::draw_shape(const ScatterSource& s, const FootprintPlan& p
       const FootprintShape::Polygon& q = shape.polygons[k];
       std::span<const Point2f> vertices(shape.points.data() + q.begin, q.count);
       if (dx != 0.0f || dy != 0.0f) {
-        scratch.moved_shape.resize(q.count);
-        for (std::size_t j = 0; j < q.count; ++j) scratch.moved_shape[j] = {vertices[j].x + dx, vertices[j].y + dy};
-        vertices = scratch.moved_shape;
+        scratch.moved.resize(q.count);
+        for (std::size_t j = 0; j < q.count; ++j) scratch.moved[j] = {vertices[j].x + dx, vertices[j].y + dy};
+        vertices = scratch.moved;
       }
       buffer.add_polygon(vertices, {value[0] * q.light, value[1] * q.light, value[2] * q.light, value[3] * q.coverage}, q.subrows);
     }
@@ -1189,7 +1200,6 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, s
       PixelPoint c{p.affine_px[0], p.affine_px[1]};
       double centre_weight = p.centre_weight;
       if (!planned) {
-        static constexpr std::array<PupilPoint, 1> kCentre{{{0.0, 0.0}}};
         hits.resize(1);
         // With discs the passing share is known (a cat's eye may leave the chief ray out).
         if (!p.discs) {
@@ -1209,7 +1219,6 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, s
     }
     // Affine model, uniform convex aperture: the outline, less what first-order vignetting cuts
     // off, mapped by the affine map of three rays; it keeps the share of the light that passes.
-    static constexpr std::array<PupilPoint, 3> kBasis{{{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}}};
     PixelPoint o, ex, ey;
     double centre_weight = p.centre_weight;
     if (planned) {

@@ -119,7 +119,7 @@ struct FootprintScratch {
     double coverage = 0.0;
   };
   std::vector<RingDeposit> ring_deposits;
-  std::vector<Point2f> moved_ring;
+  std::vector<Point2f> moved;  // a ring or a shared shape's polygon moved (deposit_nested_rings, draw_shape)
   std::vector<Point2f> ring_points;  // mapped points of the ring polygons, untangled (footprint.cpp)
   std::vector<std::span<const Point2f>> ring_spans;
   // One footprint's maps at each of its wavelengths, kept from the check whether its rings nest at
@@ -137,7 +137,6 @@ struct FootprintScratch {
   // Deposit: the mesh footprint drawn last, for its neighbours; forget_shape() before each band of
   // rows, so that what a band draws does not depend on which thread drew which band before.
   FootprintShape shape;
-  std::vector<Point2f> moved_shape;
   void forget_shape() { shape.valid = false; }
 };
 
@@ -147,10 +146,11 @@ struct FootprintScratch {
 // see the y sampling; its mesh triangles keep every sub-row.
 int footprint_subrows(const FootprintPlan& p, int buffer_subrows);
 
-// Whether source i of a layer begins a run of FootprintScatter::plan_range (true past the end): a
-// range of sources planned together should begin at one, so that the plans do not depend on where
-// the ranges are cut.
-bool starts_run(std::span<const ScatterSource> sources, std::size_t i);
+// Where the ranges of a layer's sources planned together (FootprintScatter::plan_range) begin, about
+// `target` sources apart, each where a run of neighbours that may share a mapped shape begins, so
+// that the plans depend neither on the threads nor on where the ranges are cut; the last entry is
+// sources.size().
+void plan_range_starts(std::span<const ScatterSource> sources, std::size_t target, std::vector<std::size_t>& starts);
 
 // Everything a footprint depends on besides its source; one per render, shared by the threads.
 class FootprintScatter {
