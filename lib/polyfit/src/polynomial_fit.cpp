@@ -1,5 +1,5 @@
 // Greedy term selection by order-recursive matching pursuit, then the coefficients by a column-pivoting
-// QR (Ceres, through lensmith/solve, under a robust loss).
+// QR (Eigen), or under a robust loss by Ceres (through lensmith/solve).
 // Selection: with Q an orthonormal basis of the chosen columns and r = t - Q Q^T t the least-squares
 // residual, adding column a_j lowers |r|^2 by <r, a_j>^2 / |a_j - Q Q^T a_j|^2 (r is orthogonal to
 // Q). The denominators are updated by one dot product per step, so a step costs O(pool * samples).
