@@ -1385,6 +1385,21 @@ TEST_CASE("an OpenEXR header attribute of negative size is an IoError, not an al
   CHECK_THROWS_WITH(read_radiance_image(damaged), Contains("'weird' has a negative size"));
 }
 
+TEST_CASE("an OpenEXR header naming an attribute twice is an IoError, not pixels sized by one copy and decoded by the other", "[render][image_io]") {
+  // Found by CI's exr_image fuzz run on 0ac7166: a flat 5 x 4 picture with a second header after
+  // the first, whose dataWindow is 4194309 x 4. OpenEXR's C++ reader keeps the last copy (5 x 4,
+  // what the pixels were sized for); OpenEXRCore, which decodes the chunks, the first, and wrote
+  // its 4-million-pixel rows past them (ASan: SEGV in exr_decoding_run).
+  const fs::path damaged = fs::path(LENSMITH_SOURCE_DIR) / "tests/fuzz/corpus/exr_image/duplicate-data-window.exr";
+  CHECK_THROWS_AS(read_radiance_image(damaged), IoError);
+  CHECK_THROWS_WITH(read_radiance_image(damaged), Contains("duplicate-data-window.exr") && Contains("appears twice"));
+  CHECK_THROWS_AS(read_image_metadata(damaged), IoError);
+  // The sound file the fuzzer started from reads.
+  const auto sound = read_radiance_image(fs::path(LENSMITH_SOURCE_DIR) / "tests/fuzz/corpus/exr_image/flat-none.exr");
+  CHECK(sound.width == 5);
+  CHECK(sound.height == 4);
+}
+
 TEST_CASE("an OpenEXR whose tiles are 2^29 pixels or more is an IoError, not an allocation OpenEXR's int arithmetic wrapped", "[render][image_io]") {
   // Found by tests/fuzz's exr_image target: a deep tiled header with a huge tile made OpenEXR 3.1
   // size its sample-count table as xSize * ySize * 4 in an int and allocate 2^64 - 2^31 bytes.

@@ -222,7 +222,11 @@ std::size_t fixed_value_bytes(std::string_view type) {
 // then per part a header of attributes (name, type, 32-bit little-endian size, value) ended by an
 // empty name; a multi-part file ends its headers with one more empty name. Where the walk cannot
 // follow, OpenEXR's own checks decide.
-void check_header_sizes(const fs::path& path) {
+// The walk also refuses an attribute named twice in one header: OpenEXR 3.1's C++ reader keeps the
+// last copy and OpenEXRCore the first, so a damaged file with two data windows was sized by one and
+// decoded by the other, past the end of the pixels (found by CI's exr_image fuzz run on 0ac7166).
+// No writer makes such a header (OpenEXR's own keeps its attributes in a map).
+void check_header_attributes(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   std::error_code ec;
   const std::uintmax_t length = fs::file_size(path, ec);
@@ -255,10 +259,14 @@ void check_header_sizes(const fs::path& path) {
   };
   for (int part = 0; part < 1 << 16; ++part) {
     std::string name, type;
-    int attributes = 0;
+    std::set<std::string> names;
     while (true) {
       if (!read_name(name)) return;
       if (name.empty()) break;
+      if (!names.insert(name).second) {
+        throw IoError(path.string() + ": cannot read the OpenEXR image: header attribute '" + name +
+                      "' appears twice (a damaged file: OpenEXR's readers disagree on which copy counts)");
+      }
       std::uint32_t size = 0;
       if (!read_name(type) || !read_u32(size)) return;
       // OpenEXR reads the size as a signed int: a negative one became an allocation of 2^64 - |size|
@@ -295,14 +303,13 @@ void check_header_sizes(const fs::path& path) {
         in.seekg(static_cast<std::streamoff>(size), std::ios::cur);
       }
       if (!in) return;
-      ++attributes;
     }
-    if (!multipart || attributes == 0) return;
+    if (!multipart || names.empty()) return;
   }
 }
 
 std::unique_ptr<Imf::MultiPartInputFile> open_exr(const fs::path& path) {
-  check_header_sizes(path);
+  check_header_attributes(path);
   try {
     return std::make_unique<Imf::MultiPartInputFile>(path.c_str());
   } catch (const std::exception& e) {
@@ -436,6 +443,27 @@ bool read_exr_chunks(const fs::path& path, const Imf::MultiPartInputFile& file, 
   if (exr_result_t code = exr_get_data_window(context, 0, &window); code != EXR_ERR_SUCCESS) throw failed(code);
   if (exr_result_t code = exr_get_scanlines_per_chunk(context, 0, &lines); code != EXR_ERR_SUCCESS) throw failed(code);
   if (exr_result_t code = exr_get_chunk_count(context, 0, &chunks); code != EXR_ERR_SUCCESS) throw failed(code);
+  // The pixels were sized from the C++ reader's header; OpenEXRCore parses the header again, and
+  // where the two read it differently (check_header_attributes refuses the one way known) the chunks
+  // would be decoded past the pixels' end.
+  const Imath::Box2i sized = header.dataWindow();
+  const exr_attr_chlist_t* core_channels = nullptr;
+  exr_compression_t compression = EXR_COMPRESSION_NONE;
+  if (exr_result_t code = exr_get_channels(context, 0, &core_channels); code != EXR_ERR_SUCCESS) throw failed(code);
+  if (exr_result_t code = exr_get_compression(context, 0, &compression); code != EXR_ERR_SUCCESS) throw failed(code);
+  int header_channels = 0;
+  for (auto it = header.channels().begin(); it != header.channels().end(); ++it) ++header_channels;
+  bool same_channels = core_channels->num_channels == header_channels;
+  for (int c = 0; same_channels && c < core_channels->num_channels; ++c) {
+    const exr_attr_chlist_entry_t& entry = core_channels->entries[c];
+    const Imf::Channel* ch = header.channels().findChannel(entry.name.str);
+    same_channels = ch != nullptr && static_cast<int>(ch->type) == static_cast<int>(entry.pixel_type) && entry.x_sampling == 1 &&
+                    entry.y_sampling == 1;
+  }
+  if (window.min.x != sized.min.x || window.min.y != sized.min.y || window.max.x != sized.max.x || window.max.y != sized.max.y ||
+      static_cast<int>(compression) != static_cast<int>(header.compression()) || !same_channels || lines < 1) {
+    throw IoError(path.string() + ": cannot read the OpenEXR pixels: OpenEXR's two readers read the header differently (a damaged file)");
+  }
   const std::size_t width = static_cast<std::size_t>(window.max.x) - static_cast<std::size_t>(window.min.x) + 1;
   const std::size_t row_floats = width * stride;
   std::atomic<int> next{0};
@@ -445,6 +473,11 @@ bool read_exr_chunks(const fs::path& path, const Imf::MultiPartInputFile& file, 
       exr_chunk_info_t chunk{};
       exr_decode_pipeline_t decoder = EXR_DECODE_PIPELINE_INITIALIZER;
       exr_result_t code = exr_read_scanline_chunk_info(context, 0, window.min.y + k * lines, &chunk);
+      // A chunk is decoded only where it lies in the window the pixels were sized for.
+      if (code == EXR_ERR_SUCCESS && (chunk.start_y < window.min.y || chunk.height < 1 || std::int64_t{chunk.start_y} + chunk.height - 1 > window.max.y ||
+                                      static_cast<std::size_t>(chunk.width) != width)) {
+        code = EXR_ERR_BAD_CHUNK_LEADER;
+      }
       if (code == EXR_ERR_SUCCESS) code = exr_decoding_initialize(context, 0, &chunk, &decoder);
       if (code == EXR_ERR_SUCCESS) {
         for (int16_t d = 0; d < decoder.channel_count; ++d) {
