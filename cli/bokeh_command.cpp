@@ -789,7 +789,10 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
 
   OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture, windows);
   meta.extra.insert(meta.extra.end(), {{"hidden_surfaces", std::string(to_string(options.hidden))}, {"edge_pixels", o.edge_pixels}});
-  const std::string written = write_bokeh_output(out, meta, o, depth, other, color, extras);
+  const int out_width = out.width, out_height = out.height;
+  // Moved, not copied: the picture and depth are frame-sized (copying them cost the street scene's
+  // process 4 MB of fresh memory).
+  const std::string written = write_bokeh_output(std::move(out), meta, o, std::move(depth), std::move(other), color, extras);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   std::ostringstream what;
   what << output.string() << " (" << written << ") in " << std::fixed << std::setprecision(2) << seconds
@@ -817,7 +820,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   // copies of the input's edge (streaks). Below this share of the frame (the Canon 35 mm's distortion:
   // 4.4 px of 427) it goes unremarked.
   constexpr double kEdgeGapShare = 0.02;
-  if (stats.edge_gap_px > kEdgeGapShare * std::min(out.width, out.height) && !global.quiet) {
+  if (stats.edge_gap_px > kEdgeGapShare * std::min(out_width, out_height) && !global.quiet) {
     std::cerr << "note: the lens photographs up to " << format_rounded(stats.edge_gap_px, 3)
               << " px past the input's edge (a tilt, a shift or distortion): that band repeats the input's edge pixels; "
                  "render the input with overscan (docs/sequences.md, \"Overscan\")\n";

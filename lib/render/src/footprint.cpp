@@ -680,13 +680,27 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
         p.centre_weight = static_cast<float>(basis[0].weight);
         p.mapped = basis[0].ok;
       }
+      // The probe's landings from the three rays' (output pixels are affine in sensor mm), with
+      // the centre ray's fate: an affine model clips by discs only, which the probe ignores.
+      const PixelPoint o = camera_.output_pixel(basis[0].x_mm, basis[0].y_mm);
+      const PixelPoint ex = camera_.output_pixel(basis[1].x_mm, basis[1].y_mm);
+      const PixelPoint ey = camera_.output_pixel(basis[2].x_mm, basis[2].y_mm);
+      const double axx = ex.x - o.x, axy = ex.y - o.y, ayx = ey.x - o.x, ayy = ey.y - o.y;
+      const bool lands = basis[0].ok || basis[0].unclipped;
+      any_clipped = any_clipped || !basis[0].ok;
+      if (l == 0 && basis[0].ok) probe.chief_passes = true;
       for (std::size_t i = 0; i < 9; ++i) {
-        SensorHit& h = hits[i];
-        h = basis[0];
-        h.x_mm += (basis[1].x_mm - basis[0].x_mm) * pupil[i].x + (basis[2].x_mm - basis[0].x_mm) * pupil[i].y;
-        h.y_mm += (basis[1].y_mm - basis[0].y_mm) * pupil[i].x + (basis[2].y_mm - basis[0].y_mm) * pupil[i].y;
+        ok[l][i] = lands;
+        if (!lands) continue;
+        px[l][i] = {o.x + axx * pupil[i].x + ayx * pupil[i].y, o.y + axy * pupil[i].x + ayy * pupil[i].y};
+        x_min = std::min(x_min, px[l][i].x);
+        x_max = std::max(x_max, px[l][i].x);
+        y_min = std::min(y_min, px[l][i].y);
+        y_max = std::max(y_max, px[l][i].y);
       }
-    } else if (scratch.discs.empty()) {
+      continue;
+    }
+    if (scratch.discs.empty()) {
       model_.map(point, lambdas[l], pupil, hits);
     } else {
       model_.map_passing(point, lambdas[l], pupil, hits);

@@ -1,6 +1,7 @@
 #include "hidden_surfaces.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -82,20 +83,37 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
     pass(0, 1, true);
     pass(bh - 1, -1, false);
   }
+  // The targets, in row order: each thread scans a block of rows into its own list (the box is up
+  // to the frame, once per layer).
+  const int blocks = std::max(1, std::min(threads, bh));
+  scratch.block_targets.resize(static_cast<std::size_t>(blocks));
+  std::vector<std::array<int, 4>> block_box(static_cast<std::size_t>(blocks), std::array<int, 4>{w, -1, h, -1});
+#pragma omp parallel for num_threads(threads) schedule(static, 1)
+  for (int b = 0; b < blocks; ++b) {
+    std::vector<std::size_t>& found = scratch.block_targets[static_cast<std::size_t>(b)];
+    std::array<int, 4>& box = block_box[static_cast<std::size_t>(b)];
+    found.clear();
+    for (int y = static_cast<int>(static_cast<long long>(bh) * b / blocks); y < static_cast<int>(static_cast<long long>(bh) * (b + 1) / blocks); ++y) {
+      for (int x = 0; x < bw; ++x) {
+        if (!within[static_cast<std::size_t>(y) * bw + x]) continue;
+        const std::size_t i = frame_index(x, y);
+        if (!(layers.unknown_behind(i, layer) > 0.0f)) continue;
+        found.push_back(i);
+        box = {std::min(box[0], bx0 + x), std::max(box[1], bx0 + x), std::min(box[2], by0 + y), std::max(box[3], by0 + y)};
+      }
+    }
+  }
   std::vector<std::size_t>& targets = scratch.targets;
   targets.clear();
   int x0 = w, x1 = -1, y0 = h, y1 = -1;
-  for (int y = 0; y < bh; ++y) {
-    for (int x = 0; x < bw; ++x) {
-      if (!within[static_cast<std::size_t>(y) * bw + x]) continue;
-      const std::size_t i = frame_index(x, y);
-      if (!(layers.unknown_behind(i, layer) > 0.0f)) continue;
-      targets.push_back(i);
-      x0 = std::min(x0, bx0 + x);
-      x1 = std::max(x1, bx0 + x);
-      y0 = std::min(y0, by0 + y);
-      y1 = std::max(y1, by0 + y);
-    }
+  for (int b = 0; b < blocks; ++b) {
+    const std::vector<std::size_t>& found = scratch.block_targets[static_cast<std::size_t>(b)];
+    targets.insert(targets.end(), found.begin(), found.end());
+    const std::array<int, 4>& box = block_box[static_cast<std::size_t>(b)];
+    x0 = std::min(x0, box[0]);
+    x1 = std::max(x1, box[1]);
+    y0 = std::min(y0, box[2]);
+    y1 = std::max(y1, box[3]);
   }
   if (targets.empty()) return 0;
   // Push-pull over the window of the targets widened by the reach, where the layer's pixels that
