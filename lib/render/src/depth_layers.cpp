@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 
 #include "lensmith/core/units.h"
 
@@ -19,31 +20,36 @@ int LayerSpacing::layer_at(double coc_px) const {
   return std::clamp(static_cast<int>(std::floor((coc_px - coc_min_px) / spacing_px)), 0, count - 1);
 }
 
-DepthLayers make_depth_layers(const ScatterSources& sources, int width, int height, const LayerSpacing& spacing) {
+DepthLayers make_depth_layers(const ScatterSources& sources, int width, int height, const LayerSpacing& spacing, int threads) {
   DepthLayers l;
   static_cast<LayerSpacing&>(l) = spacing;
   l.members.assign(static_cast<std::size_t>(l.count), {});
   l.max_blur_px.assign(static_cast<std::size_t>(l.count), 0.0);
   const std::size_t pixel_count = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  // Each source's layer, once (threads); the passes below are serial, as each appends in source order.
+  const auto n = static_cast<std::ptrdiff_t>(sources.size());
+  LargeVector<std::int32_t> layer_of(sources.size());
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (std::ptrdiff_t i = 0; i < n; ++i) layer_of[static_cast<std::size_t>(i)] = spacing.layer_at(sources[static_cast<std::size_t>(i)].coc_px);
   // Parts grouped by pixel: counted, then placed (a split pixel's second part comes at the end of
-  // the sources).
+  // the sources). Sources beyond the frame (the scatter's margin) are no pixel's parts: they only
+  // scatter. Each layer's members in one block of their final size: grown by doubling, the lists
+  // were copied to fresh memory again and again (half a thousand page faults on a 600 x 400 frame).
   l.part_begin.assign(pixel_count + 1, 0);
-  // Sources beyond the frame (the scatter's margin) are no pixel's parts: they only scatter.
   auto inside = [&](const ScatterSource& s) { return s.x >= 0 && s.y >= 0 && s.x < width && s.y < height; };
-  for (const ScatterSource& s : sources) {
+  std::vector<std::size_t> member_count(static_cast<std::size_t>(l.count), 0);
+  for (std::size_t i = 0; i < sources.size(); ++i) {
+    const ScatterSource& s = sources[i];
     if (inside(s)) ++l.part_begin[static_cast<std::size_t>(s.y) * width + s.x + 1];
+    ++member_count[static_cast<std::size_t>(layer_of[i])];
   }
   for (std::size_t p = 0; p < pixel_count; ++p) l.part_begin[p + 1] += l.part_begin[p];
   l.parts.resize(l.part_begin[pixel_count]);
-  // Each layer's members in one block of their final size: grown by doubling, the lists were
-  // copied to fresh memory again and again (half a thousand page faults on a 600 x 400 frame).
-  std::vector<std::size_t> member_count(static_cast<std::size_t>(l.count), 0);
-  for (const ScatterSource& s : sources) ++member_count[static_cast<std::size_t>(spacing.layer_at(s.coc_px))];
   for (std::size_t k = 0; k < member_count.size(); ++k) l.members[k].reserve(member_count[k]);
   LargeVector<std::uint32_t> next(l.part_begin.begin(), l.part_begin.end() - 1);
   for (std::size_t i = 0; i < sources.size(); ++i) {
     const ScatterSource& s = sources[i];
-    const int k = spacing.layer_at(s.coc_px);
+    const int k = layer_of[i];
     if (inside(s)) {
       PixelPart& part = l.parts[next[static_cast<std::size_t>(s.y) * width + s.x]++];
       part.layer = k;
@@ -61,14 +67,16 @@ DepthLayers make_depth_layers(const ScatterSources& sources, int width, int heig
   return l;
 }
 
-DepthLayers make_depth_layers(const ScatterSources& sources, int width, int height, double spacing_px, int max_layers) {
+DepthLayers make_depth_layers(const ScatterSources& sources, int width, int height, double spacing_px, int max_layers, int threads) {
   double coc_min = kInfinity, coc_max = -kInfinity;
-  for (const ScatterSource& s : sources) {
-    coc_min = std::min(coc_min, s.coc_px);
-    coc_max = std::max(coc_max, s.coc_px);
+  const auto n = static_cast<std::ptrdiff_t>(sources.size());
+#pragma omp parallel for num_threads(threads) schedule(static) reduction(min : coc_min) reduction(max : coc_max)
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    coc_min = std::min(coc_min, sources[static_cast<std::size_t>(i)].coc_px);
+    coc_max = std::max(coc_max, sources[static_cast<std::size_t>(i)].coc_px);
   }
   if (sources.empty()) coc_min = coc_max = 0.0;
-  return make_depth_layers(sources, width, height, LayerSpacing::over(coc_min, coc_max, spacing_px, max_layers));
+  return make_depth_layers(sources, width, height, LayerSpacing::over(coc_min, coc_max, spacing_px, max_layers), threads);
 }
 
 }  // namespace lensmith::render_detail
