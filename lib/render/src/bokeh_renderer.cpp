@@ -108,7 +108,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   for (int l = 0; l < layers.count; ++l) {
     const auto u = static_cast<std::size_t>(l);
     layer.clear();
-    for (int i : layers.members[u]) layer.push_back(sources[static_cast<std::size_t>(i)]);
+    for (int i : layers.members(l)) layer.push_back(sources[static_cast<std::size_t>(i)]);
     const double hidden_blur = layers.max_blur_px[u] + layers.nearer_blur_px[u];
     if (!layer.empty() && l + 1 < layers.count && hidden_blur >= kMinHiddenBlurPx) {
       const double reach = std::min(0.5 * hidden_blur + kHiddenMarginPx, 0.5 * (w + h));
@@ -185,7 +185,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
         if (any) render_detail::composite_layer_over(layer_rgba, stretch ? &hole_rgba : nullptr, result, w, row_begin, row_end);
         // Progress in even steps: this layer's share of the sources times the bands it has done.
         if (options.progress) {
-          const double fraction = (static_cast<double>(done) + static_cast<double>(layers.members[u].size()) *
+          const double fraction = (static_cast<double>(done) + static_cast<double>(layers.members(l).size()) *
                                                                     static_cast<double>(++bands_done) / bands) /
                                   static_cast<double>(sources.size());
 #pragma omp critical(lensmith_bokeh_progress)
@@ -196,7 +196,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
       triangles += local_triangles;
       reused += local_reused;
     }
-    done += layers.members[u].size();
+    done += layers.members(l).size();
     if (options.progress) options.progress(static_cast<double>(done) / static_cast<double>(sources.size()));
   }
   stats.footprints = footprints;

@@ -23,7 +23,6 @@ int LayerSpacing::layer_at(double coc_px) const {
 DepthLayers make_depth_layers(const ScatterSources& sources, int width, int height, const LayerSpacing& spacing, int threads) {
   DepthLayers l;
   static_cast<LayerSpacing&>(l) = spacing;
-  l.members.assign(static_cast<std::size_t>(l.count), {});
   l.max_blur_px.assign(static_cast<std::size_t>(l.count), 0.0);
   const std::size_t pixel_count = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   // Each source's layer, once (threads); the passes below are serial, as each appends in source order.
@@ -33,7 +32,7 @@ DepthLayers make_depth_layers(const ScatterSources& sources, int width, int heig
   for (std::ptrdiff_t i = 0; i < n; ++i) layer_of[static_cast<std::size_t>(i)] = spacing.layer_at(sources[static_cast<std::size_t>(i)].coc_px);
   // Parts grouped by pixel: counted, then placed (a split pixel's second part comes at the end of
   // the sources). Sources beyond the frame (the scatter's margin) are no pixel's parts: they only
-  // scatter. Each layer's members in one block of their final size: grown by doubling, the lists
+  // scatter. The layers' members are placed at their final positions: grown by doubling, the lists
   // were copied to fresh memory again and again (half a thousand page faults on a 600 x 400 frame).
   l.part_begin.assign(pixel_count + 1, 0);
   auto inside = [&](const ScatterSource& s) { return s.x >= 0 && s.y >= 0 && s.x < width && s.y < height; };
@@ -45,7 +44,10 @@ DepthLayers make_depth_layers(const ScatterSources& sources, int width, int heig
   }
   for (std::size_t p = 0; p < pixel_count; ++p) l.part_begin[p + 1] += l.part_begin[p];
   l.parts.resize(l.part_begin[pixel_count]);
-  for (std::size_t k = 0; k < member_count.size(); ++k) l.members[k].reserve(member_count[k]);
+  l.member_begin.assign(member_count.size() + 1, 0);
+  for (std::size_t k = 0; k < member_count.size(); ++k) l.member_begin[k + 1] = l.member_begin[k] + member_count[k];
+  l.member_store.resize(sources.size());
+  std::vector<std::size_t> next_member(l.member_begin.begin(), l.member_begin.end() - 1);
   LargeVector<std::uint32_t> next(l.part_begin.begin(), l.part_begin.end() - 1);
   for (std::size_t i = 0; i < sources.size(); ++i) {
     const ScatterSource& s = sources[i];
@@ -56,7 +58,7 @@ DepthLayers make_depth_layers(const ScatterSources& sources, int width, int heig
       part.visible = s.coverage - s.hidden;
       part.hidden = s.hidden;
     }
-    l.members[static_cast<std::size_t>(k)].push_back(static_cast<int>(i));
+    l.member_store[next_member[static_cast<std::size_t>(k)]++] = static_cast<int>(i);
     l.max_blur_px[static_cast<std::size_t>(k)] = std::max(l.max_blur_px[static_cast<std::size_t>(k)], std::abs(s.coc_px));
   }
   l.nearer_blur_px.assign(static_cast<std::size_t>(l.count), 0.0);

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "layer_spacing.h"
@@ -26,7 +27,15 @@ struct DepthLayers : LayerSpacing {
   // Per pixel (row-major) its parts: parts[part_begin[p] .. part_begin[p + 1]).
   LargeVector<std::uint32_t> part_begin;
   LargeVector<PixelPart> parts;
-  std::vector<LargeVector<int>> members;   // per layer: indices of its sources
+  // Per layer its sources' indices, in source order: member_store[member_begin[l] .. member_begin[l + 1]).
+  // One block for all layers: a block per layer came from the heap in 4 KiB pages, which cost the
+  // street scene's process about 3 ms of faults on one thread (docs/performance.md).
+  LargeVector<int> member_store;
+  std::vector<std::size_t> member_begin;
+  std::span<const int> members(int l) const {
+    const auto u = static_cast<std::size_t>(l);
+    return {member_store.data() + member_begin[u], member_begin[u + 1] - member_begin[u]};
+  }
   std::vector<double> max_blur_px;           // per layer: largest |signed blur| of its sources
   std::vector<double> nearer_blur_px;        // per layer: largest |signed blur| of every nearer layer
 

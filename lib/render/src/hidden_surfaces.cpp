@@ -29,7 +29,7 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
   // bounding box of the layer's pixels in the frame widened by the reach (a layer of a few distant
   // lights costs that box, not the frame).
   int bx0 = w, bx1 = -1, by0 = h, by1 = -1;
-  for (int i : layers.members[static_cast<std::size_t>(layer)]) {
+  for (int i : layers.members(layer)) {
     const ScatterSource& p = sources[static_cast<std::size_t>(i)];
     if (p.x < 0 || p.y < 0 || p.x >= w || p.y >= h) continue;  // the scatter's margin
     bx0 = std::min(bx0, p.x);
@@ -130,7 +130,7 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
   scratch.push_pull.reserve(w, h);
   cells.assign(static_cast<std::size_t>(ww) * wh, PushPullCell<5>{});
   // The layer's own whole pixels (the parts of split edge pixels are uncertain estimates).
-  for (int i : layers.members[static_cast<std::size_t>(layer)]) {
+  for (int i : layers.members(layer)) {
     const ScatterSource& p = sources[static_cast<std::size_t>(i)];
     if (p.x < x0 || p.x > x1 || p.y < y0 || p.y > y1 || p.coverage < 1.0f) continue;
     PushPullCell<5>& cell = cells[static_cast<std::size_t>(p.y - y0) * ww + (p.x - x0)];
