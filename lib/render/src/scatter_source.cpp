@@ -122,14 +122,6 @@ ScatterSources make_scatter_sources(const Image& image, const DepthMap& depth, c
   const std::size_t pixels = static_cast<std::size_t>(w) * h;
   ScatterSources sources;
   sources.reserve(pixels + pixels / 4);
-  // The frame's sources are first touched by the threads (faulting fresh memory in is the costly
-  // part of a serial resize on a virtual machine; each 2 MiB page once, by whichever thread).
-  {
-    auto* raw = reinterpret_cast<unsigned char*>(sources.data());
-    const auto pages = static_cast<std::ptrdiff_t>((pixels * sizeof(ScatterSource) + kHugePageBytes - 1) / kHugePageBytes);
-#pragma omp parallel for num_threads(threads) schedule(static)
-    for (std::ptrdiff_t k = 0; k < pages; ++k) raw[static_cast<std::size_t>(k) * kHugePageBytes] = 0;
-  }
   sources.resize(pixels);
   std::size_t clamped = 0;
   double coc_min = kInfinity, coc_max = -kInfinity;
