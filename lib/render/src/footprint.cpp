@@ -629,7 +629,7 @@ FootprintScatter::FootprintScatter(const RayModel& model, const Aperture& apertu
   }
 }
 
-FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& scratch, bool keep_probe) const {
+FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& scratch, FootprintProbe* probe_out) const {
   std::vector<PupilPoint>& pupil = scratch.pupil;
   std::vector<SensorHit>& hits = scratch.hits;
   const PixelPoint centre = source_centre(s);
@@ -641,7 +641,7 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
   pupil.assign(probe_.begin(), probe_.end());
   hits.resize(pupil.size());
   const std::array<double, 3> lambdas{camera_.reference_wavelength_nm(), groups_.lowest_nm(), groups_.highest_nm()};
-  // Copied to scratch.probe for plan_range where asked. On the stack (a thin-lens process took 4 %
+  // Copied to *probe_out for plan_range where asked. On the stack (a thin-lens process took 4 %
   // longer with it in the scratch space). `px` is read only where `ok` (not value-initialised:
   // zeroing its 432 bytes was a tenth of a thin-lens plan's time).
   FootprintProbe probe;
@@ -798,7 +798,7 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
     const int own_step = p.mesh >= 0 ? PupilMeshTable::sector_step_of_mesh(p.mesh) : p.outline;
     p.passing = static_cast<float>(disc_passing_share(scratch.discs, own_step, scratch));
   }
-  if (keep_probe) scratch.probe = probe;
+  if (probe_out != nullptr) *probe_out = probe;
   return p;
 }
 
@@ -911,10 +911,7 @@ void FootprintScatter::plan_range(std::span<const ScatterSource> sources, std::s
   }
   std::vector<FootprintProbe>& probes = scratch.range_probes;
   probes.resize(end - begin);
-  auto full = [&](std::size_t i) {
-    plans[i] = plan(sources[i], scratch, true);
-    probes[i - begin] = scratch.probe;
-  };
+  auto full = [&](std::size_t i) { plans[i] = plan(sources[i], scratch, &probes[i - begin]); };
   // Between planned a and b: all follow a where they may, else the middle is planned and each half
   // tried in turn.
   auto fill = [&](auto& self, std::size_t a, std::size_t b) -> void {

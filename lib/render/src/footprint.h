@@ -131,8 +131,7 @@ struct FootprintScratch {
   };
   std::vector<CachedMap> cached_maps;
   std::size_t cached_count = 0;
-  // Planning: the last plan's probe, and the probes of a range's planned sources (plan_range).
-  FootprintProbe probe;
+  // Planning: the probes of a range's planned sources (plan_range).
   std::vector<FootprintProbe> range_probes;
   // Deposit: the mesh footprint drawn last, for its neighbours; forget_shape() before each band of
   // rows, so that what a band draws does not depend on which thread drew which band before.
@@ -158,8 +157,8 @@ class FootprintScatter {
   FootprintScatter(const RayModel& model, const Aperture& aperture, const SpectralGroups& groups,
                    const PupilMeshTable& meshes, const BokehOptions& options);
 
-  // One source's plan; its probe is left in scratch.probe where `keep_probe`.
-  FootprintPlan plan(const ScatterSource& s, FootprintScratch& scratch, bool keep_probe = false) const;
+  // One source's plan; its probe is written to `*probe` where given.
+  FootprintPlan plan(const ScatterSource& s, FootprintScratch& scratch, FootprintProbe* probe = nullptr) const;
   // The plans of sources [begin, end) of a layer (indices into `sources` and `plans`). Where
   // BokehOptions::reuse_shapes is on and the model clips by pupil discs (paraxial, Seidel), a run of
   // neighbouring pixels of one row whose probes differ from the first's by under kShapeTolerancePx
