@@ -408,6 +408,58 @@ TEST_CASE("forward then backward returns the same ray on surface 1 for every shi
   }
 }
 
+TEST_CASE("a trace through the surfaces up to any one and on from there lands where the whole trace lands, for every shipped lens",
+          "[trace][lenses]") {
+  // The exact ray model aims through the surfaces up to the stop and traces the rest once
+  // (exact_model.cpp). Split after surface k, the second part starts from the first part's hit on k
+  // and recomputes the next intersection's first coefficient that the whole trace carries over: a
+  // few roundings, within kArithmetic_mm on the image plane.
+  int splits = 0;
+  std::vector<SurfaceHit> front;
+  std::vector<SurfaceHit> rear;
+  std::vector<SurfaceHit> whole_path;
+  for (const ShippedLens& shipped : LensLibrary::list()) {
+    const Prescription lens = LensLibrary::load(shipped.id).prescription;
+    const SequentialTracer tracer(lens);
+    const RayAimer aimer(tracer);
+    const int count = static_cast<int>(lens.surfaces.size());
+    for (const FieldPoint& field : fields_for(aimer)) {
+      const AimedRay aimed = aimer.make_ray(field, PupilCoordinate{0.3, -0.5}, lens.wavelengths_nm.front());
+      REQUIRE(aimed.ok());
+      const TraceResult whole = tracer.trace_forward(aimed.ray, &whole_path);
+      if (!whole.ok()) continue;
+      // Through every surface: the whole trace, bit for bit.
+      const TraceResult all = tracer.trace_forward_through(aimed.ray, 1, count);
+      CHECK(all.ok());
+      CHECK(all.ray.position_mm == whole.ray.position_mm);
+      CHECK(all.ray.direction == whole.ray.direction);
+      for (int k = 1; k < count; ++k) {
+        INFO(shipped.id << ", " << field.to_string() << ", split after surface " << k);
+        const TraceResult first = tracer.trace_forward_through(aimed.ray, 1, k, &front);
+        REQUIRE(first.ok());
+        REQUIRE(front.size() == static_cast<std::size_t>(k));
+        // The first part ends on surface k, leaving it as the whole trace does.
+        CHECK_THAT((first.ray.position_mm - whole_path[static_cast<std::size_t>(k - 1)].point_mm).norm(), WithinAbs(0.0, kArithmetic_mm));
+        CHECK_THAT((first.ray.direction - whole_path[static_cast<std::size_t>(k - 1)].direction_after).norm(),
+                   WithinAbs(0.0, kDirectionRounding));
+        const TraceResult second = tracer.trace_forward_through(Ray{first.ray.position_mm, first.ray.direction, aimed.ray.wavelength_nm},
+                                                                k + 1, count, &rear);
+        REQUIRE(second.ok());
+        REQUIRE(rear.size() == static_cast<std::size_t>(count - k));
+        CHECK(rear.front().surface == k + 1);
+        CHECK_THAT((second.ray.position_mm - whole.ray.position_mm).norm(), WithinAbs(0.0, kArithmetic_mm));
+        ++splits;
+      }
+    }
+  }
+  CHECK(splits > 100);
+  const SequentialTracer tracer(sasian_triplet());
+  const Ray ray;
+  CHECK_THROWS_AS(tracer.trace_forward_through(ray, 0, 3), OptionsError);
+  CHECK_THROWS_AS(tracer.trace_forward_through(ray, 4, 3), OptionsError);
+  CHECK_THROWS_AS(tracer.trace_forward_through(ray, 1, 7), OptionsError);
+}
+
 TEST_CASE("aspheric intersections lie on the sag z(r) with the normal of its gradient", "[trace][asphere]") {
   // Surfaces 7, 8, 10 and 11 of the aspherical fisheye (lentil 0014) are even aspheres (a4..a10).
   const Prescription lens = LensLibrary::load("aspherical-fisheye").prescription;

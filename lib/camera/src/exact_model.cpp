@@ -8,6 +8,7 @@
 // the element's area per unit stop area taken from the aiming's Jacobian (SensorHit).
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "lensmith/core/errors.h"
@@ -119,7 +120,8 @@ void ExactModel::map(const ScenePoint& point, double wavelength_nm, std::span<co
 
 void ExactModel::map_raw(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil,
                          std::span<SensorHit> hits) const {
-  thread_local std::vector<SurfaceHit> path;
+  // The hits of the last trace up to the stop, and of the rest of the lens (the final ray's).
+  thread_local std::vector<SurfaceHit> path, rear;
   const FirstOrderSample fo = camera_.first_order(wavelength_nm);
   const double z_target = fo.z_entrance_pupil_mm;
   const double r_target = fo.entrance_pupil_radius_mm;
@@ -127,11 +129,22 @@ void ExactModel::map_raw(const ScenePoint& point, double wavelength_nm, std::spa
   const double z_persp = camera_.z_perspective_mm();
   const std::size_t stop_index = static_cast<std::size_t>(stop_surface_ - 1);
 
-  // Stop point of the unclipped ray towards an entrance-pupil-plane target; false if it fails.
+  const int last_surface = static_cast<int>(frames_.size());
+  // Stop point of the unclipped ray towards an entrance-pupil-plane target; false if it fails. Traced
+  // only up to the stop (the surfaces behind it cannot move where it crosses the stop): aiming is
+  // most of the model's traces, and the aimed ray goes on from the stop once (below). `path` keeps
+  // the hits and `traced` the target, so that the aimed ray's own last trace is not repeated.
+  TraceResult front;
+  double traced_x = std::numeric_limits<double>::quiet_NaN(), traced_y = traced_x;
   auto stop_point = [&](double tx, double ty, double& sx, double& sy) {
     const Ray r = ray_towards(point, z_persp, tx, ty, z_target, wavelength_nm, start_z);
-    free_->trace_forward(r, &path);
-    if (path.size() <= stop_index) return false;
+    traced_x = tx;
+    traced_y = ty;
+    front = free_->trace_forward_through(r, 1, stop_surface_, &path);
+    if (!front.ok() || path.size() <= stop_index) {
+      traced_x = std::numeric_limits<double>::quiet_NaN();
+      return false;
+    }
     // In the stop's own frame (a tilted or shifted lens's stop turns and moves with it).
     const Eigen::Vector3d on_stop = stop_frame_.to_local(path[stop_index].point_mm);
     sx = on_stop.x();
@@ -204,9 +217,14 @@ void ExactModel::map_raw(const ScenePoint& point, double wavelength_nm, std::spa
   aim_options.max_iterations = kAimIterations - 1;
   const RootSolver2d aim_solver(aim_options);
 
+  // How far the last aimed ray's target lay from the affine guess. The points of a pupil mesh come
+  // ring by ring and sector by sector, and neighbours need nearly the same correction: each starts
+  // from its guess moved by its predecessor's.
+  double carried_x = 0.0, carried_y = 0.0;
   for (std::size_t i = 0; i < pupil.size(); ++i) {
     const double want_x = pupil[i].x * stop_radius_mm_, want_y = pupil[i].y * stop_radius_mm_;
-    Vector2 target{cx + i11 * (want_x - s0x) + i12 * (want_y - s0y), cy + i21 * (want_x - s0x) + i22 * (want_y - s0y)};
+    const Vector2 guess{cx + i11 * (want_x - s0x) + i12 * (want_y - s0y), cy + i21 * (want_x - s0x) + i22 * (want_y - s0y)};
+    Vector2 target{guess[0] + carried_x, guess[1] + carried_y};
     // Quasi-Newton from the beam's Jacobian, updated by Broyden's rank-one rule from each step's
     // change on the stop: at the rim of a strongly aberrated pupil (the Sasian triplet's frame at
     // 1.2 m) the beam's Jacobian alone converges too slowly, and a ray given up there took the
@@ -234,14 +252,27 @@ void ExactModel::map_raw(const ScenePoint& point, double wavelength_nm, std::spa
     if (!aim_solver.solve(miss, target, &beam_jacobian).converged() && !aimed_by_ray_aimer()) {
       hits[i] = {};
       if (on_stop) unaimed_.fetch_add(1, std::memory_order_relaxed);
+      carried_x = carried_y = 0.0;
       continue;
     }
+    carried_x = target[0] - guess[0];
+    carried_y = target[1] - guess[1];
     const double tx = target[0], ty = target[1];
-    const Ray ray = ray_towards(point, z_persp, tx, ty, z_target, wavelength_nm, start_z);
     const double weight = target_area * patch_solid_angle(point, z_persp, tx, ty, z_target);
-    // One unclipped trace: where the ray lands, and how far inside the tightest clear aperture it
-    // passes (a stopped ray still lands, for the edge of the beam between rays).
-    const TraceResult f = free_->trace_forward(ray, &path);
+    // The aimed ray from the stop on, unclipped: where it lands, and how far inside the tightest clear
+    // aperture it passes (a stopped ray still lands, for the edge of the beam between rays).
+    if (!(traced_x == tx && traced_y == ty)) {
+      double sx, sy;
+      if (!stop_point(tx, ty, sx, sy)) {
+        hits[i] = SensorHit{};
+        continue;
+      }
+    }
+    const SurfaceHit& at_stop = path[stop_index];
+    const TraceResult f = stop_surface_ < last_surface
+                              ? free_->trace_forward_through(Ray{at_stop.point_mm, at_stop.direction_after, wavelength_nm},
+                                                             stop_surface_ + 1, last_surface, &rear)
+                              : front;
     if (!f.ok()) {
       hits[i] = SensorHit{};
       continue;
@@ -249,7 +280,8 @@ void ExactModel::map_raw(const ScenePoint& point, double wavelength_nm, std::spa
     double clearance = 1.0;
     for (const ClipSurface& c : apertures_) {
       const std::size_t k = static_cast<std::size_t>(c.surface - 1);
-      const Eigen::Vector3d p = frames_[k].to_local(path[k].point_mm);
+      const Eigen::Vector3d& on_surface = k <= stop_index ? path[k].point_mm : rear[k - stop_index - 1].point_mm;
+      const Eigen::Vector3d p = frames_[k].to_local(on_surface);
       clearance = std::min(clearance, c.clearance(p.x(), p.y()));
     }
     hits[i] = SensorHit{f.ray.position_mm.x(), f.ray.position_mm.y(), clearance >= 0.0, true, weight, clearance};

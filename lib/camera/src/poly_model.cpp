@@ -140,9 +140,13 @@ void PolyModel::map_raw(const ScenePoint& camera_point, double wavelength_nm, st
   chord.tolerance = tolerance_mm;
   chord.max_iterations = kMaxChordEvaluations - 1;
   const RootSolver2d chord_solver(chord);
+  // As in the exact model: each pupil point starts from its affine guess moved by the correction its
+  // predecessor (a neighbour, in a pupil mesh) needed.
+  double carried_x = 0.0, carried_y = 0.0;
   for (std::size_t i = 0; i < pupil.size(); ++i) {
     const double sx = pupil[i].x * stop_radius_mm_, sy = pupil[i].y * stop_radius_mm_;
-    Vector2 on_outer{centre.ray.x_mm + inverse[0] * sx + inverse[1] * sy, centre.ray.y_mm + inverse[2] * sx + inverse[3] * sy};
+    const Vector2 guess{centre.ray.x_mm + inverse[0] * sx + inverse[1] * sy, centre.ray.y_mm + inverse[2] * sx + inverse[3] * sy};
+    Vector2 on_outer{guess[0] + carried_x, guess[1] + carried_y};
     auto miss = [&](const Vector2& u, Vector2& r, Matrix2*) {
       const auto at = fit_->stop_from_object(object, u[0], u[1], wavelength_nm);
       if (!at) return false;
@@ -158,11 +162,14 @@ void PolyModel::map_raw(const ScenePoint& camera_point, double wavelength_nm, st
       if (!aim.converged) {
         hits[i] = {};
         unaimed_.fetch_add(1, std::memory_order_relaxed);
+        carried_x = carried_y = 0.0;
         continue;
       }
       x = aim.ray.x_mm;
       y = aim.ray.y_mm;
     }
+    carried_x = x - guess[0];
+    carried_y = y - guess[1];
     const std::optional<PlaneRay> outer = fit_->outer_ray_from_object(object, x, y);
     if (!outer) {
       hits[i] = {};

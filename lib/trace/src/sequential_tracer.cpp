@@ -627,9 +627,10 @@ struct Walker {
   bool carried_b;
 };
 
+// `first_step`: where a forward walk through part of the lens begins (it starts in medium first_step).
 template <bool kForward>
-inline Walker start_walk(const Core& impl, const State& r, double wavelength_nm, const double* table) {
-  const std::size_t start_medium = kForward ? 0 : impl.count();
+inline Walker start_walk(const Core& impl, const State& r, double wavelength_nm, const double* table, int first_step = 0) {
+  const std::size_t start_medium = kForward ? static_cast<std::size_t>(first_step) : impl.count();
   return Walker{r, table, wavelength_nm,
                 table ? table[start_medium] : impl.media[start_medium].index(wavelength_nm), 0.0, false};
 }
@@ -746,18 +747,31 @@ inline int surface_of_step(const Core& impl, int step) {
   return kForward ? step + 1 : count - step;
 }
 
+// Which surfaces a forward trace crosses: steps [first, end) (0-based surfaces); end < 0: to the last
+// surface and on to the image plane, which only a trace through the last surface reaches.
+struct StepRange {
+  int first = 0;
+  int end = -1;
+};
+
 // The single-ray driver. Returns the status and sets `surface` (0 when Ok); `r` ends as TraceResult::ray.
 template <bool kForward, bool kRecord>
 RayStatus propagate(const Core& impl, State& r, double wavelength_nm, const double* table, int& surface,
-                    std::vector<SurfaceHit>* path) {
-  Walker w = start_walk<kForward>(impl, r, wavelength_nm, table);
+                    std::vector<SurfaceHit>* path, StepRange range = {}) {
+  Walker w = start_walk<kForward>(impl, r, wavelength_nm, table, range.first);
   const int count = static_cast<int>(impl.count());
+  const int end = range.end < 0 ? count : range.end;
   RayStatus status = RayStatus::Ok;
-  int step = 0;
-  for (; step < count && status == RayStatus::Ok; ++step) {
+  int step = range.first;
+  for (; step < end && status == RayStatus::Ok; ++step) {
     status = cross_surface<kForward, kRecord>(impl, step, w, path);
   }
   if (status == RayStatus::Ok) {
+    if (end < count) {
+      surface = 0;
+      r = w.r;
+      return status;
+    }
     if constexpr (kForward) status = to_image_plane(impl, w);
     step = count + 1;
   }
@@ -800,8 +814,9 @@ inline void from_frame(const PlacedFrame& placed, State& r) {
 
 template <bool kForward, bool kRecord>
 RayStatus propagate_general(const Core& impl, State& r, double wavelength_nm, const double* table, int& surface,
-                            std::vector<SurfaceHit>* path, bool clip = true) {
+                            std::vector<SurfaceHit>* path, bool clip = true, StepRange range = {}) {
   const int count = static_cast<int>(impl.count());
+  const int end = range.end < 0 ? count : range.end;
   auto index_of = [&](std::size_t medium) { return table ? table[medium] : impl.media[medium].index(wavelength_nm); };
   if constexpr (!kForward) {
     // From the image plane's output frame (z reversed when light arrives toward -z) into global coordinates.
@@ -809,8 +824,8 @@ RayStatus propagate_general(const Core& impl, State& r, double wavelength_nm, co
     r.n *= impl.image_sense;
     from_frame(impl.image_frame, r);
   }
-  double n_current = index_of(kForward ? 0 : impl.count());
-  for (int step = 0; step < count; ++step) {
+  double n_current = index_of(kForward ? static_cast<std::size_t>(range.first) : impl.count());
+  for (int step = range.first; step < end; ++step) {
     const int k = kForward ? step : count - 1 - step;
     const SurfaceGeometry& g = impl.surfaces[static_cast<std::size_t>(k)];
     const PlacedFrame& frame = impl.frames[static_cast<std::size_t>(k)];
@@ -900,6 +915,10 @@ RayStatus propagate_general(const Core& impl, State& r, double wavelength_nm, co
     from_frame(frame, r);
   }
   if constexpr (kForward) {
+    if (end < count) {
+      surface = 0;
+      return RayStatus::Ok;
+    }
     State local = r;
     to_frame(impl.image_frame, local);
     if (!(local.n * impl.image_sense > 0.0)) {
@@ -1125,7 +1144,7 @@ double SequentialTracer::index_after(int surface, double wavelength_nm) const {
 namespace {
 
 template <bool kForward>
-TraceResult trace_one(const Core& impl, const Ray& ray, std::vector<SurfaceHit>* path) {
+TraceResult trace_one(const Core& impl, const Ray& ray, std::vector<SurfaceHit>* path, StepRange range = {}) {
   TraceResult result;
   result.ray = ray;
   if (path) path->clear();
@@ -1138,11 +1157,11 @@ TraceResult trace_one(const Core& impl, const Ray& ray, std::vector<SurfaceHit>*
   const double* table = impl.indices(ray.wavelength_nm);
   int surface = 0;
   if (impl.general) {
-    result.status = path ? propagate_general<kForward, true>(impl, s, ray.wavelength_nm, table, surface, path)
-                         : propagate_general<kForward, false>(impl, s, ray.wavelength_nm, table, surface, nullptr);
+    result.status = path ? propagate_general<kForward, true>(impl, s, ray.wavelength_nm, table, surface, path, true, range)
+                         : propagate_general<kForward, false>(impl, s, ray.wavelength_nm, table, surface, nullptr, true, range);
   } else {
-    result.status = path ? propagate<kForward, true>(impl, s, ray.wavelength_nm, table, surface, path)
-                         : propagate<kForward, false>(impl, s, ray.wavelength_nm, table, surface, nullptr);
+    result.status = path ? propagate<kForward, true>(impl, s, ray.wavelength_nm, table, surface, path, range)
+                         : propagate<kForward, false>(impl, s, ray.wavelength_nm, table, surface, nullptr, range);
   }
   result.surface = surface;
   result.ray.position_mm = Eigen::Vector3d(s.x, s.y, s.z);
@@ -1253,6 +1272,16 @@ void trace_many(const Core& impl, const RayBatchView& batch, int threads) {
 
 TraceResult SequentialTracer::trace_forward(const Ray& ray, std::vector<SurfaceHit>* path) const {
   return trace_one<true>(*impl_, ray, path);
+}
+
+TraceResult SequentialTracer::trace_forward_through(const Ray& ray, int first_surface, int last_surface,
+                                                    std::vector<SurfaceHit>* path) const {
+  const int count = static_cast<int>(impl_->count());
+  if (first_surface < 1 || last_surface < first_surface || last_surface > count) {
+    throw OptionsError("SequentialTracer::trace_forward_through: surfaces " + std::to_string(first_surface) + " to " +
+                       std::to_string(last_surface) + " are not a range within 1.." + std::to_string(count));
+  }
+  return trace_one<true>(*impl_, ray, path, StepRange{first_surface - 1, last_surface == count ? -1 : last_surface});
 }
 
 TraceResult SequentialTracer::trace_backward(const Ray& ray, std::vector<SurfaceHit>* path) const {

@@ -101,6 +101,14 @@ class SequentialTracer {
   // it) travelling +z; traced through every surface to the image plane. `path`, when given, receives
   // one SurfaceHit per surface reached (and is cleared first).
   TraceResult trace_forward(const Ray& ray, std::vector<SurfaceHit>* path = nullptr) const;
+  // Forward through surfaces first_surface..last_surface (1-based, inclusive) alone: `ray` lies in
+  // the medium before first_surface (object space for surface 1), and the result's ray is the ray
+  // leaving last_surface, on it, or on the image plane when last_surface is the last (then it is
+  // trace_forward, bit for bit, from surface 1). A ray aimed at the aperture stop needs only the
+  // surfaces up to it until it is aimed, and then the rest from the stop on (the exact ray model).
+  // Throws OptionsError for surfaces that are not a range of the lens's.
+  TraceResult trace_forward_through(const Ray& ray, int first_surface, int last_surface,
+                                    std::vector<SurfaceHit>* path = nullptr) const;
   // Backward: `ray` starts in image space (e.g. on the sensor) travelling -z; traced through the
   // surfaces from the last to the first. The result is the ray leaving surface 1 into object space.
   TraceResult trace_backward(const Ray& ray, std::vector<SurfaceHit>* path = nullptr) const;
