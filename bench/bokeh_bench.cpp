@@ -160,11 +160,20 @@ void args(benchmark::internal::Benchmark* b) {
   b->ArgNames({"blur_px", "threads"})->Unit(benchmark::kSecond)->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true)->UseRealTime();
 }
 
+void aimed_args(benchmark::internal::Benchmark* b) {
+  b->Args({16, 2});
+  b->ArgNames({"blur_px", "threads"})->Unit(benchmark::kSecond)->Iterations(1)->Repetitions(1)->UseRealTime();
+}
+
 }  // namespace
 
 BENCHMARK_CAPTURE(run, thin, RayModelKind::Thin)->Apply(args);
 BENCHMARK_CAPTURE(run, paraxial, RayModelKind::Paraxial)->Apply(args);
 BENCHMARK_CAPTURE(run, seidel, RayModelKind::Seidel)->Apply(args);
+// The models that aim every ray (poly: on the fit, made in the run before timing; exact: through the
+// prescription) take minutes a frame here: one blur, 2 threads, one run each.
+BENCHMARK_CAPTURE(run, poly, RayModelKind::Poly)->Apply(aimed_args);
+BENCHMARK_CAPTURE(run, exact, RayModelKind::Exact)->Apply(aimed_args);
 BENCHMARK_CAPTURE(run_lightfield, thin, RayModelKind::Thin)->Apply(lightfield_args);
 BENCHMARK_CAPTURE(run_lightfield, seidel, RayModelKind::Seidel)->Apply(lightfield_args);
 BENCHMARK_CAPTURE(run_ewa, thin, RayModelKind::Thin)->Apply(ewa_args);
