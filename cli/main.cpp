@@ -486,8 +486,8 @@ int main(int argc, char** argv) {
                       "Every point as bright as on the axis: no cos^4-type falloff, no darkening where clear apertures clip "
                       "(the bokeh keeps its cat's-eye shape)");
   bokeh_scatter_only.push_back(bokeh_cmd->add_flag("--no-shape-reuse", bokeh.no_shape_reuse,
-                      "Map every pixel's footprint on its own (slower, for checking). By default a pixel whose footprint differs "
-                      "from its row neighbour's by under 1/16 px beyond a move (a clipped edge included) draws that neighbour's mapped shape"));
+                      "Map every pixel's footprint on its own (paraxial, Seidel; slower, for checking). By default a pixel whose "
+                      "footprint differs from its row neighbour's by under 1/16 px beyond a move draws that neighbour's mapped shape"));
   bokeh_cmd->add_flag("--no-spectral", bokeh.no_spectral, "Trace every ray at 587.6 nm and keep RGB as it is (no colour fringes)");
   bokeh_cmd->add_option("--spectral-samples", bokeh.spectral_samples, "Wavelengths of the spectral quadrature (3-64, default 16)")
       ->check(range(3, 64));

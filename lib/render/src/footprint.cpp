@@ -59,13 +59,6 @@ constexpr double kEdgeKeptPx = 8.0;
 constexpr std::size_t kShapeStride = 8;
 constexpr double kShapeTolerancePx = 1.0 / 16.0;
 constexpr float kShapePassingTolerance = 0.004f;
-// Models that clip ray by ray (exact, poly) share a shape only where every probe ray of both ends
-// passes at least this far inside every clear aperture (a fraction of its radius), or where the
-// edge of the cut moves by under kShapeTolerancePx between the ends (FootprintScatter::shares_shape).
-// Between two of the probe's rim rays, 45 degrees apart, a clear aperture's edge can come nearer
-// than at either by up to about 0.08 of its radius (a beam as wide as the aperture: rho (1 - cos
-// 22.5 deg) of it).
-constexpr float kProbeClearanceMargin = 0.1f;
 // Grid cells of an aperture-picture mesh per pixel of footprint size.
 constexpr double kPxPerGridCell = 1.5;
 // Pupil points: the centre (the chief ray), and the centre with the two axes' unit points (an affine
@@ -700,7 +693,6 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
         ok[l][i] = lands;
         if (!lands) continue;
         px[l][i] = {o.x + axx * pupil[i].x + ayx * pupil[i].y, o.y + axy * pupil[i].x + ayy * pupil[i].y};
-        probe.clearance[l][i] = 1.0f;
         x_min = std::min(x_min, px[l][i].x);
         x_max = std::max(x_max, px[l][i].x);
         y_min = std::min(y_min, px[l][i].y);
@@ -723,7 +715,6 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
       if (!ok[l][i]) continue;
       const PixelPoint q = camera_.output_pixel(hits[i].x_mm, hits[i].y_mm);
       px[l][i] = {q.x, q.y};
-      probe.clearance[l][i] = static_cast<float>(hits[i].clearance);
       x_min = std::min(x_min, px[l][i].x);
       x_max = std::max(x_max, px[l][i].x);
       y_min = std::min(y_min, px[l][i].y);
@@ -863,29 +854,6 @@ bool FootprintScatter::shares_shape(std::span<const ScatterSource> sources, std:
     one_depth = one_depth && d == da;
   }
   if (!one_depth && std::abs(A.passing - B.passing) > kShapePassingTolerance) return false;
-  // Models that clip ray by ray: near a clear aperture's edge, the edge may move by under the
-  // tolerance along the run. A clear aperture's image moves across the pupil as the field changes, so
-  // the clearance field shifts nearly as a whole: the largest change of a probe ray's clearance
-  // between the ends, over the steepest fall of a's clearance from the pupil's centre to its rim,
-  // is how far the edge moves in pupil radii; times the footprint's radius, in px.
-  if (model_.kind() == RayModelKind::Exact || model_.kind() == RayModelKind::Poly) {
-    for (std::size_t l = 0; l < pa.wavelengths; ++l) {
-      if (!pa.ok[l][0] || !pb.ok[l][0]) return false;
-      bool near = false;
-      double shift = 0.0, fall = 0.0, radius2 = 0.0;
-      for (std::size_t i = 0; i < 9; ++i) {
-        if (pa.ok[l][i] != pb.ok[l][i]) return false;
-        if (!pa.ok[l][i]) continue;
-        const float ca = pa.clearance[l][i], cb = pb.clearance[l][i];
-        near = near || std::min(ca, cb) < kProbeClearanceMargin;
-        shift = std::max(shift, static_cast<double>(std::abs(ca - cb)));
-        fall = std::max(fall, static_cast<double>(std::abs(ca - pa.clearance[l][0])));
-        const double dx = pa.px[l][i].x - pa.px[l][0].x, dy = pa.px[l][i].y - pa.px[l][0].y;
-        radius2 = std::max(radius2, dx * dx + dy * dy);
-      }
-      if (near && !(shift * std::sqrt(radius2) <= kShapeTolerancePx * fall)) return false;
-    }
-  }
   // Every probe ray, at every probed wavelength, where a's and b's chief rays put it, within the
   // tolerance of each other.
   const double tolerance2 = kShapeTolerancePx * kShapeTolerancePx;
@@ -931,11 +899,12 @@ bool FootprintScatter::follow(const ScatterSource& s, const FootprintPlan& a, co
 
 void FootprintScatter::plan_range(std::span<const ScatterSource> sources, std::span<FootprintPlan> plans, std::size_t begin,
                                   std::size_t end, FootprintScratch& scratch) const {
-  // Every model with mesh footprints (an affine model through a uniform convex aperture has none to
-  // share); the exact and poly models, which clip ray by ray, where their probes' clearances say that
-  // a clipped edge moves by under the tolerance (shares_shape).
+  // Models that clip by pupil discs alone (paraxial, Seidel): the exact and poly models clip ray by
+  // ray, and a beam's clipped edge can move faster along a row than their probe shows. An affine
+  // model through a uniform convex aperture has no mesh footprints to share.
   const bool meshes = !(model_.affine_in_pupil() && aperture_.is_uniform_convex());
-  const bool reuse = options_.reuse_shapes && meshes;
+  const bool reuse = options_.reuse_shapes && meshes &&
+                     (model_.kind() == RayModelKind::Paraxial || model_.kind() == RayModelKind::Seidel);
   if (!reuse) {
     for (std::size_t i = begin; i < end; ++i) plans[i] = plan(sources[i], scratch);
     return;

@@ -65,9 +65,6 @@ struct FootprintProbe {
     double x, y;  // read only where `ok` (left uninitialised: see FootprintScatter::plan)
   };
   std::array<std::array<Pixel, 9>, 3> px;
-  // How far inside the tightest clear aperture each ray passes (SensorHit::clearance; read only where
-  // `ok`): set for models that clip ray by ray (exact, poly), 1 for the others.
-  std::array<std::array<float, 9>, 3> clearance;
   std::array<std::array<bool, 9>, 3> ok{};
   std::size_t wavelengths = 0;
   bool chief_passes = false;  // the pupil centre's ray at the reference wavelength (FootprintPlan::affine_px)
