@@ -747,8 +747,8 @@ inline int surface_of_step(const Core& impl, int step) {
   return kForward ? step + 1 : count - step;
 }
 
-// Which surfaces a forward trace crosses: steps [first, end) (0-based surfaces); end < 0: to the last
-// surface and on to the image plane, which only a trace through the last surface reaches.
+// Which surfaces a forward trace crosses: steps [first, end) (0-based surfaces); end < 0: every
+// surface. Only a trace through the last surface goes on to the image plane.
 struct StepRange {
   int first = 0;
   int end = -1;
@@ -766,12 +766,7 @@ RayStatus propagate(const Core& impl, State& r, double wavelength_nm, const doub
   for (; step < end && status == RayStatus::Ok; ++step) {
     status = cross_surface<kForward, kRecord>(impl, step, w, path);
   }
-  if (status == RayStatus::Ok) {
-    if (end < count) {
-      surface = 0;
-      r = w.r;
-      return status;
-    }
+  if (status == RayStatus::Ok && end == count) {
     if constexpr (kForward) status = to_image_plane(impl, w);
     step = count + 1;
   }
@@ -1281,7 +1276,7 @@ TraceResult SequentialTracer::trace_forward_through(const Ray& ray, int first_su
     throw OptionsError("SequentialTracer::trace_forward_through: surfaces " + std::to_string(first_surface) + " to " +
                        std::to_string(last_surface) + " are not a range within 1.." + std::to_string(count));
   }
-  return trace_one<true>(*impl_, ray, path, StepRange{first_surface - 1, last_surface == count ? -1 : last_surface});
+  return trace_one<true>(*impl_, ray, path, StepRange{first_surface - 1, last_surface});
 }
 
 TraceResult SequentialTracer::trace_backward(const Ray& ray, std::vector<SurfaceHit>* path) const {
