@@ -497,3 +497,20 @@ TEST_CASE("The exact model maps a point 1e10 m away (a renderer's sky depth) as 
     }
   }
 }
+
+TEST_CASE("A pixel's chief-ray image area is the same everywhere through the paraxial model, whose map of the field is linear",
+          "[camera]") {
+  // The paraxial map from tangents to the sensor is linear at every depth: the same area per pixel
+  // over the frame and the margin beyond it (a few ulps of lengths near 1000 px).
+  const Prescription lens = LensLibrary::load("canon-35mm-f1.8-1956").prescription;
+  const Camera cam = Camera::from_lens(lens, options(2.0, 2.8), 160, 120);
+  const auto paraxial = make_ray_model(RayModelKind::Paraxial, cam);
+  const double centre = chief_ray_image_area(*paraxial, {80.0, 60.0}, 1.0 / 2000.0);
+  REQUIRE(centre > 0.0);
+  for (const PixelPoint at : {PixelPoint{0.5, 0.5}, PixelPoint{159.5, 60.0}, PixelPoint{-20.0, 130.0}}) {
+    for (const double inverse_depth : {0.0, 1.0 / 2000.0, 1.0 / 500.0}) {
+      CHECK(chief_ray_image_area(*paraxial, at, inverse_depth) == Approx(centre).epsilon(1e-9));
+    }
+  }
+  // (The exact model's, against lensmith analyze's distortion curve: tests/scene, bokeh_radiometry_test.)
+}

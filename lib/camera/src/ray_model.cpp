@@ -1,6 +1,7 @@
 #include "lensmith/camera/ray_model.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "lensmith/core/errors.h"
@@ -87,6 +88,27 @@ void require_poly_model_lens(const Camera& camera) {
   if (const auto why = LensFit::why_not_fittable(lens)) {
     throw OptionsError("the poly model cannot fit this lens: " + *why + ": use the exact model (--model exact)");
   }
+}
+
+double chief_ray_image_area(const RayModel& model, const PixelPoint& at, double inverse_depth_per_mm, double step_px,
+                            const PixelPoint* chief_px) {
+  const Camera& camera = model.camera();
+  const std::array<PixelPoint, 3> in{at, PixelPoint{at.x + step_px, at.y}, PixelPoint{at.x, at.y + step_px}};
+  std::array<PixelPoint, 3> out{};
+  constexpr std::array<PupilPoint, 1> kChief{{{0.0, 0.0}}};
+  for (std::size_t k = 0; k < in.size(); ++k) {
+    if (k == 0 && chief_px != nullptr) {
+      out[0] = *chief_px;
+      continue;
+    }
+    const Tangents t = camera.frame().tangents_at(in[k]);
+    std::array<SensorHit, 1> hit;
+    model.map(ScenePoint{t.x, t.y, inverse_depth_per_mm}, camera.reference_wavelength_nm(), kChief, hit);
+    if (!(hit[0].ok || hit[0].unclipped)) return 0.0;  // a blocked chief ray still lands where it would
+    out[k] = camera.output_pixel(hit[0].x_mm, hit[0].y_mm);
+  }
+  const double det = (out[1].x - out[0].x) * (out[2].y - out[0].y) - (out[1].y - out[0].y) * (out[2].x - out[0].x);
+  return std::isfinite(det) ? std::abs(det) / (step_px * step_px) : 0.0;
 }
 
 std::unique_ptr<RayModel> make_ray_model(RayModelKind kind, const Camera& camera, const RayModelOptions& options) {

@@ -20,6 +20,7 @@
 #include "depth_layers.h"
 #include "footprint.h"
 #include "hidden_surfaces.h"
+#include "image_area_table.h"
 #include "layer_compositing.h"
 #include "mixed_pixels.h"
 #include "lensmith/core/errors.h"
@@ -77,7 +78,18 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   const int threads = thread_count(options);
   const render_detail::SpectralGroups groups(camera, options.spectral, options.spectral_samples);
   const render_detail::PupilMeshTable meshes(aperture);
-  const FootprintScatter scatter(model, aperture, groups, meshes, options);
+  // Where the model has distortion, the image area of a pixel over the frame and the sources' depths.
+  render_detail::ImageAreaTable areas;
+  if (model.kind() != RayModelKind::Thin && model.kind() != RayModelKind::Paraxial && !sources.empty()) {
+    double w_min = sources.front().inverse_depth_per_mm, w_max = w_min;
+#pragma omp parallel for num_threads(threads) reduction(min : w_min) reduction(max : w_max)
+    for (std::size_t i = 0; i < sources.size(); ++i) {
+      w_min = std::min(w_min, sources[i].inverse_depth_per_mm);
+      w_max = std::max(w_max, sources[i].inverse_depth_per_mm);
+    }
+    areas = render_detail::ImageAreaTable(model, margin, w_min, w_max, threads);
+  }
+  const FootprintScatter scatter(model, aperture, groups, meshes, areas, options);
   stats.layer_spacing_px = layers.spacing_px;
   const std::size_t unaimed_before = model.unaimed_rays();
 

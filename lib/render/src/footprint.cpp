@@ -615,9 +615,9 @@ std::array<float, 4> FootprintScatter::lit(const std::array<float, 4>& value, do
 }
 
 FootprintScatter::FootprintScatter(const RayModel& model, const Aperture& aperture, const SpectralGroups& groups,
-                                   const PupilMeshTable& meshes, const BokehOptions& options)
+                                   const PupilMeshTable& meshes, const ImageAreaTable& areas, const BokehOptions& options)
     : model_(model), camera_(model.camera()), aperture_(aperture), groups_(groups), meshes_(meshes), options_(options),
-      stamps_(meshes, 0.5 * kHalfResolutionPx + kStampMarginPx) {
+      stamps_(meshes, 0.5 * kHalfResolutionPx + kStampMarginPx), areas_(areas) {
   probe_[0] = {0.0, 0.0};
   for (int k = 0; k < 8; ++k) {
     const double a = kPi / 2.0 + 2.0 * kPi * k / 8.0;
@@ -798,6 +798,7 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
     const int own_step = p.mesh >= 0 ? PupilMeshTable::sector_step_of_mesh(p.mesh) : p.outline;
     p.passing = static_cast<float>(disc_passing_share(scratch.discs, own_step, scratch));
   }
+  p.area = areas_.at(centre.x, centre.y, s.inverse_depth_per_mm);
   if (probe_out != nullptr) *probe_out = probe;
   return p;
 }
@@ -891,6 +892,8 @@ bool FootprintScatter::follow(const ScatterSource& s, const FootprintPlan& a, co
   out.y_min = a.y_min + dy;
   out.y_max = a.y_max + dy;
   const auto f = static_cast<float>(along);
+  const PixelPoint centre = source_centre(s);
+  out.area = areas_.at(centre.x, centre.y, s.inverse_depth_per_mm);
   out.blend = a.blend + f * (b.blend - a.blend);
   out.passing = a.passing + f * (b.passing - a.passing);
   out.shape_source = a_index;
@@ -970,11 +973,12 @@ void FootprintShape::add(std::span<const Point2f> vertices, const std::array<flo
 
 namespace {
 
-// A wavelength group's share of a source's light (RGB) and coverage (alpha).
-std::array<float, 4> group_value(const ScatterSource& s, const SpectralGroup& g, float share) {
+// A wavelength group's share of a source's light (RGB) and coverage (alpha, times the output area
+// its pixel's image covers: FootprintPlan::area).
+std::array<float, 4> group_value(const ScatterSource& s, const SpectralGroup& g, float share, float area) {
   std::array<float, 4> value{};
   for (std::size_t c = 0; c < 3; ++c) value[c] = share * (g.m[c][0] * s.rgb[0] + g.m[c][1] * s.rgb[1] + g.m[c][2] * s.rgb[2]);
-  value[3] = share * g.alpha * s.coverage;
+  value[3] = share * g.alpha * s.coverage * area;
   return value;
 }
 
@@ -1133,7 +1137,7 @@ void FootprintScatter::draw_shape(const ScatterSource& s, const FootprintPlan& p
   const float dx = p.affine_px[0] - shape.chief_px[0], dy = p.affine_px[1] - shape.chief_px[1];
   std::size_t group = 0;
   auto draw_group = [&](const SpectralGroup& g, float share) {
-    std::array<float, 4> value = group_value(s, g, share);
+    std::array<float, 4> value = group_value(s, g, share, options_.vignetting ? p.area : 1.0f);
     if (scale != 1.0) {
       for (std::size_t c = 0; c < 3; ++c) value[c] = static_cast<float>(value[c] * scale);
     }
@@ -1204,7 +1208,7 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, s
   }
   // One wavelength group's share of the light.
   auto deposit_group = [&](const SpectralGroup& g, float share) {
-    const std::array<float, 4> value = group_value(s, g, share);
+    const std::array<float, 4> value = group_value(s, g, share, options_.vignetting ? p.area : 1.0f);
     // A single group's rays are the plan's, at the reference wavelength.
     const bool planned = p.mapped && p.groups == 1 && p.blend == 1.0f;
     if (p.outline == FootprintPlan::kPoint) {

@@ -19,6 +19,7 @@
 #include "lensmith/camera/ray_model.h"
 #include "lensmith/render/splat_buffer.h"
 #include "footprint_stamps.h"
+#include "image_area_table.h"
 #include "pupil_mesh_table.h"
 #include "scatter_source.h"
 #include "spectral_groups.h"
@@ -56,6 +57,11 @@ struct FootprintPlan {
   // The layer index of the source whose mapped shape this footprint draws, moved to its own chief
   // ray (FootprintScatter::plan_range), or -1: its own.
   std::int32_t shape_source = -1;
+  // The output area its pixel's image covers, relative to a pixel's at the frame's centre
+  // (ImageAreaTable): its coverage, not its light, scales by it, so that where distortion packs
+  // more of the scene into a pixel the light of more sources shares it. 1 for models without
+  // distortion (thin, paraxial).
+  float area = 1.0f;
 };
 
 // What the planner probed of a footprint: where the probe's rays land (output px) at up to three
@@ -154,8 +160,9 @@ void plan_range_starts(std::span<const ScatterSource> sources, std::size_t targe
 // Everything a footprint depends on besides its source; one per render, shared by the threads.
 class FootprintScatter {
  public:
+  // `areas`: the image area of a pixel over the frame (FootprintPlan::area); kept by the caller.
   FootprintScatter(const RayModel& model, const Aperture& aperture, const SpectralGroups& groups,
-                   const PupilMeshTable& meshes, const BokehOptions& options);
+                   const PupilMeshTable& meshes, const ImageAreaTable& areas, const BokehOptions& options);
 
   // One source's plan; its probe is written to `*probe` where given.
   FootprintPlan plan(const ScatterSource& s, FootprintScratch& scratch, FootprintProbe* probe = nullptr) const;
@@ -230,6 +237,7 @@ class FootprintScatter {
   // Single-polygon footprints at full resolution that are the outline scaled about their pixel's
   // centre (the thin lens's): deposited from stamps.
   FootprintStamps stamps_;
+  const ImageAreaTable& areas_;
 };
 
 }  // namespace lensmith::render_detail

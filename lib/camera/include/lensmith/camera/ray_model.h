@@ -143,6 +143,17 @@ LensFitOptions lens_fit_options_for(const Camera& camera);
 // that fit before making the model check first.
 void require_poly_model_lens(const Camera& camera);
 
+// The output area (px^2) that one input pixel about pixel point `at` (input px: the camera's
+// pinhole frame) images to at this inverse depth (1/mm): the determinant of the map from input to
+// output pixels that the chief rays (pupil centre, reference wavelength) of `at` and of the points
+// `step_px` to its right and below span (distortion, focus breathing). Where a lens compresses the
+// picture (barrel distortion) an output pixel takes in more of the scene and its irradiance is
+// higher by as much: the renderers weigh their footprints by it against the frame centre's.
+// `chief_px`, where given, is where `at`'s chief ray lands (output px), already mapped. 0 where a
+// chief ray lands nowhere.
+double chief_ray_image_area(const RayModel& model, const PixelPoint& at, double inverse_depth_per_mm, double step_px = 1.0,
+                            const PixelPoint* chief_px = nullptr);
+
 // Thin needs a thin-lens camera; the others a camera made from a prescription. Throws OptionsError
 // for a mismatch (poly: a fit of another lens, a stop wider than the fit's, a frame or wavelength
 // range beyond it) and what the Seidel analysis or the fit throws.
