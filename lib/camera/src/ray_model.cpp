@@ -90,17 +90,12 @@ void require_poly_model_lens(const Camera& camera) {
   }
 }
 
-double chief_ray_image_area(const RayModel& model, const PixelPoint& at, double inverse_depth_per_mm, double step_px,
-                            const PixelPoint* chief_px) {
+double chief_ray_image_area(const RayModel& model, const PixelPoint& at, double inverse_depth_per_mm, double step_px) {
   const Camera& camera = model.camera();
   const std::array<PixelPoint, 3> in{at, PixelPoint{at.x + step_px, at.y}, PixelPoint{at.x, at.y + step_px}};
   std::array<PixelPoint, 3> out{};
   constexpr std::array<PupilPoint, 1> kChief{{{0.0, 0.0}}};
   for (std::size_t k = 0; k < in.size(); ++k) {
-    if (k == 0 && chief_px != nullptr) {
-      out[0] = *chief_px;
-      continue;
-    }
     const Tangents t = camera.frame().tangents_at(in[k]);
     std::array<SensorHit, 1> hit;
     model.map(ScenePoint{t.x, t.y, inverse_depth_per_mm}, camera.reference_wavelength_nm(), kChief, hit);

@@ -80,7 +80,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   const render_detail::PupilMeshTable meshes(aperture);
   // Where the model has distortion, the image area of a pixel over the frame and the sources' depths.
   render_detail::ImageAreaTable areas;
-  if (model.kind() != RayModelKind::Thin && model.kind() != RayModelKind::Paraxial && !sources.empty()) {
+  if (render_detail::ImageAreaTable::needed(model) && !sources.empty()) {
     double w_min = sources.front().inverse_depth_per_mm, w_max = w_min;
 #pragma omp parallel for num_threads(threads) reduction(min : w_min) reduction(max : w_max)
     for (std::size_t i = 0; i < sources.size(); ++i) {

@@ -29,7 +29,7 @@ constexpr double kMaxArea = 4.0;
 }  // namespace
 
 ImageAreaTable::ImageAreaTable(const RayModel& model, int margin_px, double w_min, double w_max, int threads) {
-  if (model.kind() == RayModelKind::Thin || model.kind() == RayModelKind::Paraxial) return;
+  if (!needed(model)) return;
   const Camera& camera = model.camera();
   const PinholeFrame& frame = camera.frame();
   const double axial =

@@ -15,10 +15,12 @@ namespace lensmith::render_detail {
 
 class ImageAreaTable {
  public:
-  // Every area 1 (a model that maps the field linearly: thin, paraxial).
+  // Whether `model` has distortion to tabulate: not thin and paraxial, which map the field linearly.
+  static bool needed(const RayModel& model) { return model.kind() != RayModelKind::Thin && model.kind() != RayModelKind::Paraxial; }
+  // Every area 1.
   ImageAreaTable() = default;
-  // For `model`'s frame and `margin_px` beyond it, inverse depths w_min..w_max (1/mm); models that
-  // map the field linearly get the empty table.
+  // For `model`'s frame and `margin_px` beyond it, inverse depths w_min..w_max (1/mm); empty where
+  // not needed().
   ImageAreaTable(const RayModel& model, int margin_px, double w_min, double w_max, int threads);
   bool empty() const { return areas_.empty(); }
   // The relative area at input pixel point (x, y) (px) and inverse depth w (1/mm), clamped to the

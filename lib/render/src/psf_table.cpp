@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 
+#include "image_area_table.h"
 #include "lensmith/core/units.h"
 
 namespace lensmith::render_detail {
@@ -143,24 +144,18 @@ PsfTable::PsfTable(const RayModel& model, const Aperture& aperture, double w_min
   }
   // Where the lens compresses the picture (barrel distortion) each output pixel takes in more of the
   // scene, and its irradiance is higher by as much; where it stretches it, lower. So the throughput
-  // (light per unit of output area) is divided by the image area of a pixel there (its chief rays',
-  // chief_ray_image_area) relative to the frame centre's at the focus distance, as the scatter
-  // method weighs a footprint's coverage (footprint.cpp, FootprintPlan::area). (The centroids'
-  // Jacobian above put the corners of a wall through pbrt's 50 mm double Gauss 4.6 % bright against
-  // the ground truth, the chief rays' 3.9 %; without either, lentil's 14 mm Canon retrofocus came out
-  // 0.14 of the centre at its frame's edge against the truth's 0.27.) Natural vignetting off: a flat
-  // picture stays flat.
-  if (options_.vignetting) {
-    const double axial = chief_ray_image_area(model, {0.5 * w, 0.5 * h}, inverse_per_mm(camera_.focus_distance_mm()));
-    if (axial > 0.0) {
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
-      for (int d = 0; d < depths_; ++d) {
-        for (int gy = 0; gy < kGridY; ++gy) {
-          for (int gx = 0; gx < kGridX; ++gx) {
-            const PixelPoint node{gx * cell_x_ - margin_, gy * cell_y_ - margin_};
-            const double image_area = chief_ray_image_area(model, node, w0_ + d * dw_);
-            if (image_area > 0.0) entries_[index(gx, gy, d)].throughput *= static_cast<float>(axial / image_area);
-          }
+  // (light per unit of output area) is divided by the image area of a pixel there (ImageAreaTable:
+  // its chief rays' area relative to the frame centre's), as the scatter method weighs a footprint's
+  // coverage (FootprintPlan::area). (The centroids' Jacobian above put the corners of a wall through
+  // pbrt's 50 mm double Gauss 4.6 % bright against the ground truth, the chief rays' 3.9 %; without
+  // either, lentil's 14 mm Canon retrofocus came out 0.14 of the centre at its frame's edge against
+  // the truth's 0.27.) Natural vignetting off: a flat picture stays flat.
+  if (options_.vignetting && ImageAreaTable::needed(model)) {
+    const ImageAreaTable areas(model, margin_, w_min, w_max, threads);
+    for (int d = 0; d < depths_; ++d) {
+      for (int gy = 0; gy < kGridY; ++gy) {
+        for (int gx = 0; gx < kGridX; ++gx) {
+          entries_[index(gx, gy, d)].throughput /= areas.at(gx * cell_x_ - margin_, gy * cell_y_ - margin_, w0_ + d * dw_);
         }
       }
     }

@@ -148,11 +148,9 @@ void require_poly_model_lens(const Camera& camera);
 // output pixels that the chief rays (pupil centre, reference wavelength) of `at` and of the points
 // `step_px` to its right and below span (distortion, focus breathing). Where a lens compresses the
 // picture (barrel distortion) an output pixel takes in more of the scene and its irradiance is
-// higher by as much: the renderers weigh their footprints by it against the frame centre's.
-// `chief_px`, where given, is where `at`'s chief ray lands (output px), already mapped. 0 where a
-// chief ray lands nowhere.
-double chief_ray_image_area(const RayModel& model, const PixelPoint& at, double inverse_depth_per_mm, double step_px = 1.0,
-                            const PixelPoint* chief_px = nullptr);
+// higher by as much: the renderers weigh their footprints by it against the frame centre's. 0 where
+// a chief ray lands nowhere.
+double chief_ray_image_area(const RayModel& model, const PixelPoint& at, double inverse_depth_per_mm, double step_px = 1.0);
 
 // Thin needs a thin-lens camera; the others a camera made from a prescription. Throws OptionsError
 // for a mismatch (poly: a fit of another lens, a stop wider than the fit's, a frame or wavelength
