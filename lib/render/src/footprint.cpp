@@ -908,6 +908,26 @@ void FootprintScatter::plan_range(std::span<const ScatterSource> sources, std::s
   const bool meshes = !(model_.affine_in_pupil() && aperture_.is_uniform_convex());
   const bool reuse = options_.reuse_shapes && meshes &&
                      (model_.kind() == RayModelKind::Paraxial || model_.kind() == RayModelKind::Seidel);
+  if (!reuse && model_.kind() == RayModelKind::Thin) {
+    // A thin lens images every point at one depth alike, moved with it: its chief ray goes through
+    // the lens's centre, undeviated, to where the pinhole puts the point, and the aperture's image
+    // about it depends on the depth alone (no weights, no clear apertures, no distortion). So a
+    // source at the inverse depth of one planned before it in the range takes that plan moved by the
+    // difference of their pixels' centres (walls, the sky and a level ground's rows hold many equal
+    // depths); the street scene's thin-lens process planned in 25 ms of CPU before.
+    std::size_t planned = end;
+    for (std::size_t i = begin; i < end; ++i) {
+      const ScatterSource& s = sources[i];
+      if (planned != end && sources[planned].inverse_depth_per_mm == s.inverse_depth_per_mm &&
+          sources[planned].coverage_only == s.coverage_only) {
+        plans[i] = moved_plan(plans[planned], sources[planned], s);
+      } else {
+        plans[i] = plan(s, scratch);
+        planned = i;
+      }
+    }
+    return;
+  }
   if (!reuse) {
     for (std::size_t i = begin; i < end; ++i) plans[i] = plan(sources[i], scratch);
     return;
@@ -949,6 +969,17 @@ void FootprintScatter::plan_range(std::span<const ScatterSource> sources, std::s
     fill(fill, i, last);
     i = last;
   }
+}
+
+FootprintPlan moved_plan(const FootprintPlan& p, const ScatterSource& from, const ScatterSource& to) {
+  const PixelPoint a = source_centre(from), b = source_centre(to);
+  const auto dx = static_cast<float>(b.x - a.x), dy = static_cast<float>(b.y - a.y);
+  FootprintPlan q = p;
+  q.affine_px[0] += dx;
+  q.affine_px[1] += dy;
+  q.y_min += dy;
+  q.y_max += dy;
+  return q;
 }
 
 int footprint_subrows(const FootprintPlan& p, int buffer_subrows) {

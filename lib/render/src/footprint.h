@@ -145,6 +145,10 @@ struct FootprintScratch {
   void forget_shape() { shape.valid = false; }
 };
 
+// The plan of source `from` moved to source `to`'s pixel (where its chief ray lands, the rows it
+// touches), for a model that images every point of a depth alike (the thin lens: plan_range).
+FootprintPlan moved_plan(const FootprintPlan& p, const ScatterSource& from, const ScatterSource& to);
+
 // Sub-rows per pixel (of `buffer_subrows`, the buffer's) at which a footprint's own polygons (its
 // outline, its ring polygons) are scanned: all of them below kMediumFootprintPx grid cells high, half
 // below kTallFootprintPx, a quarter above (at least 1). Only a tall footprint's top and bottom rows
