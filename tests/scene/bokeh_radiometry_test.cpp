@@ -246,6 +246,42 @@ TEST_CASE("Barrel distortion brightens the frame's edges as in the ground truth:
   }
 }
 
+TEST_CASE("Beyond a fisheye's image circle the frame stays black, as in the ground truth, through every lens model",
+          "[scene][radiometry]") {
+  // pbrt's 10 mm fisheye (155.9 deg) on a 36 mm frame: its image circle, about 13.6 mm across at
+  // 78 deg (lensmith analyze), leaves the frame's corners dark. The renderer used to fill every pixel
+  // no footprint reached with the colours around it, and the corners came out grey (0.2 to 0.4 of the
+  // centre) where the truth is black.
+  const Prescription lens = lens_at("pbrt-fisheye-10mm");
+  const int w = 48, h = 32;
+  CameraOptions co;
+  co.focus_distance_m = 2.0;
+  const Camera camera = Camera::from_lens(lens, co, w, h);
+  const auto [truth, input] = truth_and_input(white_wall(2.0), camera, 64);
+  // Black: below a thousandth of the centre (no ray of the truth reaches those pixels at all).
+  constexpr double kBlack = 1e-3;
+  const double truth_centre = patch_mean(truth.rgb, w / 2 - 2, h / 2 - 2, 4, 4);
+  REQUIRE(truth_centre > 0.5);
+  for (RayModelKind kind : {RayModelKind::Seidel, RayModelKind::Exact}) {
+    const auto model = make_ray_model(kind, camera);
+    BokehOptions bo;
+    bo.spectral = false;
+    const Image out = render_bokeh(input.rgb, input.depth, *model, Aperture::circular(), bo);
+    INFO(to_string(kind));
+    CHECK(patch_mean(out, w / 2 - 2, h / 2 - 2, 4, 4) > 0.5 * truth_centre);
+    int dark = 0;
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        if (truth.rgb.at(x, y, 1) > kBlack * truth_centre) continue;
+        ++dark;
+        INFO("pixel (" << x << ", " << y << "): " << out.at(x, y, 1) << " of a centre of " << truth_centre);
+        CHECK(out.at(x, y, 1) <= kBlack * truth_centre);
+      }
+    }
+    CHECK(dark > 100);  // the corners beyond the circle (about a fifth of the frame)
+  }
+}
+
 TEST_CASE("A pixel's chief-ray image area through the render camera follows the distortion curve of lensmith analyze",
           "[scene][radiometry]") {
   // The Canon 35 mm (-1 % distortion at 27 deg at its paraxial focus, with real aiming) focused far

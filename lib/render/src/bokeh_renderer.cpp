@@ -20,6 +20,7 @@
 #include "depth_layers.h"
 #include "footprint.h"
 #include "hidden_surfaces.h"
+#include "image_circle.h"
 #include "image_area_table.h"
 #include "layer_compositing.h"
 #include "mixed_pixels.h"
@@ -215,7 +216,10 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   stats.triangles = triangles;
   stats.reused_shapes = reused;
   stats.unaimed_rays = model.unaimed_rays() - unaimed_before;
-  return render_detail::finish_composite(result, w, h, threads, hidden_scratch.cells, hidden_scratch.push_pull);
+  // The lens's image circle, where some pixel is left uncovered (a fisheye's frame corners).
+  const render_detail::ImageCircle circle =
+      render_detail::has_gaps(result) ? render_detail::ImageCircle(model, threads) : render_detail::ImageCircle();
+  return render_detail::finish_composite(result, w, h, threads, hidden_scratch.cells, hidden_scratch.push_pull, circle);
 }
 
 // Sources beyond a w x h frame over `margin` px each side, copies of the nearest edge pixel's parts

@@ -16,6 +16,9 @@ constexpr double kRenormaliseCoverage = 0.05;
 // (coverage of a tiling of distorted footprints wanders a few per cent around 1), never with the
 // pixel's own amplified light.
 constexpr double kKnownCoverage = 0.9;
+// A frame with no pixel covered less than this has no part beyond the lens's image circle worth
+// measuring it for (a pixel there gets no light at all; coverage wanders a few per cent elsewhere).
+constexpr double kHalfCovered = 0.5;
 // Coverage short of 1 by less than this is rounding, not a gap.
 constexpr double kGapTolerance = 1e-9;
 }  // namespace
@@ -42,11 +45,23 @@ void composite_layer_over(const LargeVector<float>& layer_rgba, const LargeVecto
   }
 }
 
+bool has_gaps(const LargeVector<double>& result) {
+  for (std::size_t k = 3; k < result.size(); k += 4) {
+    if (result[k] < kHalfCovered) return true;
+  }
+  return false;
+}
+
 Image finish_composite(const LargeVector<double>& result, int width, int height, int threads,
-                       LargeVector<PushPullCell<5>>& fill, PushPullScratch<5>& scratch) {
+                       LargeVector<PushPullCell<5>>& fill, PushPullScratch<5>& scratch, const ImageCircle& circle) {
   const std::size_t count = static_cast<std::size_t>(width) * height;
+  // Gaps beyond the lens's image circle stay dark: nothing the lens images lands there.
+  auto reached = [&](std::size_t k) {
+    return circle.reaches(static_cast<double>(k % static_cast<std::size_t>(width)) + 0.5,
+                          static_cast<double>(k / static_cast<std::size_t>(width)) + 0.5);
+  };
   bool any_gap = false;
-  for (std::size_t k = 0; k < count && !any_gap; ++k) any_gap = result[4 * k + 3] < kRenormaliseCoverage;
+  for (std::size_t k = 0; k < count && !any_gap; ++k) any_gap = result[4 * k + 3] < kRenormaliseCoverage && reached(k);
   // The push-pull fill (5 floats a pixel) only where some gap is too empty to renormalise.
   const auto pixels = static_cast<std::ptrdiff_t>(count);
   if (any_gap) {
@@ -64,6 +79,10 @@ Image finish_composite(const LargeVector<double>& result, int width, int height,
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (std::ptrdiff_t k = 0; k < pixels; ++k) {
     const double gap = std::max(0.0, 1.0 - result[4 * k + 3]);
+    if (gap > kGapTolerance && circle.bounded() && !reached(static_cast<std::size_t>(k))) {
+      for (std::size_t c = 0; c < 3; ++c) out.data[3 * k + c] = static_cast<float>(std::max(0.0, result[4 * k + c]));
+      continue;
+    }
     if (gap > 0.0 && result[4 * k + 3] >= kRenormaliseCoverage) {
       for (std::size_t c = 0; c < 3; ++c) out.data[3 * k + c] = static_cast<float>(std::max(0.0, result[4 * k + c] / result[4 * k + 3]));
       continue;

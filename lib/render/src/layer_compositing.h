@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "lensmith/core/huge_page_allocator.h"
+#include "image_circle.h"
 #include "push_pull.h"
 
 #include "lensmith/render/image.h"
@@ -23,9 +24,14 @@ namespace lensmith::render_detail {
 void composite_layer_over(const LargeVector<float>& layer_rgba, const LargeVector<float>* holes, LargeVector<double>& result,
                           int width, int row_begin, int row_end);
 
-// The output picture: the result with its uncovered remainder filled, on `threads` threads; `fill`
-// and `scratch` are working memory kept by the caller (their contents are overwritten).
+// Whether some pixel of the result is covered less than half (then the image circle is measured).
+bool has_gaps(const LargeVector<double>& result);
+
+// The output picture: the result with its uncovered remainder filled, on `threads` threads, except
+// beyond the lens's image circle, where the uncovered part stays dark and the covered part's light
+// is not spread over the pixel; `fill` and `scratch` are working memory kept by the caller (their
+// contents are overwritten).
 Image finish_composite(const LargeVector<double>& result, int width, int height, int threads,
-                       LargeVector<PushPullCell<5>>& fill, PushPullScratch<5>& scratch);
+                       LargeVector<PushPullCell<5>>& fill, PushPullScratch<5>& scratch, const ImageCircle& circle);
 
 }  // namespace lensmith::render_detail
