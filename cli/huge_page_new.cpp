@@ -1,4 +1,4 @@
-// The command line's global operator new and delete: blocks of 512 KiB and more come as whole,
+// The command line's global operator new and delete: blocks of 2 MiB and more come as whole,
 // 2-MiB aligned pages advised to the kernel as transparent huge pages (allocate_huge_pages, what
 // HugePageAllocator gives the renderer's own frame-sized buffers), so that the rest (pictures and
 // depth maps as read, the EXR codec's buffers, the output picture) is faulted in 2 MiB at a time

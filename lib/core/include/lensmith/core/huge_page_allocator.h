@@ -1,5 +1,5 @@
 // An allocator for the renderer's frame-sized buffers (sources, layers, splat bands, composites):
-// blocks of 512 KiB and more are aligned to 2 MiB, rounded up to whole 2 MiB pages and advised to
+// blocks of 2 MiB and more are aligned to 2 MiB, rounded up to whole 2 MiB pages and advised to
 // the kernel as transparent huge pages, so that touching them for the first time costs one page
 // fault per 2 MiB instead of one per 4 KiB. On a virtual machine a fault is expensive: on the KVM guest of docs/performance.md, first
 // touching 256 MiB took 0.84-0.98 s in 4 KiB pages and 0.025 s in huge pages, and a 1080p render
@@ -20,8 +20,14 @@ namespace lensmith {
 
 // Blocks from this size up are advised as huge pages, rounded up to whole 2 MiB pages: a block of
 // 512 KiB faulted in as 128 small pages costs about 1.5 ms on that guest, as one huge page 0.1 ms.
+// But a huge page is zeroed whole when first touched, so a block of 1 MiB rounded up to one wasted
+// half of it: smaller blocks are left to operator new, which in the command line comes from a heap
+// whose first 32 MiB are huge pages already (cli/huge_page_new.cpp), packed without rounding. From
+// 512 KiB, the street scene's thin-lens process touched 115 MB and from 2 MiB 95 MB: 138.0 -> 131.7 ms
+// at f/1.4 and 107.6 -> 101.0 ms at f/16 (docs/performance.md). Elsewhere (the Python module)
+// blocks under 2 MiB are faulted in 4 KiB at a time, as std::allocator's are.
 inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
-inline constexpr std::size_t kHugePageFromBytes = std::size_t{512} << 10;
+inline constexpr std::size_t kHugePageFromBytes = std::size_t{2} << 20;
 
 // A block of at least kHugePageFromBytes bytes (the caller checks), 2-MiB aligned, its size rounded
 // up to whole huge pages and advised as such; released by std::free. Throws std::bad_alloc.
