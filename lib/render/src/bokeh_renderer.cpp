@@ -97,7 +97,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   const bool stretch = options.hidden == HiddenSurfaces::Stretch;
   LargeVector<float> layer_rgba(static_cast<std::size_t>(w) * h * 4);
   LargeVector<float> hole_rgba(stretch ? layer_rgba.size() : 0);  // Stretch: coverage of the hidden sources
-  LargeVector<double> result(static_cast<std::size_t>(w) * h * 4, 0.0);  // premultiplied RGB + coverage
+  LargeVector<float> result(static_cast<std::size_t>(w) * h * 4, 0.0f);  // premultiplied RGB + coverage
   const int bands = std::max(1, std::min(h, threads * (model.affine_in_pupil() ? kBandsPerThreadAffine : kBandsPerThreadMapped)));
   std::size_t done = 0;
   std::atomic<std::size_t> footprints{0}, triangles{0}, reused{0};

@@ -23,7 +23,7 @@ constexpr double kHalfCovered = 0.5;
 constexpr double kGapTolerance = 1e-9;
 }  // namespace
 
-void composite_layer_over(const LargeVector<float>& layer_rgba, const LargeVector<float>* holes, LargeVector<double>& result,
+void composite_layer_over(const LargeVector<float>& layer_rgba, const LargeVector<float>* holes, LargeVector<float>& result,
                           int width, int row_begin, int row_end) {
   for (std::size_t k = static_cast<std::size_t>(row_begin) * width; k < static_cast<std::size_t>(row_end) * width; ++k) {
     double c[4] = {layer_rgba[4 * k], layer_rgba[4 * k + 1], layer_rgba[4 * k + 2], layer_rgba[4 * k + 3]};
@@ -41,18 +41,18 @@ void composite_layer_over(const LargeVector<float>& layer_rgba, const LargeVecto
       continue;  // rounding of an empty region
     }
     const double keep = 1.0 - c[3];
-    for (std::size_t ch = 0; ch < 4; ++ch) result[4 * k + ch] = c[ch] + keep * result[4 * k + ch];
+    for (std::size_t ch = 0; ch < 4; ++ch) result[4 * k + ch] = static_cast<float>(c[ch] + keep * result[4 * k + ch]);
   }
 }
 
-bool has_gaps(const LargeVector<double>& result) {
+bool has_gaps(const LargeVector<float>& result) {
   for (std::size_t k = 3; k < result.size(); k += 4) {
     if (result[k] < kHalfCovered) return true;
   }
   return false;
 }
 
-Image finish_composite(const LargeVector<double>& result, int width, int height, int threads,
+Image finish_composite(const LargeVector<float>& result, int width, int height, int threads,
                        LargeVector<PushPullCell<5>>& fill, PushPullScratch<5>& scratch, const ImageCircle& circle) {
   const std::size_t count = static_cast<std::size_t>(width) * height;
   // Gaps beyond the lens's image circle stay dark: nothing the lens images lands there.
@@ -68,28 +68,28 @@ Image finish_composite(const LargeVector<double>& result, int width, int height,
     fill.resize(count);  // every cell is written below
 #pragma omp parallel for num_threads(threads) schedule(static)
     for (std::ptrdiff_t k = 0; k < pixels; ++k) {
-      const double coverage = result[4 * k + 3];
-      fill[k] = coverage >= kKnownCoverage ? PushPullCell<5>{static_cast<float>(result[4 * k]), static_cast<float>(result[4 * k + 1]),
-                                                             static_cast<float>(result[4 * k + 2]), 0.0f, static_cast<float>(coverage)}
+      const float coverage = result[4 * k + 3];
+      fill[k] = coverage >= kKnownCoverage ? PushPullCell<5>{result[4 * k], result[4 * k + 1], result[4 * k + 2], 0.0f, coverage}
                                            : PushPullCell<5>{};
     }
     push_pull(width, height, fill, threads, &scratch);
   }
   Image out(width, height, 3);
+  auto at = [&](std::ptrdiff_t i) { return static_cast<double>(result[static_cast<std::size_t>(i)]); };
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (std::ptrdiff_t k = 0; k < pixels; ++k) {
-    const double gap = std::max(0.0, 1.0 - result[4 * k + 3]);
+    const double gap = std::max(0.0, 1.0 - at(4 * k + 3));
     if (gap > kGapTolerance && circle.bounded() && !reached(static_cast<std::size_t>(k))) {
-      for (std::size_t c = 0; c < 3; ++c) out.data[3 * k + c] = static_cast<float>(std::max(0.0, result[4 * k + c]));
+      for (std::size_t c = 0; c < 3; ++c) out.data[3 * k + c] = static_cast<float>(std::max(0.0, at(4 * k + c)));
       continue;
     }
-    if (gap > 0.0 && result[4 * k + 3] >= kRenormaliseCoverage) {
-      for (std::size_t c = 0; c < 3; ++c) out.data[3 * k + c] = static_cast<float>(std::max(0.0, result[4 * k + c] / result[4 * k + 3]));
+    if (gap > 0.0 && at(4 * k + 3) >= kRenormaliseCoverage) {
+      for (std::size_t c = 0; c < 3; ++c) out.data[3 * k + c] = static_cast<float>(std::max(0.0, at(4 * k + c) / at(4 * k + 3)));
       continue;
     }
     for (std::size_t c = 0; c < 3; ++c) {
       // A gap below kRenormaliseCoverage exists only where any_gap made the fill.
-      out.data[3 * k + c] = static_cast<float>(std::max(0.0, result[4 * k + c] + (gap > 0.0 && any_gap ? gap * fill[k][c] : 0.0)));
+      out.data[3 * k + c] = static_cast<float>(std::max(0.0, at(4 * k + c) + (gap > 0.0 && any_gap ? gap * fill[k][c] : 0.0)));
     }
   }
   return out;
