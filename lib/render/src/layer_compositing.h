@@ -4,7 +4,8 @@
 // layers do not cover fully at the end (the frame's borders, where part of the blur would come
 // from beyond the frame), the covered part's colour stands for the whole pixel, as in a normalised
 // gather; a pixel covered less than 5 % takes the colour of the fully covered pixels around it by
-// push-pull, never its own amplified light. A flat image keeps its mean.
+// push-pull, never its own amplified light. A flat image keeps its mean. Beyond the lens's image
+// circle (image_circle.h) neither: what light arrived stays as it is, the rest is dark.
 #pragma once
 
 #include <array>
