@@ -58,6 +58,15 @@ TruthAndInput truth_and_input(const Scene& scene, const Camera& camera, int spp)
   return {render_through_lens(scene, camera, ro), render_pinhole(scene, camera.frame())};
 }
 
+// The bokeh renderer's picture of `input` through a round iris at one wavelength, as the truth above
+// is traced; `vignetting` false: every point as bright as on the axis.
+Image render_one_wavelength(const PinholeRender& input, const RayModel& model, bool vignetting = true) {
+  BokehOptions bo;
+  bo.spectral = false;
+  bo.vignetting = vignetting;
+  return render_bokeh(input.rgb, input.depth, model, Aperture::circular(), bo);
+}
+
 }  // namespace
 
 TEST_CASE("The ground truth through the lens falls off across the field as the relative illumination of lensmith analyze",
@@ -122,11 +131,9 @@ TEST_CASE("Every ray model renders a flat white wall through a vignetting lens a
   constexpr double kCentre = 0.015;
   // Without vignetting a flat white wall in focus keeps its 1.0 in every pixel: float rounding; headroom, not derived.
   constexpr double kUnvignetted = 1e-3;
-  BokehOptions bo;
-  bo.spectral = false;
   for (const auto& [kind, tolerance] : models) {
     const auto model = make_ray_model(kind, camera, mo);
-    const Image out = render_bokeh(input.rgb, input.depth, *model, Aperture::circular(), bo);
+    const Image out = render_one_wavelength(input, *model);
     // Along the diagonal, 4 x 4 patches from 4 px inside the corner to the centre.
     for (int x = 4; x <= w / 2 - 4; x += 6) {
       const int y = x * h / w;
@@ -139,9 +146,7 @@ TEST_CASE("Every ray model renders a flat white wall through a vignetting lens a
     INFO(to_string(kind) << " centre " << centre << ", ground truth " << patch_mean(truth.rgb, w / 2 - 2, h / 2 - 2, 4, 4));
     CHECK(centre == Approx(patch_mean(truth.rgb, w / 2 - 2, h / 2 - 2, 4, 4)).epsilon(kCentre));
     // Without vignetting, every point as bright as the centre.
-    BokehOptions flat = bo;
-    flat.vignetting = false;
-    const Image unlit = render_bokeh(input.rgb, input.depth, *model, Aperture::circular(), flat);
+    const Image unlit = render_one_wavelength(input, *model, false);
     CHECK(patch_mean(unlit, 4, 3, 4, 4) == Approx(1.0).epsilon(kUnvignetted));
   }
 }
@@ -162,9 +167,7 @@ TEST_CASE("The exact model aims every rim ray of a strongly aberrated pupil: a w
   const Camera camera = Camera::from_lens(lens_at("sasian-triplet"), co, w, h);
   const auto [truth, input] = truth_and_input(white_wall(1.2), camera, 512);
   const auto exact = make_ray_model(RayModelKind::Exact, camera);
-  BokehOptions bo;
-  bo.spectral = false;
-  const Image out = render_bokeh(input.rgb, input.depth, *exact, Aperture::circular(), bo);
+  const Image out = render_one_wavelength(input, *exact);
   // Along the diagonal from the centre to 4 px inside the corner, every 4 px.
   for (int x = w / 2 - 2; x >= 4; x -= 4) {
     const int y = (x + 2) * h / w - 2;
@@ -200,9 +203,7 @@ TEST_CASE("The fitted Seidel model darkens a defocused sky across the frame as t
   mo.nearest_depth_m = 1.0;
   mo.seidel_coefficients = SeidelCoefficients::Fitted;
   const auto fitted = make_ray_model(RayModelKind::Seidel, camera, mo);
-  BokehOptions bo;
-  bo.spectral = false;
-  const Image out = render_bokeh(input.rgb, input.depth, *fitted, Aperture::circular(), bo);
+  const Image out = render_one_wavelength(input, *fitted);
   double last = 0.0;
   for (int x = 2; x <= w / 2 - 2; x += 4) {
     const double expected = patch_mean(truth.rgb, x, h / 2 - 2, 4, 4);
@@ -228,9 +229,7 @@ TEST_CASE("Barrel distortion brightens the frame's edges as in the ground truth:
   const Camera camera = Camera::from_lens(lens, co, w, h);
   const auto [truth, input] = truth_and_input(white_wall(3.0), camera, 4096);
   const auto model = make_ray_model(RayModelKind::Exact, camera);
-  BokehOptions bo;
-  bo.spectral = false;
-  const Image out = render_bokeh(input.rgb, input.depth, *model, Aperture::circular(), bo);
+  const Image out = render_one_wavelength(input, *model);
   // Each 4 x 4 patch against the centre's, from the centre to 2 px inside the right edge. Tolerance:
   // the truth's noise (about 1.5 % a patch at this sample count, twice for the ratio) and the exact
   // model's own error at the edge (0.378 against 0.414 measured there; its rays that cannot be aimed
@@ -264,9 +263,7 @@ TEST_CASE("Beyond a fisheye's image circle the frame stays black, as in the grou
   REQUIRE(truth_centre > 0.5);
   for (RayModelKind kind : {RayModelKind::Seidel, RayModelKind::Exact}) {
     const auto model = make_ray_model(kind, camera);
-    BokehOptions bo;
-    bo.spectral = false;
-    const Image out = render_bokeh(input.rgb, input.depth, *model, Aperture::circular(), bo);
+    const Image out = render_one_wavelength(input, *model);
     INFO(to_string(kind));
     CHECK(patch_mean(out, w / 2 - 2, h / 2 - 2, 4, 4) > 0.5 * truth_centre);
     int dark = 0;

@@ -218,7 +218,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   stats.unaimed_rays = model.unaimed_rays() - unaimed_before;
   // The lens's image circle, where some pixel is left uncovered (a fisheye's frame corners).
   const render_detail::ImageCircle circle =
-      render_detail::has_gaps(result) ? render_detail::ImageCircle(model, threads) : render_detail::ImageCircle();
+      render_detail::has_gaps(result) ? render_detail::ImageCircle(camera, threads) : render_detail::ImageCircle();
   return render_detail::finish_composite(result, w, h, threads, hidden_scratch.cells, hidden_scratch.push_pull, circle);
 }
 

@@ -175,7 +175,9 @@ class FootprintScatter {
   // neighbouring pixels of one row whose probes differ from the first's by under kShapeTolerancePx
   // beyond the move of their chief rays draws the first's mapped shape (FootprintPlan::shape_source):
   // only the pixels every kShapeStride apart and where that fails are probed, the others map their
-  // chief ray alone (see the .cpp). The result depends on [begin, end) alone, not on the thread.
+  // chief ray alone (see the .cpp). Through a thin lens a source at the depth of one planned before
+  // it in the range takes that plan moved to its pixel (moved_plan). The result depends on
+  // [begin, end) alone, not on the thread.
   void plan_range(std::span<const ScatterSource> sources, std::span<FootprintPlan> plans, std::size_t begin,
                   std::size_t end, FootprintScratch& scratch) const;
   // Deposits the footprint of layer source `index` into `buffer` (the plan's grid level):

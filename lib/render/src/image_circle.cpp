@@ -24,8 +24,7 @@ constexpr std::array<double, 4> kRingAreas{0.2, 0.45, 0.7, 0.95};
 constexpr int kSamplesPerRing = 8;
 }  // namespace
 
-ImageCircle::ImageCircle(const RayModel& model, int threads) {
-  const Camera& camera = model.camera();
+ImageCircle::ImageCircle(const Camera& camera, int threads) {
   if (camera.is_thin_lens() || camera.lens() == nullptr) return;
   const double lambda = camera.reference_wavelength_nm();
   std::optional<LensCamera> lens;

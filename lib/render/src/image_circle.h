@@ -12,7 +12,7 @@
 
 #include <vector>
 
-#include "lensmith/camera/ray_model.h"
+#include "lensmith/camera/camera.h"
 
 namespace lensmith::render_detail {
 
@@ -20,7 +20,8 @@ class ImageCircle {
  public:
   // Reaches every pixel (a thin lens, a lens LensCamera cannot trace, a circle beyond the frame).
   ImageCircle() = default;
-  ImageCircle(const RayModel& model, int threads);
+  // Measured through `camera`'s lens, whatever ray model renders with it.
+  ImageCircle(const Camera& camera, int threads);
 
   // Whether a ray through the lens reaches output point (x, y) (px; a pixel's centre): with a margin of
   // a pixel, the fisheye's pixels just outside its circle were filled and came out at 0.3 to 0.5 of
