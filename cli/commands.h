@@ -215,6 +215,7 @@ struct BokehCommandOptions {
   bool no_vignetting = false;                // --no-vignetting: every point as bright as on the axis
   bool no_spectral = false;                  // --no-spectral
   bool no_shape_reuse = false;               // --no-shape-reuse (BokehOptions::reuse_shapes)
+  bool rays_per_pixel = false;               // --rays-per-pixel (BokehOptions::interpolated_rays)
   int spectral_samples = 16;                 // --spectral-samples
   double highlight_gain = 1.0;               // --highlight-gain (8-bit inputs)
   double highlight_threshold = 0.98;         // --highlight-threshold

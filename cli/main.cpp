@@ -488,6 +488,9 @@ int main(int argc, char** argv) {
   bokeh_scatter_only.push_back(bokeh_cmd->add_flag("--no-shape-reuse", bokeh.no_shape_reuse,
                       "Map every pixel's footprint on its own (paraxial, Seidel; slower, for checking). By default a pixel whose "
                       "footprint differs from its row neighbour's by under 1/16 px beyond a move draws that neighbour's mapped shape"));
+  bokeh_scatter_only.push_back(bokeh_cmd->add_flag("--rays-per-pixel", bokeh.rays_per_pixel,
+                      "exact, poly: aim and trace every pixel's footprint rays itself (much slower, for checking). By default a "
+                      "rotationally symmetric lens's rays are interpolated from a table every 8 px of field and 1 px of blur"));
   bokeh_cmd->add_flag("--no-spectral", bokeh.no_spectral, "Trace every ray at 587.6 nm and keep RGB as it is (no colour fringes)");
   bokeh_cmd->add_option("--spectral-samples", bokeh.spectral_samples, "Wavelengths of the spectral quadrature (3-64, default 16)")
       ->check(range(3, 64));

@@ -321,7 +321,7 @@ std::string BokehOptions::to_string() const {
   os << "BokehOptions(threads " << threads << ", " << splat.to_string() << ", layer spacing " << layer_spacing_px
      << " px, max layers " << max_layers << ", hidden " << lensmith::to_string(hidden) << ", spectral "
      << (spectral ? std::to_string(spectral_samples) + " nodes" : std::string("off")) << ", chromatic tolerance "
-     << chromatic_tolerance_px << " px, max blur " << max_blur_px << " px" << (reuse_shapes ? "" : ", shapes not reused") << ")";
+     << chromatic_tolerance_px << " px, max blur " << max_blur_px << " px" << (reuse_shapes ? "" : ", shapes not reused") << (interpolated_rays ? "" : ", rays per pixel") << ")";
   return os.str();
 }
 

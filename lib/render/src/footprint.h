@@ -13,6 +13,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -20,6 +21,7 @@
 #include "lensmith/render/splat_buffer.h"
 #include "footprint_stamps.h"
 #include "image_area_table.h"
+#include "mapped_pupil_table.h"
 #include "pupil_mesh_table.h"
 #include "scatter_source.h"
 #include "spectral_groups.h"
@@ -143,6 +145,8 @@ struct FootprintScratch {
   // rows, so that what a band draws does not depend on which thread drew which band before.
   FootprintShape shape;
   void forget_shape() { shape.valid = false; }
+  // The mapped-pupil table's nodes this thread used last (FootprintScatter's table, where it has one).
+  MappedPupilTable::Cache table_cache;
 };
 
 // The plan of source `from` moved to source `to`'s pixel (where its chief ray lands, the rows it
@@ -217,11 +221,15 @@ class FootprintScatter {
   void deposit_clipped_rings(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p, double passing,
                              bool allow_rings, bool shapes_checked, const std::array<float, 4>& value, FootprintShape& out,
                              int ring_subrows, FootprintScratch& scratch, std::size_t& triangles) const;
-  // model.map (set 0) or map_passing (set 1) of `pupil` at one wavelength into `hits`, from
-  // scratch.cached_maps when this footprint mapped them there already, else mapped (and kept when
-  // `keep`).
-  void map_cached(const ScenePoint& point, double wavelength_nm, int set, std::span<const PupilPoint> pupil,
+  // model.map (set 0: the points of mesh `mesh`, through map_set) or map_passing (set 1) of `pupil` at
+  // one wavelength into `hits`, from scratch.cached_maps when this footprint mapped them there already,
+  // else mapped (and kept when `keep`).
+  void map_cached(const ScenePoint& point, double wavelength_nm, int set, int mesh, std::span<const PupilPoint> pupil,
                   std::vector<SensorHit>& hits, FootprintScratch& scratch, bool keep) const;
+  // The model's map of a fixed pupil set (MappedPupilTable's sets: a mesh index, or its probe, centre
+  // or basis set), from the table where the render has one.
+  void map_set(const ScenePoint& point, double wavelength_nm, int set, std::span<const PupilPoint> pupil, std::span<SensorHit> hits,
+               FootprintScratch& scratch) const;
   // The clipped rings (clip_rings) mapped at one wavelength: scratch.hits, points, ring_spans, ring_weights.
   void map_clipped_rings(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p, FootprintScratch& scratch,
                          bool keep = false) const;
@@ -244,6 +252,8 @@ class FootprintScatter {
   // centre (the thin lens's): deposited from stamps.
   FootprintStamps stamps_;
   const ImageAreaTable& areas_;
+  // The exact and poly models' maps interpolated over field and depth (BokehOptions::interpolated_rays).
+  std::unique_ptr<MappedPupilTable> table_;
 };
 
 }  // namespace lensmith::render_detail

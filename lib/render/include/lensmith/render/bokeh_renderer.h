@@ -63,6 +63,11 @@ struct BokehOptions {
   // its own light (paraxial and Seidel models; docs/bokeh.md). false: every footprint mapped on its
   // own, slower, for checking.
   bool reuse_shapes = true;
+  // true: the exact and poly models' rays of a rotationally symmetric lens through a circular
+  // aperture interpolated from a table over field radius and inverse depth (nodes every 8 px of field
+  // and 1 px of blur; docs/bokeh.md), not aimed and traced per pixel. false: every footprint's rays
+  // from the model itself, much slower, for checking.
+  bool interpolated_rays = true;
   // Called with the fraction done (0..1) after each band of rows of each layer, from the rendering
   // threads one at a time (never concurrently): it must not assume the calling thread.
   std::function<void(double)> progress;
