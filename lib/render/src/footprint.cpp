@@ -61,19 +61,6 @@ constexpr double kShapeTolerancePx = 1.0 / 16.0;
 constexpr float kShapePassingTolerance = 0.004f;
 // Grid cells of an aperture-picture mesh per pixel of footprint size.
 constexpr double kPxPerGridCell = 1.5;
-// A stopped ray whose clearance is above -this (a fraction of the aperture's radius) passed just
-// beyond the clear aperture, and a clipped ring's edge is interpolated towards its landing; from one
-// stopped further out the edge is extrapolated from the passing side (clipped_mesh_rings). Measured
-// against the exact tracer's ground truth at 960 x 540 through pbrt-dgauss-50mm at f/2: 0.05 kept the
-// fence scene within 0.16 dB of the triangles' picture (0.02: 0.34 dB; 0.2: crescents, 0.6 dB) and
-// the occluder's edge band 0.04 dB closer to the truth.
-constexpr double kNearEdgeClearance = 0.05;
-// Clipped rings are deposited only where no annulus is lit more than this many times the footprint's
-// mean (annuli_even): where the interpolated landings squeeze an annulus while its pupil share stays,
-// it is a sliver of concentrated light. A uniform wall at 3 m through the double Gauss at f/2 focused
-// at 1.2 m showed such slivers as sparkles (second differences of 18 % between neighbouring pixels,
-// 0.13 % with triangles); with this guard 0.19 %, and half the footprints still go down as rings.
-constexpr double kClippedAnnulusLight = 3.0;
 // The polar mesh on which interpolated rays' clipped light is measured (MappedPupilTable::passing_light):
 // 8 rings of 48 sectors (PupilMeshTable's sector step 5). A white wall's corners through the double
 // Gauss at f/2 within 0.5 % of the ground truth with it (3 % too bright from the footprints' own
@@ -492,129 +479,6 @@ bool mesh_ring_spans(const PupilMesh& mesh, const std::vector<SensorHit>& hits, 
   return true;
 }
 
-// The rings of a polar mesh mapped by a model that clips ray by ray (exact, poly), cut where clear
-// apertures stop its rays: along each spoke (one sector's vertices from the centre out) the beam passes
-// up to where the clearances of the last passing vertex and the first stopped one interpolate to 0
-// (first order, as a clipped triangle is cut), and ring k reaches the smaller of that and span k / R
-// (span: the widest reach, so that no two rings clip to one polygon where every spoke is cut short of
-// the rim). Landings and weights between mesh vertices are interpolated along the spoke. Into scratch:
-// ring_pupil (the centre, then each ring's vertices), clipped_points, clipped_hits (their weights),
-// ring_offsets, ring_spans (untangled), pupil_areas (shares of the mesh's outline) and ring_weights.
-// False where the centre is stopped, a ray is lost before its spoke's edge, or a spoke passes again
-// beyond it: a beam nested rings cannot describe, left to the triangles.
-// Through pbrt-dgauss-50mm at f/2 (just beyond its f/2.03, so its rim is clipped even on the axis)
-// every footprint of an exact render went down triangle by triangle, 200-700 of them, before.
-// Whether no annulus of scratch's ring polygons is lit more than `factor` times the footprint's mean
-// (its pupil share over its mapped area against the whole's).
-bool annuli_even(const FootprintScratch& scratch, double factor) {
-  const auto area = [](std::span<const Point2f> ring) {
-    double twice = 0.0;
-    for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++) {
-      twice += static_cast<double>(ring[j].x) * ring[i].y - static_cast<double>(ring[i].x) * ring[j].y;
-    }
-    return 0.5 * std::abs(twice);
-  };
-  const std::size_t count = scratch.ring_spans.size();
-  if (count == 0) return false;
-  const double total = area(scratch.ring_spans.back());
-  if (!(total > 0.0)) return false;
-  const double mean = scratch.pupil_areas[count] / total;
-  double inner = 0.0;
-  for (std::size_t k = 1; k <= count; ++k) {
-    const double outer = area(scratch.ring_spans[k - 1]);
-    const double pupil = scratch.pupil_areas[k] - scratch.pupil_areas[k - 1];
-    if (pupil > factor * mean * (outer - inner)) return false;
-    inner = outer;
-  }
-  return true;
-}
-
-bool clipped_mesh_rings(const PupilMesh& mesh, const std::vector<SensorHit>& hits, const std::vector<Point2f>& points,
-                        FootprintScratch& scratch) {
-  const int rings = mesh.rings;
-  const auto sectors = static_cast<std::size_t>(mesh.sectors);
-  if (rings < 1 || sectors < 3 || !hits[0].ok) return false;
-  auto vertex = [sectors](int k, std::size_t s) { return k == 0 ? std::size_t{0} : 1 + static_cast<std::size_t>(k - 1) * sectors + s; };
-  std::vector<double>& reach = scratch.reach;  // (the discs' reach is not in use: these models have none)
-  reach.assign(sectors, 1.0);
-  scratch.spoke_stops.assign(sectors, 0);
-  double widest = 0.0;
-  for (std::size_t s = 0; s < sectors; ++s) {
-    int& stopped = scratch.spoke_stops[s];
-    for (int k = 1; k <= rings && stopped == 0; ++k) {
-      if (!hits[vertex(k, s)].ok) stopped = k;
-    }
-    if (stopped > 0) {
-      const SensorHit& a = hits[vertex(stopped - 1, s)];
-      const SensorHit& b = hits[vertex(stopped, s)];
-      if (!b.unclipped || !(a.clearance >= 0.0) || !(b.clearance < 0.0)) return false;
-      for (int k = stopped + 1; k <= rings; ++k) {
-        if (hits[vertex(k, s)].ok) return false;
-      }
-      const double along = a.clearance / (a.clearance - b.clearance);
-      reach[s] = (stopped - 1 + along) / rings;
-    }
-    widest = std::max(widest, reach[s]);
-  }
-  if (!(widest > 0.0)) return false;
-  const double span = std::min(1.0, widest);
-  std::vector<PupilPoint>& pupil = scratch.ring_pupil;
-  std::vector<Point2f>& mapped = scratch.clipped_points;
-  std::vector<SensorHit>& weights = scratch.clipped_hits;
-  pupil.assign(1, PupilPoint{0.0, 0.0});
-  mapped.assign(1, points[0]);
-  weights.assign(1, hits[0]);
-  scratch.ring_offsets.assign(1, 1);
-  scratch.pupil_areas.assign(1, 0.0);
-  scratch.ring_weights.assign(1, hits[0].weight);
-  scratch.clipped.assign(mesh.points.begin() + static_cast<std::ptrdiff_t>(vertex(rings, 0)), mesh.points.end());
-  const double outline_area = pupil_polygon_area(scratch.clipped);
-  if (!(outline_area > 0.0)) return false;
-  for (int k = 1; k <= rings; ++k) {
-    double weight_sum = 0.0;
-    scratch.clipped.clear();
-    for (std::size_t s = 0; s < sectors; ++s) {
-      const double radius = std::min(span * k / rings, reach[s]);
-      const double u = radius * rings;
-      const int j = std::min(static_cast<int>(u), rings - 1);
-      const double f = u - j;
-      const std::size_t i0 = vertex(j, s), i1 = vertex(j + 1, s);
-      Point2f q = points[i0];
-      double w = hits[i0].weight;
-      if (f > 0.0 && j + 1 == scratch.spoke_stops[s] && j >= 1 && hits[i1].clearance < -kNearEdgeClearance) {
-        // Beyond the last passing vertex, towards a ray stopped well beyond a clear aperture:
-        // extrapolated from that vertex and the one before. Such a ray's unclipped landing lies where
-        // the glass beyond the aperture would send it, often far out (its aberrations grow fast
-        // there), and interpolated towards it, the edge of a beam through the fence scene drew
-        // crescents 60 px wide around highlights.
-        const std::size_t ib = vertex(j - 1, s);
-        q = {static_cast<float>(q.x + f * (q.x - points[ib].x)), static_cast<float>(q.y + f * (q.y - points[ib].y))};
-        w += f * (w - hits[ib].weight);
-      } else if (f > 0.0) {
-        q = {static_cast<float>(q.x + f * (points[i1].x - q.x)), static_cast<float>(q.y + f * (points[i1].y - q.y))};
-        w += f * (hits[i1].weight - w);
-      }
-      mapped.push_back(q);
-      SensorHit h;
-      h.ok = true;
-      h.weight = w;
-      weights.push_back(h);
-      weight_sum += w;
-      const PupilPoint& edge = mesh.points[vertex(rings, s)];
-      pupil.push_back({edge.x * radius, edge.y * radius});
-      scratch.clipped.push_back(pupil.back());
-    }
-    scratch.ring_offsets.push_back(pupil.size());
-    scratch.pupil_areas.push_back(pupil_polygon_area(scratch.clipped) / outline_area);
-    scratch.ring_weights.push_back(weight_sum / static_cast<double>(sectors));
-  }
-  auto ring_range = [&scratch](int k) {
-    return std::pair{scratch.ring_offsets[static_cast<std::size_t>(k) - 1], scratch.ring_offsets[static_cast<std::size_t>(k)]};
-  };
-  untangled_ring_spans(mapped, rings, ring_range, scratch);
-  return true;
-}
-
 bool deposit_ring_polygons(const PupilMesh& mesh, const std::vector<SensorHit>& hits, const std::vector<Point2f>& points,
                            const std::array<float, 4>& value, bool weighted, FootprintShape& out, int subrows, bool shapes_checked,
                            FootprintScratch& scratch) {
@@ -932,8 +796,8 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
     spread = std::max(spread, dx * dx + dy * dy);
   }
   spread = std::sqrt(spread);
-  // The rows a footprint may touch (and its wavelength groups) come from every landing; its mesh and
-  // grid from the beam that passes. A clear aperture that stops part of a beam stops rays which, unclipped, would
+  // The rows a footprint may touch come from every landing; its mesh, grid and wavelength groups from
+  // the beam that passes. A clear aperture that stops part of a beam stops rays which, unclipped, would
   // land far out (through pbrt-dgauss-50mm at f/2, in focus at 0.6 of the field: probe rays 29 px
   // apart where the passing beam spans a few): sized by them, in-focus footprints got meshes of 12
   // rings and 32 sectors, most of an exact render's triangles.
@@ -1232,9 +1096,7 @@ void FootprintScatter::map_shape(const ScatterSource& s, const FootprintPlan& p,
           const PixelPoint q = camera_.output_pixel(hits[i].x_mm, hits[i].y_mm);
           points[i] = {static_cast<float>(q.x), static_cast<float>(q.y)};
         }
-        if (!mesh_ring_spans(mesh, hits, points, scratch) && !(clips_ray_by_ray() && clipped_mesh_rings(mesh, hits, points, scratch))) {
-          return false;
-        }
+        if (!mesh_ring_spans(mesh, hits, points, scratch)) return false;
       }
       return rings_nest(scratch.ring_spans, scratch.areas);
     };
@@ -1285,33 +1147,6 @@ void FootprintScatter::record_mesh(const ScenePoint& point, double wavelength_nm
   if (mesh.sectors > 0 && allow_rings &&
       deposit_ring_polygons(mesh, hits, points, kUnit, options_.vignetting, shape, own_subrows, rings_checked, scratch)) {
     return;
-  }
-  // Clipped by clear apertures (exact, poly): the rings cut along the spokes, where they nest.
-  if (mesh.sectors > 0 && allow_rings && clips_ray_by_ray() && clipped_mesh_rings(mesh, hits, points, scratch) &&
-      annuli_even(scratch, kClippedAnnulusLight)) {
-    std::array<float, 4> unit = kUnit;
-    if (table_ && options_.vignetting) {
-      // The light the rings carry (deposit_nested_rings: each annulus its pupil share at its two
-      // rings' mean weight) brought to the table's (MappedPupilTable::passing_light).
-      double rings_light = 0.0;
-      for (std::size_t k = 1; k < scratch.pupil_areas.size(); ++k) {
-        rings_light += (scratch.pupil_areas[k] - scratch.pupil_areas[k - 1]) * 0.5 * (scratch.ring_weights[k - 1] + scratch.ring_weights[k]);
-      }
-      const PupilMesh& fine = meshes_.mesh(PupilMeshTable::polar_mesh(kLightRings, kLightSectorStep));
-      if (rings_light > 0.0) {
-        const auto scale = static_cast<float>(table_->passing_light(point, wavelength_nm, fine, scratch.table_cache) / rings_light);
-        unit = {scale, scale, scale, 1.0f};
-      }
-    }
-    auto ring_begin = [&scratch](int k) { return scratch.ring_offsets[static_cast<std::size_t>(k) - 1]; };
-    auto centroid = [&](double& cx, double& cy) {
-      return fan_light_centroid(scratch.ring_pupil, scratch.clipped_points, scratch.clipped_hits, mesh.rings,
-                                static_cast<std::size_t>(mesh.sectors), ring_begin, options_.vignetting, cx, cy);
-    };
-    if (deposit_nested_rings(scratch.ring_spans, scratch.pupil_areas, scratch.ring_weights, 1.0, unit, options_.vignetting, centroid,
-                             shape, own_subrows, rings_checked, scratch)) {
-      return;
-    }
   }
   // A triangle whose corners a clear aperture partly stops (exact, poly) passes the part of its
   // area where the linear interpolation of their clearances is >= 0, in place: the beam's edge

@@ -129,11 +129,6 @@ struct FootprintScratch {
   std::vector<RingDeposit> ring_deposits;
   std::vector<Point2f> moved;  // a ring or a shared shape's polygon moved (deposit_nested_rings, draw_shape)
   std::vector<Point2f> ring_points;  // mapped points of the ring polygons, untangled (footprint.cpp)
-  // A mesh's rings cut where clear apertures stop its rays (clipped_mesh_rings, footprint.cpp): their
-  // landings and weights, interpolated along the mesh's spokes (the pupil points in ring_pupil).
-  std::vector<Point2f> clipped_points;
-  std::vector<SensorHit> clipped_hits;
-  std::vector<int> spoke_stops;  // the first stopped ring of each spoke (0: none)
   std::vector<std::span<const Point2f>> ring_spans;
   // One footprint's maps at each of its wavelengths, kept from the check whether its rings nest at
   // all of them to their deposit (set 0: the mesh by map, 1: the clipped rings by map_passing).
@@ -231,8 +226,6 @@ class FootprintScatter {
   // else mapped (and kept when `keep`).
   void map_cached(const ScenePoint& point, double wavelength_nm, int set, int mesh, std::span<const PupilPoint> pupil,
                   std::vector<SensorHit>& hits, FootprintScratch& scratch, bool keep) const;
-  // Whether the model clips ray by ray at real clear apertures (exact, poly: no pupil discs).
-  bool clips_ray_by_ray() const { return model_.kind() == RayModelKind::Exact || model_.kind() == RayModelKind::Poly; }
   // The model's map of a fixed pupil set (MappedPupilTable's sets: a mesh index, or its probe, centre
   // or basis set), from the table where the render has one.
   void map_set(const ScenePoint& point, double wavelength_nm, int set, std::span<const PupilPoint> pupil, std::span<SensorHit> hits,
