@@ -664,18 +664,6 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
   auto& px = probe.px;
   auto& ok = probe.ok;  // where the ray lands is known (it passes, or would)
   double x_min = kInfinity, x_max = -kInfinity, y_min = kInfinity, y_max = -kInfinity;
-  // The extent of what passes (exact, poly: where a clear aperture stops probe rays whose unclipped
-  // landings lie far out; see below).
-  struct Extent {
-    double x_min = kInfinity, x_max = -kInfinity, y_min = kInfinity, y_max = -kInfinity;
-    void add(double x, double y) {
-      x_min = std::min(x_min, x);
-      x_max = std::max(x_max, x);
-      y_min = std::min(y_min, y);
-      y_max = std::max(y_max, y);
-    }
-    double size() const { return std::max(x_max - x_min, y_max - y_min); }
-  } passing_extent;
   // Without dispersion (a thin lens, or colour off) one wavelength tells all.
   const std::size_t wavelengths = camera_.is_thin_lens() || !options_.spectral ? 1 : 3;
   probe.wavelengths = wavelengths;
@@ -747,17 +735,6 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
       x_max = std::max(x_max, px[l][i].x);
       y_min = std::min(y_min, px[l][i].y);
       y_max = std::max(y_max, px[l][i].y);
-      // The passing beam's extent (models that clip ray by ray): a stopped edge ray's landing pulled in
-      // along its spoke from the passing centre to where their clearances interpolate to 0.
-      if (scratch.discs.empty() && hits[0].ok) {
-        PixelPoint e = q;
-        if (!hits[i].ok) {
-          const double along = hits[0].clearance / (hits[0].clearance - hits[i].clearance);
-          const PixelPoint c = camera_.output_pixel(hits[0].x_mm, hits[0].y_mm);
-          e = {c.x + along * (q.x - c.x), c.y + along * (q.y - c.y)};
-        }
-        passing_extent.add(e.x, e.y);
-      }
     }
   }
   if (probe.chief_passes && !affine) {  // (an affine plan has them from its three rays)
@@ -796,14 +773,7 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
     spread = std::max(spread, dx * dx + dy * dy);
   }
   spread = std::sqrt(spread);
-  // The rows a footprint may touch come from every landing; its mesh, grid and wavelength groups from
-  // the beam that passes. A clear aperture that stops part of a beam stops rays which, unclipped, would
-  // land far out (through pbrt-dgauss-50mm at f/2, in focus at 0.6 of the field: probe rays 29 px
-  // apart where the passing beam spans a few): sized by them, in-focus footprints got meshes of 12
-  // rings and 32 sectors, most of an exact render's triangles.
-  const double reach = std::max(x_max - x_min, y_max - y_min);
-  const bool passing_only = any_clipped && scratch.discs.empty() && passing_extent.x_min <= passing_extent.x_max;
-  const double size = passing_only ? std::min(reach, passing_extent.size()) : reach;
+  const double size = std::max(x_max - x_min, y_max - y_min);
   // Coverage has no colour: one group carries it. A point whose colour spread just crossed into one
   // more group than its neighbour's is split both ways, its light cross-faded between the two over
   // kGroupBlend of the tolerance: each split places its colours at its groups' wavelengths, and a
@@ -816,7 +786,7 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
   }
   p.level = grid_level(size);
   const double cell_px = 1 << p.level;
-  const double margin = kTentMarginPx * cell_px + (near_affine ? 0.0 : kMeshMarginFraction * reach);
+  const double margin = kTentMarginPx * cell_px + (near_affine ? 0.0 : kMeshMarginFraction * size);
   p.y_min = static_cast<float>(y_min - margin);
   p.y_max = static_cast<float>(y_max + margin);
   // The outline need only follow the circle to 0.1 of a cell.
