@@ -42,8 +42,16 @@ std::size_t MappedPupilTable::KeyHash::operator()(const std::pair<std::uint64_t,
 
 bool MappedPupilTable::applies(const RayModel& model, const Aperture& aperture) {
   const Camera& camera = model.camera();
-  return (model.kind() == RayModelKind::Exact || model.kind() == RayModelKind::Poly) && aperture.kind() == Aperture::Kind::Circular &&
-         camera.lens() != nullptr && !camera.exact_model_only() && camera.squeeze() == 1.0;
+  if (!(model.kind() == RayModelKind::Exact || model.kind() == RayModelKind::Poly) || aperture.kind() != Aperture::Kind::Circular ||
+      camera.lens() == nullptr || camera.exact_model_only() || camera.squeeze() != 1.0) {
+    return false;
+  }
+  // Round surfaces may still have clear apertures that are not (a rectangle, an ellipse, a decentred
+  // circle, as a Zemax file can give them): those clip a beam differently at each azimuth.
+  return std::all_of(camera.lens()->surfaces.begin(), camera.lens()->surfaces.end(), [](const Surface& s) {
+    return !s.aperture || (s.aperture->shape == SurfaceAperture::Shape::Circular && s.aperture->decenter_x_mm == 0.0 &&
+                           s.aperture->decenter_y_mm == 0.0);
+  });
 }
 
 MappedPupilTable::MappedPupilTable(const RayModel& model) : model_(model) {

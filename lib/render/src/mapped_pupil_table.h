@@ -11,7 +11,8 @@
 // alone gives the hits of the pupil set turned by phi, not of the set itself: through a circular
 // aperture that is the same pupil sampled at other angles, which is all the renderer asks of a mesh
 // (its outer ring on the aperture's edge, its triangles' pupil areas unchanged). Blades and aperture
-// pictures are not round: they keep the model's own map.
+// pictures are not round, nor are a surface's rectangular, elliptical or decentred clear apertures:
+// they keep the model's own map.
 //
 // Nodes lie every kFieldStepPx pixels of field radius (pinhole pixels from the frame's centre; finer
 // on small frames, at least kFieldNodes across the half-diagonal) and every kBlurStepPx pixels of blur
