@@ -1131,8 +1131,14 @@ void FootprintScatter::record_mesh(const ScenePoint& point, double wavelength_nm
   // Colour carries the transmitted fraction and the rays' radiometric weights (vignetting darkens);
   // coverage is normalised over the light that passes, so a vignetted point is still an opaque
   // surface. Without vignetting the colour is normalised the same way.
-  double passed = 0.0;
-  for (const PupilTriangle& tri : mesh.triangles) passed += tri.weight * triangle_passing(tri);
+  // The share of the pupil that passes, and (interpolated rays) the light it carries at the rays'
+  // weights, for the table's finer measure below.
+  double passed = 0.0, coarse = 0.0;
+  for (const PupilTriangle& tri : mesh.triangles) {
+    const double fraction = triangle_passing(tri);
+    passed += tri.weight * fraction;
+    if (table_ && fraction > 0.0) coarse += tri.weight * fraction * (hits[tri.a].weight + hits[tri.b].weight + hits[tri.c].weight) / 3.0;
+  }
   if (!(passed > 0.0)) return;
   // Where the model describes its clipping as discs, the light that passes is known exactly (the
   // outline less the discs); the triangles' linear interpolation only distributes it.
@@ -1141,11 +1147,6 @@ void FootprintScatter::record_mesh(const ScenePoint& point, double wavelength_nm
   if (table_ && options_.vignetting) {
     // Interpolated rays (exact, poly): the light that passes from the table's finer mesh, this
     // mesh's triangles only distributing it (MappedPupilTable::passing_light says why).
-    double coarse = 0.0;
-    for (const PupilTriangle& tri : mesh.triangles) {
-      const double fraction = triangle_passing(tri);
-      if (fraction > 0.0) coarse += tri.weight * fraction * (hits[tri.a].weight + hits[tri.b].weight + hits[tri.c].weight) / 3.0;
-    }
     const PupilMesh& fine = meshes_.mesh(PupilMeshTable::polar_mesh(kLightRings, kLightSectorStep));
     if (coarse > 0.0) unlit = table_->passing_light(point, wavelength_nm, fine, scratch.table_cache) / coarse;
   }

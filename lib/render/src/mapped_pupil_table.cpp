@@ -71,11 +71,6 @@ MappedPupilTable::MappedPupilTable(const RayModel& model) : model_(model) {
 
 MappedPupilTable::~MappedPupilTable() = default;
 
-std::size_t MappedPupilTable::nodes() const {
-  std::shared_lock lock(mutex_);
-  return nodes_.size();
-}
-
 const MappedPupilTable::Node& MappedPupilTable::node(int set, double wavelength_nm, std::int64_t field_index, std::int64_t depth_index,
                                                      std::span<const PupilPoint> pupil, Cache& cache, const PupilMesh* fine) const {
   const std::uint64_t key = pack_key(set, field_index, depth_index);

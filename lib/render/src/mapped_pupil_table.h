@@ -83,8 +83,6 @@ class MappedPupilTable {
   // misjudged a cat's eye's light by up to 3 %, the same at every azimuth of a field radius once the
   // mesh turns with the point (a white wall's corners 0.302 where the ground truth has 0.294).
   double passing_light(const ScenePoint& point, double wavelength_nm, const PupilMesh& fine, Cache& cache) const;
-  // Nodes made so far (statistics).
-  std::size_t nodes() const;
 
  private:
   // The node of `set` (pupil points `pupil`; for kLightSet the points of `fine`, reduced to its light).
