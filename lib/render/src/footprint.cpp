@@ -157,19 +157,26 @@ double FootprintScatter::disc_passing_share(const std::vector<PupilDisc>& discs,
 
 namespace {
 
+// A ring's topmost and bottommost vertices (the first of each where several are at that height).
+std::pair<std::size_t, std::size_t> ring_ends(std::span<const Point2f> ring) {
+  std::size_t top = 0, bottom = 0;
+  for (std::size_t i = 1; i < ring.size(); ++i) {
+    if (ring[i].y < ring[top].y) top = i;
+    if (ring[i].y > ring[bottom].y) bottom = i;
+  }
+  return {top, bottom};
+}
+
 // Whether a ring that rises and falls once in y (two chains from its topmost to its bottommost
 // vertex) is simple: its two chains must not cross. One that does is a figure eight (a near-focus
 // beam with coma and astigmatism maps a pupil ring so), whose signed area, the difference of its
 // two lobes, can be near zero: spread over that area its light would become large positive and
 // negative densities. Each chain vertex strictly between the ends is compared with the other chain
 // at its height; both walks are monotone in y, so O(vertices).
-bool monotone_ring_is_simple(std::span<const Point2f> ring) {
+// `ends`: ring_ends(ring).
+bool monotone_ring_is_simple(std::span<const Point2f> ring, std::pair<std::size_t, std::size_t> ends) {
   const std::size_t n = ring.size();
-  std::size_t top = 0, bottom = 0;
-  for (std::size_t i = 1; i < n; ++i) {
-    if (ring[i].y < ring[top].y) top = i;
-    if (ring[i].y > ring[bottom].y) bottom = i;
-  }
+  const auto [top, bottom] = ends;
   const double y_top = ring[top].y, y_bottom = ring[bottom].y;
   auto next = [n](std::size_t i, bool forward) { return forward ? (i + 1 == n ? 0 : i + 1) : (i == 0 ? n - 1 : i - 1); };
   int side = 0;  // the sign of (this chain's x - the other's) seen so far
@@ -268,17 +275,11 @@ bool chain_left_of(RingChain& left, RingChain& right, double tolerance) {
 // orientation whose areas grow can still cross (near a caustic, a larger ring mapped off to one
 // side): their differences, deposited as ring polygons, would then be negative densities, dark and
 // bright crescents where a uniform wall is seen through the Biotar wide open in colour.
-bool ring_within(std::span<const Point2f> inner, std::span<const Point2f> outer, double orientation, double tolerance) {
-  auto ends = [](std::span<const Point2f> ring) {
-    std::size_t top = 0, bottom = 0;
-    for (std::size_t i = 1; i < ring.size(); ++i) {
-      if (ring[i].y < ring[top].y) top = i;
-      if (ring[i].y > ring[bottom].y) bottom = i;
-    }
-    return std::pair{top, bottom};
-  };
-  const auto [in_top, in_bottom] = ends(inner);
-  const auto [out_top, out_bottom] = ends(outer);
+// `inner_ends` and `outer_ends`: ring_ends of each.
+bool ring_within(std::span<const Point2f> inner, std::pair<std::size_t, std::size_t> inner_ends, std::span<const Point2f> outer,
+                 std::pair<std::size_t, std::size_t> outer_ends, double orientation, double tolerance) {
+  const auto [in_top, in_bottom] = inner_ends;
+  const auto [out_top, out_bottom] = outer_ends;
   if (inner[in_top].y < outer[out_top].y - tolerance || inner[in_bottom].y > outer[out_bottom].y + tolerance) return false;
   // Walking forward from the top, a ring of positive shoelace orientation (y pointing down) goes
   // down its right side.
@@ -350,6 +351,7 @@ bool rings_nest(const std::vector<std::span<const Point2f>>& rings, std::vector<
   const int count = static_cast<int>(rings.size());
   areas.assign(static_cast<std::size_t>(count) + 1, 0.0);
   double orientation = 0.0;
+  std::pair<std::size_t, std::size_t> inner_ends{0, 0};  // ring k - 1's, for the nesting check
   for (int k = 1; k <= count; ++k) {
     const std::span<const Point2f> ring = rings[static_cast<std::size_t>(k - 1)];
     const std::size_t n = ring.size();
@@ -374,11 +376,13 @@ bool rings_nest(const std::vector<std::span<const Point2f>>& rings, std::vector<
         if (last_dy != 0.0 && (dy > 0.0) != (last_dy > 0.0)) ++turns;
         last_dy = dy;
       }
-      if (turns > 2 || !monotone_ring_is_simple(ring)) return false;
+      const std::pair<std::size_t, std::size_t> ends = ring_ends(ring);
+      if (turns > 2 || !monotone_ring_is_simple(ring, ends)) return false;
+      if (k > 1 && !ring_within(rings[static_cast<std::size_t>(k - 2)], inner_ends, ring, ends, orientation, kNestingTolerancePx)) return false;
+      inner_ends = ends;
     }
     const double area = 0.5 * twice * orientation;
     if (!(area > areas[static_cast<std::size_t>(k) - 1] + 1e-3 * std::max(area, 1e-9))) return false;
-    if (!shapes_checked && k > 1 && !ring_within(rings[static_cast<std::size_t>(k - 2)], ring, orientation, kNestingTolerancePx)) return false;
     areas[static_cast<std::size_t>(k)] = area;
   }
   return true;
