@@ -111,7 +111,11 @@ TEST_CASE("A sharp subject sends no light beyond its silhouette into the blurred
   // Beyond 2 px outside the silhouette the truth has no red at all (the 2 px tent filter spreads
   // the edge by at most 1 px). Before the fix the frame showed up to 20 % of the subject's red there.
   constexpr double kMaxLeak = 0.01;     // of the subject's red, at any pixel
-  constexpr double kMaxMeanLeak = 1e-3; // of the subject's red, averaged over the band 2-14 px outside
+  // Of the subject's red, averaged over the band 2-14 px outside. Measured at most 0.10 % (averaged
+  // edge depths with --hidden stretch; 0.03 % until the depth layers were centred on the focus plane,
+  // which sends edge pixels blurred by 1-2 px to the layer behind the subject; every other case
+  // 0.06 % or less); a halo is 5 %, and before the fix the band held up to 20 %.
+  constexpr double kMaxMeanLeak = 2e-3;
   for (EdgeDepth edge : {EdgeDepth::FirstSample, EdgeDepth::Nearest, EdgeDepth::Farthest, EdgeDepth::Averaged}) {
     const Scene scene = disc_over_wall(w, h, radius_px, {0.8f, 0.0f, 0.0f}, 1.0, 5.0, edge);
     for (HiddenSurfaces hidden : {HiddenSurfaces::Extend, HiddenSurfaces::Stretch}) {

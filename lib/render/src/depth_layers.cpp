@@ -10,9 +10,22 @@ namespace lensmith::render_detail {
 
 LayerSpacing LayerSpacing::over(double coc_min_px, double coc_max_px, double spacing_px, int max_layers) {
   LayerSpacing l;
-  l.coc_min_px = coc_min_px;
-  l.spacing_px = std::max(spacing_px, (coc_max_px - coc_min_px) / max_layers);
-  l.count = std::max(1, static_cast<int>(std::floor((coc_max_px - coc_min_px) / l.spacing_px)) + 1);
+  const double range = coc_max_px - coc_min_px;
+  // The bins lie on a grid with one centred on blur 0, the focus plane: sharp points then share a
+  // layer only with what is blurred by less than half a spacing. Within a layer footprints
+  // average by coverage, and with the grid starting at the smallest blur a sharp light 3 m away
+  // shared its layer with a black wall at 6 m blurred by 1.85 px (pbrt-dgauss-50mm at f/2, 320 px
+  // wide): where the wall's blur reached the light's pixels, the light was averaged with it and
+  // kept 74 % of its light (paraxial; 87 % exact).
+  auto place = [&](double spacing) {
+    l.spacing_px = spacing;
+    l.coc_min_px = (std::floor((coc_min_px + 0.5 * spacing) / spacing) - 0.5) * spacing;
+    l.count = std::max(1, static_cast<int>(std::floor((coc_max_px - l.coc_min_px) / spacing)) + 1);
+  };
+  place(std::max(spacing_px, range / max_layers));
+  // The grid's offset can cost one bin more than the range needs: widened to fit the cap.
+  if (l.count > max_layers && max_layers > 1) place(range / (max_layers - 1));
+  l.count = std::min(l.count, std::max(1, max_layers));
   return l;
 }
 

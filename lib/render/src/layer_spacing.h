@@ -4,7 +4,8 @@
 
 namespace lensmith::render_detail {
 
-// Signed-blur layers evenly spaced: layer k holds blurs [coc_min_px + k spacing, + (k + 1) spacing).
+// Signed-blur layers evenly spaced: layer k holds blurs [coc_min_px + k spacing, + (k + 1) spacing),
+// on a grid with a layer centred on blur 0 (coc_min_px at most the smallest blur).
 struct LayerSpacing {
   double coc_min_px = 0.0;
   double spacing_px = 0.0;
