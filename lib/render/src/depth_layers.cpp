@@ -26,11 +26,24 @@ LayerSpacing LayerSpacing::over(double coc_min_px, double coc_max_px, double spa
   // The grid's offset can cost one bin more than the range needs: widened to fit the cap.
   if (l.count > max_layers && max_layers > 1) place(range / (max_layers - 1));
   l.count = std::min(l.count, std::max(1, max_layers));
+  // The focus bin cut in three: a sharp light in front of a wall blurred by 0.9 px (the case above,
+  // the wall at 4 m) still kept 85 % of its light, averaged with the wall where its 0.9 px reached.
+  if (l.coc_min_px <= 0.0 && 0.0 < l.coc_min_px + l.count * l.spacing_px) {
+    l.focus_split = true;
+    l.count += 2;
+  }
   return l;
 }
 
 int LayerSpacing::layer_at(double coc_px) const {
-  return std::clamp(static_cast<int>(std::floor((coc_px - coc_min_px) / spacing_px)), 0, count - 1);
+  const int grid = count - (focus_split ? 2 : 0);
+  const int g = std::clamp(static_cast<int>(std::floor((coc_px - coc_min_px) / spacing_px)), 0, grid - 1);
+  if (!focus_split) return g;
+  const int focus = static_cast<int>(std::floor(-coc_min_px / spacing_px));
+  if (g < focus) return g;
+  if (g > focus) return g + 2;
+  const double cut = kFocusCut * spacing_px;
+  return g + (coc_px < -cut ? 0 : coc_px < cut ? 1 : 2);
 }
 
 DepthLayers make_depth_layers(const ScatterSources& sources, int width, int height, const LayerSpacing& spacing, int threads) {
