@@ -298,11 +298,7 @@ bool ring_within(std::span<const Point2f> inner, std::pair<std::size_t, std::siz
 void untangle_ring(std::span<Point2f> ring) {
   const std::size_t n = ring.size();
   if (n < 3) return;
-  std::size_t top = 0, bottom = 0;
-  for (std::size_t i = 1; i < n; ++i) {
-    if (ring[i].y < ring[top].y) top = i;
-    if (ring[i].y > ring[bottom].y) bottom = i;
-  }
+  const auto [top, bottom] = ring_ends(ring);
   auto next = [n](std::size_t i, bool forward) { return forward ? (i + 1 == n ? 0 : i + 1) : (i == 0 ? n - 1 : i - 1); };
   float worst = 0.0f;
   for (const bool forward : {true, false}) {
@@ -1237,18 +1233,19 @@ void FootprintScatter::record_mesh(const ScenePoint& point, double wavelength_nm
   // surface. Without vignetting the colour is normalised the same way.
   // The share of the pupil that passes, and (interpolated rays) the light it carries at the rays'
   // weights, for the table's finer measure below.
+  const bool finer_light = table_ && options_.vignetting;
   double passed = 0.0, coarse = 0.0;
   for (const PupilTriangle& tri : mesh.triangles) {
     const double fraction = triangle_passing(tri);
     passed += tri.weight * fraction;
-    if (table_ && fraction > 0.0) coarse += tri.weight * fraction * (hits[tri.a].weight + hits[tri.b].weight + hits[tri.c].weight) / 3.0;
+    if (finer_light && fraction > 0.0) coarse += tri.weight * fraction * (hits[tri.a].weight + hits[tri.b].weight + hits[tri.c].weight) / 3.0;
   }
   if (!(passed > 0.0)) return;
   // Where the model describes its clipping as discs, the light that passes is known exactly (the
   // outline less the discs); the triangles' linear interpolation only distributes it.
   const double exact_share = !scratch.discs.empty() && aperture_.is_uniform_convex() ? static_cast<double>(p.passing) : passed;
   double unlit = options_.vignetting ? exact_share / passed : 1.0 / passed;
-  if (table_ && options_.vignetting) {
+  if (finer_light) {
     // Interpolated rays (exact, poly): the light that passes from the table's finer mesh, this
     // mesh's triangles only distributing it (MappedPupilTable::passing_light says why).
     const PupilMesh& fine = meshes_.mesh(PupilMeshTable::polar_mesh(kLightRings, kLightSectorStep));
