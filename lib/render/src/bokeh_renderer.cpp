@@ -21,6 +21,7 @@
 #include "footprint.h"
 #include "hidden_surfaces.h"
 #include "image_circle.h"
+#include "illumination_table.h"
 #include "image_area_table.h"
 #include "layer_compositing.h"
 #include "mixed_pixels.h"
@@ -80,8 +81,11 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   const render_detail::SpectralGroups groups(camera, options.spectral, options.spectral_samples);
   const render_detail::PupilMeshTable meshes(aperture);
   // Where the model has distortion, the image area of a pixel over the frame and the sources' depths.
+  // Where the model only approximates the lens's brightness across the frame, the real lens's.
   render_detail::ImageAreaTable areas;
-  if (render_detail::ImageAreaTable::needed(model) && !sources.empty()) {
+  render_detail::IlluminationTable illumination;
+  const bool real_illumination = render_detail::IlluminationTable::applies(model, aperture, options.vignetting);
+  if ((render_detail::ImageAreaTable::needed(model) || real_illumination) && !sources.empty()) {
     double w_min = sources.front().inverse_depth_per_mm, w_max = w_min;
 #pragma omp parallel for num_threads(threads) reduction(min : w_min) reduction(max : w_max)
     for (std::size_t i = 0; i < sources.size(); ++i) {
@@ -89,8 +93,12 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
       w_max = std::max(w_max, sources[i].inverse_depth_per_mm);
     }
     areas = render_detail::ImageAreaTable(model, margin, w_min, w_max, threads);
+    if (real_illumination) {
+      illumination = render_detail::IlluminationTable(model, meshes.mesh(FootprintScatter::light_mesh()), areas, margin, w_min,
+                                                      w_max, threads);
+    }
   }
-  const FootprintScatter scatter(model, aperture, groups, meshes, areas, options);
+  const FootprintScatter scatter(model, aperture, groups, meshes, areas, illumination, options);
   stats.layer_spacing_px = layers.spacing_px;
   const std::size_t unaimed_before = model.unaimed_rays();
 

@@ -730,9 +730,10 @@ std::array<float, 4> FootprintScatter::lit(const std::array<float, 4>& value, do
 }
 
 FootprintScatter::FootprintScatter(const RayModel& model, const Aperture& aperture, const SpectralGroups& groups,
-                                   const PupilMeshTable& meshes, const ImageAreaTable& areas, const BokehOptions& options)
+                                   const PupilMeshTable& meshes, const ImageAreaTable& areas, const IlluminationTable& illumination,
+                                   const BokehOptions& options)
     : model_(model), camera_(model.camera()), aperture_(aperture), groups_(groups), meshes_(meshes), options_(options),
-      stamps_(meshes, 0.5 * kHalfResolutionPx + kStampMarginPx), areas_(areas) {
+      stamps_(meshes, 0.5 * kHalfResolutionPx + kStampMarginPx), areas_(areas), illumination_(illumination) {
   if (options.interpolated_rays && MappedPupilTable::applies(model, aperture)) table_ = std::make_unique<MappedPupilTable>(model);
   probe_[0] = {0.0, 0.0};
   for (int k = 0; k < 8; ++k) {
@@ -744,6 +745,13 @@ FootprintScatter::FootprintScatter(const RayModel& model, const Aperture& apertu
     probe_directions_.inverse_length.push_back(1.0 / r);
   }
 }
+
+void FootprintScatter::clip_discs(const ScenePoint& point, std::vector<PupilDisc>& discs) const {
+  model_.clip_discs(point, discs);
+  illumination_.widen(point, discs);
+}
+
+int FootprintScatter::light_mesh() { return PupilMeshTable::polar_mesh(kLightRings, kLightSectorStep); }
 
 FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& scratch, FootprintProbe* probe_out) const {
   std::vector<PupilPoint>& pupil = scratch.pupil;
@@ -769,7 +777,7 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
   probe.wavelengths = wavelengths;
   // Where the model describes its clipping as pupil discs, those that cut the aperture say that the
   // beam is clipped, and the probe maps without clipping (cheaper).
-  model_.clip_discs(point, scratch.discs);
+  clip_discs(point, scratch.discs);
   bool any_clipped = !scratch.discs.empty();
   // The probe's edge points pulled in to the discs' edge where they cut it (star-shaped about the
   // centre when the centre passes): the footprint's extent and its colour spread are the passing
@@ -915,6 +923,7 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
     p.passing = static_cast<float>(disc_passing_share(scratch.discs, own_step, scratch));
   }
   p.area = areas_.at(centre.x, centre.y, s.inverse_depth_per_mm);
+  p.light = illumination_.factor(point);
   if (probe_out != nullptr) *probe_out = probe;
   return p;
 }
@@ -1010,6 +1019,7 @@ bool FootprintScatter::follow(const ScatterSource& s, const FootprintPlan& a, co
   const auto f = static_cast<float>(along);
   const PixelPoint centre = source_centre(s);
   out.area = areas_.at(centre.x, centre.y, s.inverse_depth_per_mm);
+  out.light = illumination_.factor(point);
   out.blend = a.blend + f * (b.blend - a.blend);
   out.passing = a.passing + f * (b.passing - a.passing);
   out.shape_source = a_index;
@@ -1120,12 +1130,14 @@ void FootprintShape::add(std::span<const Point2f> vertices, const std::array<flo
 
 namespace {
 
-// A wavelength group's share of a source's light (RGB) and coverage (alpha, times the output area
-// its pixel's image covers: FootprintPlan::area).
-std::array<float, 4> group_value(const ScatterSource& s, const SpectralGroup& g, float share, float area) {
+// A wavelength group's share of a source's light (RGB, times the plan's FootprintPlan::light) and
+// coverage (alpha, times the output area its pixel's image covers, FootprintPlan::area, with
+// vignetting on).
+std::array<float, 4> group_value(const ScatterSource& s, const SpectralGroup& g, float share, const FootprintPlan& p, bool vignetting) {
   std::array<float, 4> value{};
-  for (std::size_t c = 0; c < 3; ++c) value[c] = share * (g.m[c][0] * s.rgb[0] + g.m[c][1] * s.rgb[1] + g.m[c][2] * s.rgb[2]);
-  value[3] = share * g.alpha * s.coverage * area;
+  const float light = share * p.light;
+  for (std::size_t c = 0; c < 3; ++c) value[c] = light * (g.m[c][0] * s.rgb[0] + g.m[c][1] * s.rgb[1] + g.m[c][2] * s.rgb[2]);
+  value[3] = share * g.alpha * s.coverage * (vignetting ? p.area : 1.0f);
   return value;
 }
 
@@ -1139,7 +1151,7 @@ void FootprintScatter::map_shape(const ScatterSource& s, const FootprintPlan& p,
   const ScenePoint point{t.x, t.y, s.inverse_depth_per_mm};
   const double passing = p.passing;
   if (p.discs) {
-    model_.clip_discs(point, scratch.discs);
+    clip_discs(point, scratch.discs);
   } else {
     scratch.discs.clear();
   }
@@ -1208,6 +1220,20 @@ void FootprintScatter::record_mesh(const ScenePoint& point, double wavelength_nm
   FootprintShape& shape = scratch.shape;
   const PupilMesh& mesh = meshes_.mesh(p.mesh);
   map_cached(point, wavelength_nm, 0, p.mesh, mesh.points, hits, scratch, false);
+  if (!scratch.discs.empty()) {
+    // The discs as planned (widened where the real lens passes more: IlluminationTable::widen), not
+    // the model's own, as RayModel::map applies them.
+    for (std::size_t i = 0; i < mesh.points.size(); ++i) {
+      double c = 1.0;
+      for (const PupilDisc& d : scratch.discs) {
+        const double dx = mesh.points[i].x - d.x, dy = mesh.points[i].y - d.y;
+        c = std::min(c, 1.0 - std::sqrt(dx * dx + dy * dy) / d.radius);
+      }
+      hits[i].clearance = c;
+      hits[i].ok = c >= 0.0;
+      hits[i].unclipped = true;
+    }
+  }
   points.resize(mesh.points.size());
   for (std::size_t i = 0; i < mesh.points.size(); ++i) {
     if (!hits[i].unclipped && !hits[i].ok) continue;
@@ -1248,7 +1274,7 @@ void FootprintScatter::record_mesh(const ScenePoint& point, double wavelength_nm
   if (finer_light) {
     // Interpolated rays (exact, poly): the light that passes from the table's finer mesh, this
     // mesh's triangles only distributing it (MappedPupilTable::passing_light says why).
-    const PupilMesh& fine = meshes_.mesh(PupilMeshTable::polar_mesh(kLightRings, kLightSectorStep));
+    const PupilMesh& fine = meshes_.mesh(light_mesh());
     if (coarse > 0.0) unlit = table_->passing_light(point, wavelength_nm, fine, scratch.table_cache) / coarse;
   }
   for (const PupilTriangle& tri : mesh.triangles) {
@@ -1297,7 +1323,7 @@ void FootprintScatter::draw_shape(const ScatterSource& s, const FootprintPlan& p
   const float dx = p.affine_px[0] - shape.chief_px[0], dy = p.affine_px[1] - shape.chief_px[1];
   std::size_t group = 0;
   auto draw_group = [&](const SpectralGroup& g, float share) {
-    std::array<float, 4> value = group_value(s, g, share, options_.vignetting ? p.area : 1.0f);
+    std::array<float, 4> value = group_value(s, g, share, p, options_.vignetting);
     if (scale != 1.0) {
       for (std::size_t c = 0; c < 3; ++c) value[c] = static_cast<float>(value[c] * scale);
     }
@@ -1327,7 +1353,26 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, s
   // aperture that passes was planned; the point path needs nothing more, the single polygon the
   // outline less what the discs cut off.
   const double passing = p.passing;
-  if (!(passing > 0.0)) return;  // the whole beam is stopped
+  // Where the model's discs stop the whole beam (or leave too thin a sliver to draw), the point is
+  // still an opaque surface that sends no light: it darkens its pixel as a vignetted corner does,
+  // instead of leaving a hole that the fill paints with its neighbours' colour (a retrofocus's frame
+  // corners came out at 0.28 of the centre through the paraxial model where the ground truth has 0.05).
+  auto stopped = [&] {
+    if (!p.discs || !options_.vignetting) return;
+    // Only where the model's field is not folded back onto the frame's middle (a black point there
+    // would darken what the model does draw).
+    const Tangents t = camera_.frame().tangents_at(source_centre(s));
+    if (!illumination_.unfolded(ScenePoint{t.x, t.y, s.inverse_depth_per_mm})) return;
+    const Point2f at{p.affine_px[0], p.affine_px[1]};
+    for (const SpectralGroup& g : groups_.split(p.groups)) {
+      const std::array<float, 4> value = group_value(s, g, 1.0f, p, true);
+      if (value[3] > 0.0f) buffer.add_point(at, {0.0f, 0.0f, 0.0f, value[3]});
+    }
+  };
+  if (!(passing > 0.0)) {
+    stopped();
+    return;
+  }
   if (p.mesh >= 0) {
     // A mesh footprint is mapped into its shape, or drawn from its neighbour's (plan_range).
     const std::int64_t key = p.shape_source >= 0 ? p.shape_source : static_cast<std::int64_t>(index);
@@ -1348,7 +1393,7 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, s
   const Tangents t = camera_.frame().tangents_at(source_centre(s));
   const ScenePoint point{t.x, t.y, s.inverse_depth_per_mm};
   if (p.discs && p.outline != FootprintPlan::kPoint) {
-    model_.clip_discs(point, scratch.discs);
+    clip_discs(point, scratch.discs);
   } else {
     scratch.discs.clear();
   }
@@ -1363,12 +1408,15 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, s
     } else {
       clip_pupil_polygon(own, scratch.discs, scratch.clipped, scratch.clip_work);
     }
-    if (scratch.clipped.size() < 3) return;
+    if (scratch.clipped.size() < 3) {
+      stopped();
+      return;
+    }
     outline = &scratch.clipped;
   }
   // One wavelength group's share of the light.
   auto deposit_group = [&](const SpectralGroup& g, float share) {
-    const std::array<float, 4> value = group_value(s, g, share, options_.vignetting ? p.area : 1.0f);
+    const std::array<float, 4> value = group_value(s, g, share, p, options_.vignetting);
     // A single group's rays are the plan's, at the reference wavelength.
     const bool planned = p.mapped && p.groups == 1 && p.blend == 1.0f;
     if (p.outline == FootprintPlan::kPoint) {

@@ -20,6 +20,7 @@
 #include "lensmith/camera/ray_model.h"
 #include "lensmith/render/splat_buffer.h"
 #include "footprint_stamps.h"
+#include "illumination_table.h"
 #include "image_area_table.h"
 #include "mapped_pupil_table.h"
 #include "pupil_mesh_table.h"
@@ -64,6 +65,9 @@ struct FootprintPlan {
   // more of the scene into a pixel the light of more sources shares it. 1 for models without
   // distortion (thin, paraxial).
   float area = 1.0f;
+  // The factor on its light that makes a uniform surface as bright across the frame as through the
+  // real lens (IlluminationTable; 1 for the thin lens, the exact model and without vignetting).
+  float light = 1.0f;
 };
 
 // What the planner probed of a footprint: where the probe's rays land (output px) at up to three
@@ -169,8 +173,12 @@ void plan_range_starts(std::span<const ScatterSource> sources, std::size_t targe
 class FootprintScatter {
  public:
   // `areas`: the image area of a pixel over the frame (FootprintPlan::area); kept by the caller.
+  // `illumination`: the real lens's brightness across the frame (FootprintPlan::light); kept by the caller.
   FootprintScatter(const RayModel& model, const Aperture& aperture, const SpectralGroups& groups,
-                   const PupilMeshTable& meshes, const ImageAreaTable& areas, const BokehOptions& options);
+                   const PupilMeshTable& meshes, const ImageAreaTable& areas, const IlluminationTable& illumination,
+                   const BokehOptions& options);
+  // The polar mesh the light of a beam is measured on (MappedPupilTable::passing_light, IlluminationTable).
+  static int light_mesh();
 
   // One source's plan; its probe is written to `*probe` where given.
   FootprintPlan plan(const ScatterSource& s, FootprintScratch& scratch, FootprintProbe* probe = nullptr) const;
@@ -233,6 +241,9 @@ class FootprintScatter {
   // The clipped rings (clip_rings) mapped at one wavelength: scratch.hits, points, ring_spans, ring_weights.
   void map_clipped_rings(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p, FootprintScratch& scratch,
                          bool keep = false) const;
+  // The model's first-order discs of `point` (RayModel::clip_discs), widened where they pass less of
+  // the pupil than the real lens's apertures (IlluminationTable::widen).
+  void clip_discs(const ScenePoint& point, std::vector<PupilDisc>& discs) const;
   // FootprintPlan::passing for `discs` and a footprint drawn with `own_step`'s sector count.
   double disc_passing_share(const std::vector<PupilDisc>& discs, int own_step, FootprintScratch& scratch) const;
   // `value` with its light (not its coverage) scaled by a ray's radiometric weight (SensorHit), when
@@ -252,6 +263,7 @@ class FootprintScatter {
   // centre (the thin lens's): deposited from stamps.
   FootprintStamps stamps_;
   const ImageAreaTable& areas_;
+  const IlluminationTable& illumination_;
   // The exact and poly models' maps interpolated over field and depth (BokehOptions::interpolated_rays).
   std::unique_ptr<MappedPupilTable> table_;
 };

@@ -40,18 +40,19 @@ std::size_t MappedPupilTable::KeyHash::operator()(const std::pair<std::uint64_t,
   return std::hash<std::uint64_t>{}(k.first * 0x9E3779B97F4A7C15ull ^ bits);
 }
 
-bool MappedPupilTable::applies(const RayModel& model, const Aperture& aperture) {
-  const Camera& camera = model.camera();
-  if (!(model.kind() == RayModelKind::Exact || model.kind() == RayModelKind::Poly) || aperture.kind() != Aperture::Kind::Circular ||
-      camera.lens() == nullptr || camera.exact_model_only() || camera.squeeze() != 1.0) {
-    return false;
-  }
+bool MappedPupilTable::round_lens(const Camera& camera) {
+  if (camera.lens() == nullptr || camera.exact_model_only() || camera.squeeze() != 1.0) return false;
   // Round surfaces may still have clear apertures that are not (a rectangle, an ellipse, a decentred
   // circle, as a Zemax file can give them): those clip a beam differently at each azimuth.
   return std::all_of(camera.lens()->surfaces.begin(), camera.lens()->surfaces.end(), [](const Surface& s) {
     return !s.aperture || (s.aperture->shape == SurfaceAperture::Shape::Circular && s.aperture->decenter_x_mm == 0.0 &&
                            s.aperture->decenter_y_mm == 0.0);
   });
+}
+
+bool MappedPupilTable::applies(const RayModel& model, const Aperture& aperture) {
+  return (model.kind() == RayModelKind::Exact || model.kind() == RayModelKind::Poly) && aperture.kind() == Aperture::Kind::Circular &&
+         round_lens(model.camera());
 }
 
 MappedPupilTable::MappedPupilTable(const RayModel& model) : model_(model) {

@@ -52,6 +52,9 @@ class MappedPupilTable {
   // rotationally symmetric lens (no anamorphic squeeze, nothing that only the exact model takes),
   // through a circular aperture.
   static bool applies(const RayModel& model, const Aperture& aperture);
+  // Whether the camera's lens is round about its axis: a prescription (not a thin lens) with no
+  // mirrors, tilts or anamorphic squeeze, every clear aperture a centred circle.
+  static bool round_lens(const Camera& camera);
 
   explicit MappedPupilTable(const RayModel& model);
   ~MappedPupilTable();

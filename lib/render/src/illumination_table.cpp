@@ -1,0 +1,278 @@
+#include "illumination_table.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "lensmith/core/units.h"
+#include "mapped_pupil_table.h"
+
+namespace lensmith::render_detail {
+
+namespace {
+
+// The discs' radius factor is looked for up to this (beyond it the first-order discs are too far off
+// to say where the real beam passes) and to this precision.
+constexpr double kMaxDiscScale = 4.0;
+constexpr int kBisections = 24;
+// The real lens's nodes span this many times the model's field.
+constexpr double kRealReach = 2.0;
+// Below this share of the axis's light the model passes nothing worth scaling (its discs stop the
+// beam, which it then draws as an opaque point that sends no light).
+constexpr double kNothing = 1e-6;
+// The discs are widened where they pass less than this share of what the real lens passes, fully
+// where less than the second.
+constexpr double kWiden = 0.5;
+constexpr double kWidenFully = 0.25;
+// A share the widest discs cannot reach is approached to this fraction of their most.
+constexpr double kReachable = 0.999;
+
+// What a node measures of one model: where the chief ray lands (output px), and of a uniform
+// surface's point the light it sends through the pupil (the mean over the unit pupil of the rays'
+// weights where they pass) and the share of the pupil that passes; or lands = false.
+struct Beam {
+  bool lands = false;
+  double x_px = 0.0, y_px = 0.0;
+  double light = 0.0;
+  double share = 0.0;
+};
+
+// A node's rays on the fine mesh, and the discs that clip them (first-order models).
+struct NodeRays {
+  std::vector<SensorHit> hits;
+  std::vector<double> clearance;  // with the discs at the scale last applied
+  std::vector<PupilDisc> discs;
+};
+
+// The rays' clearances with the discs' radii scaled by `scale`: min of their own (traced apertures)
+// and 1 - |p - c| / (scale R) of each disc.
+void apply_discs(const PupilMesh& fine, double scale, NodeRays& n) {
+  n.clearance.resize(n.hits.size());
+  for (std::size_t i = 0; i < n.hits.size(); ++i) {
+    double c = n.hits[i].clearance;
+    for (const PupilDisc& d : n.discs) {
+      const double dx = fine.points[i].x - d.x, dy = fine.points[i].y - d.y;
+      c = std::min(c, 1.0 - std::sqrt(dx * dx + dy * dy) / (scale * d.radius));
+    }
+    n.clearance[i] = c;
+  }
+}
+
+// Each triangle passes the share where the linear interpolation of its corners' clearance is >= 0
+// (MappedPupilTable::passing_light measures the same way), at its corners' mean weight for the light;
+// a corner that lands nowhere loses its triangle.
+void measure(const PupilMesh& fine, const NodeRays& n, Beam& beam) {
+  beam.light = beam.share = 0.0;
+  double total = 0.0;
+  for (const PupilTriangle& t : fine.triangles) {
+    total += t.weight;
+    const auto a = static_cast<std::size_t>(t.a), b = static_cast<std::size_t>(t.b), c = static_cast<std::size_t>(t.c);
+    const SensorHit& ha = n.hits[a];
+    const SensorHit& hb = n.hits[b];
+    const SensorHit& hc = n.hits[c];
+    if (!(ha.ok || ha.unclipped) || !(hb.ok || hb.unclipped) || !(hc.ok || hc.unclipped)) continue;
+    const double passing = t.weight * passing_share(n.clearance[a], n.clearance[b], n.clearance[c]);
+    beam.share += passing;
+    beam.light += passing * (ha.weight + hb.weight + hc.weight) / 3.0;
+  }
+  if (total > 0.0) beam.share /= total;
+}
+
+// The chief ray's landing and the fine mesh's rays of `point`, the discs at scale 1.
+Beam trace(const RayModel& model, const ScenePoint& point, double wavelength_nm, const PupilMesh& fine, NodeRays& n) {
+  Beam beam;
+  std::array<SensorHit, 1> chief;
+  const std::array<PupilPoint, 1> centre{PupilPoint{0.0, 0.0}};
+  model.map(point, wavelength_nm, centre, chief);
+  if (!(chief[0].ok || chief[0].unclipped)) return beam;
+  const PixelPoint q = model.camera().output_pixel(chief[0].x_mm, chief[0].y_mm);
+  beam.lands = true;
+  beam.x_px = q.x;
+  beam.y_px = q.y;
+  model.clip_discs(point, n.discs);
+  n.hits.resize(fine.points.size());
+  // The traced apertures' clearances (exact, poly); the first-order models' discs are applied here.
+  model.map_passing(point, wavelength_nm, fine.points, n.hits);
+  apply_discs(fine, 1.0, n);
+  measure(fine, n, beam);
+  return beam;
+}
+
+// Linear interpolation of ys over increasing xs at x, clamped to the ends.
+double interpolate(const std::vector<double>& xs, const std::vector<double>& ys, double x) {
+  if (xs.size() == 1 || x <= xs.front()) return ys.front();
+  if (x >= xs.back()) return ys.back();
+  const auto it = std::upper_bound(xs.begin(), xs.end(), x);
+  const auto k = static_cast<std::size_t>(it - xs.begin());
+  const double t = (x - xs[k - 1]) / (xs[k] - xs[k - 1]);
+  return ys[k - 1] + t * (ys[k] - ys[k - 1]);
+}
+
+// The nodes' values at fractional node index f (0 .. kFieldNodes - 1), linearly.
+double interpolated(const std::vector<double>& v, double f) {
+  const auto i = std::min(static_cast<std::size_t>(f), v.size() - 2);
+  const double t = f - static_cast<double>(i);
+  return v[i] + t * (v[i + 1] - v[i]);
+}
+
+}  // namespace
+
+bool IlluminationTable::applies(const RayModel& model, const Aperture& aperture, bool vignetting) {
+  const RayModelKind kind = model.kind();
+  return vignetting && (kind == RayModelKind::Paraxial || kind == RayModelKind::Seidel || kind == RayModelKind::Poly) &&
+         aperture.kind() != Aperture::Kind::Mask && MappedPupilTable::round_lens(model.camera());
+}
+
+IlluminationTable::IlluminationTable(const RayModel& model, const PupilMesh& fine, const ImageAreaTable& areas, int margin_px,
+                                     double w_min, double w_max, int threads) {
+  const Camera& camera = model.camera();
+  const std::unique_ptr<RayModel> exact = make_ray_model(RayModelKind::Exact, camera);
+  const PinholeFrame& frame = camera.frame();
+  const double centre_x = 0.5 * frame.width_px(), centre_y = 0.5 * frame.height_px();
+  const double reach_px = std::hypot(centre_x + margin_px, centre_y + margin_px);
+  step_ = reach_px / frame.focal_length_px() / (kFieldNodes - 1);
+  const int depth_nodes = w_max > w_min ? kDepthNodes : 1;
+  w0_ = w_min;
+  dw_ = depth_nodes > 1 ? (w_max - w_min) / (depth_nodes - 1) : 1.0;
+  const double wavelength_nm = camera.reference_wavelength_nm();
+  const auto nodes = static_cast<std::size_t>(depth_nodes) * kFieldNodes;
+  // Node n at kRealReach times the model's field step for the real lens: where its barrel distortion
+  // is strong it images the frame's corner from beyond the field the model's nodes span (lentil
+  // 0005: 16 %).
+  auto point_of = [&](std::size_t n, double reach) {
+    return ScenePoint{static_cast<double>(n % kFieldNodes) * reach * step_, 0.0, w0_ + static_cast<double>(n / kFieldNodes) * dw_};
+  };
+  auto pixel_of = [&](std::size_t n, double reach) {
+    return PixelPoint{centre_x + static_cast<double>(n % kFieldNodes) * reach * step_ * frame.focal_length_px(), centre_y};
+  };
+  // The real lens at every node, the model on the axis (its share there is what the real lens's
+  // relative share scales), then the model at every node with its discs widened to that share.
+  std::vector<Beam> model_beam(nodes), real_beam(nodes);
+  std::vector<double> model_area(nodes, 1.0), real_area(nodes, 0.0), scale(nodes, 1.0);
+#pragma omp parallel num_threads(threads)
+  {
+    NodeRays rays;
+#pragma omp for schedule(dynamic, 1)
+    for (std::size_t n = 0; n < nodes; ++n) {
+      const ScenePoint real_point = point_of(n, kRealReach);
+      real_beam[n] = trace(*exact, real_point, wavelength_nm, fine, rays);
+      if (real_beam[n].lands) real_area[n] = chief_ray_image_area(*exact, pixel_of(n, kRealReach), real_point.inverse_depth_per_mm, 1.0);
+      if (n % kFieldNodes == 0) model_beam[n] = trace(model, point_of(n, 1.0), wavelength_nm, fine, rays);
+    }
+#pragma omp for schedule(dynamic, 1)
+    for (std::size_t n = 0; n < nodes; ++n) {
+      const std::size_t axis = n - n % kFieldNodes;
+      const PixelPoint pixel = pixel_of(n, 1.0);
+      model_area[n] = areas.at(pixel.x, pixel.y, point_of(n, 1.0).inverse_depth_per_mm);
+      if (n == axis) continue;
+      model_beam[n] = trace(model, point_of(n, 1.0), wavelength_nm, fine, rays);
+      if (rays.discs.empty() || !model_beam[n].lands || !(real_beam[axis].share > 0.0)) continue;
+      // The real lens's share at this field (its nodes are kRealReach times as far apart).
+      const double real_f = static_cast<double>(n - axis) / kRealReach;
+      const auto real_i = static_cast<std::size_t>(real_f);
+      const Beam& r0 = real_beam[axis + real_i];
+      const Beam& r1 = real_beam[axis + std::min(real_i + 1, static_cast<std::size_t>(kFieldNodes - 1))];
+      if (!r0.lands || !r1.lands) continue;
+      const double real_share = r0.share + (real_f - static_cast<double>(real_i)) * (r1.share - r0.share);
+      const double target = model_beam[axis].share * real_share / real_beam[axis].share;
+      // Only where the discs are far off (they pass less than kWiden of the real share), fully below
+      // kWidenFully: widened discs change the footprints' shapes from pixel to pixel, and through the
+      // Canon 35 mm (discs 4-8 % too small at its corners) a flat wall rippled by 3 % there.
+      const double ratio = model_beam[n].share / target;
+      if (!(ratio < kWiden)) continue;
+      const double blend = std::min(1.0, (kWiden - ratio) / (kWiden - kWidenFully));
+      // Bisection on the radius factor: the share grows with it.
+      double lo = 1.0, hi = kMaxDiscScale;
+      Beam b;
+      apply_discs(fine, hi, rays);
+      measure(fine, rays, b);
+      // A target the widest discs cannot reach (the real lens's share grows off axis beyond the
+      // first-order discs' most): as near it as they come, not wider than needed.
+      const double reachable = std::min(target, kReachable * b.share);
+      if (b.share > reachable) {
+        for (int k = 0; k < kBisections; ++k) {
+          const double mid = 0.5 * (lo + hi);
+          apply_discs(fine, mid, rays);
+          measure(fine, rays, b);
+          (b.share < reachable ? lo : hi) = mid;
+        }
+      }
+      scale[n] = 1.0 + blend * (hi - 1.0);
+      apply_discs(fine, scale[n], rays);
+      measure(fine, rays, model_beam[n]);
+    }
+  }
+  std::vector<Depth> depths(static_cast<std::size_t>(depth_nodes));
+  for (int d = 0; d < depth_nodes; ++d) {
+    const std::size_t first = static_cast<std::size_t>(d) * kFieldNodes;
+    const Beam& model_axis = model_beam[first];
+    const Beam& real_axis = real_beam[first];
+    if (!model_axis.lands || !real_axis.lands || !(model_axis.light > 0.0) || !(real_axis.light > 0.0) || !(real_area[first] > 0.0)) {
+      return;  // empty: nothing to scale against
+    }
+    // Brightness B = L / A relative to the axis's; where the output's centre is, from the axes.
+    const double model_axis_b = model_axis.light / model_area[first], real_axis_b = real_axis.light / real_area[first];
+    Depth& depth = depths[static_cast<std::size_t>(d)];
+    double rho_before = -1.0;
+    for (std::size_t i = 0; i < kFieldNodes; ++i) {
+      const Beam& m = model_beam[first + i];
+      depth.disc_scale.push_back(scale[first + i]);
+      depth.model_relative.push_back(m.lands && model_area[first + i] > 0.0 ? m.light / model_area[first + i] / model_axis_b : -1.0);
+      const double rho = std::hypot(m.x_px - model_axis.x_px, m.y_px - model_axis.y_px);
+      depth.model_rho_px.push_back(m.lands ? rho : 0.0);
+      if (m.lands && rho > rho_before && depth.unfolded + 1 == i) depth.unfolded = i;
+      rho_before = m.lands ? rho : kInfinity;
+    }
+    // The real lens's brightness by where its chief ray lands, up to where it stops landing or folds
+    // back (a fisheye's aimer beyond its reach): beyond that the last node's holds. The factor is
+    // kept per node (a source's interpolated between them: no search per footprint).
+    for (std::size_t i = 0; i < kFieldNodes; ++i) {
+      const Beam& r = real_beam[first + i];
+      if (!r.lands || !(real_area[first + i] > 0.0)) break;
+      const double rho = std::hypot(r.x_px - real_axis.x_px, r.y_px - real_axis.y_px);
+      if (!depth.real_rho_px.empty() && !(rho > depth.real_rho_px.back())) break;
+      depth.real_rho_px.push_back(rho);
+      depth.real_relative.push_back(r.light / real_area[first + i] / real_axis_b);
+    }
+    for (std::size_t i = 0; i < kFieldNodes; ++i) depth.factor.push_back(node_factor(depth, i));
+    widened_ = widened_ || std::any_of(depth.disc_scale.begin(), depth.disc_scale.end(), [](double k) { return k != 1.0; });
+  }
+  depths_ = std::move(depths);
+}
+
+double IlluminationTable::node_factor(const Depth& d, std::size_t i) {
+  const double model = d.model_relative[i];
+  if (model < 0.0) return 1.0;             // the model's chief ray lands nowhere: its own light stays
+  if (!(model > kNothing)) return 1.0;     // the model passes nothing here (an opaque point that sends no light)
+  return std::clamp(interpolate(d.real_rho_px, d.real_relative, d.model_rho_px[i]) / model, 0.0, kMaxFactor);
+}
+
+template <typename Of>
+double IlluminationTable::at(const ScenePoint& point, Of&& of) const {
+  const double f = std::clamp(std::sqrt(point.tan_x * point.tan_x + point.tan_y * point.tan_y) / step_, 0.0, static_cast<double>(kFieldNodes - 1));
+  if (depths_.size() == 1) return of(depths_[0], f);
+  const double fd = std::clamp((point.inverse_depth_per_mm - w0_) / dw_, 0.0, static_cast<double>(depths_.size() - 1));
+  const std::size_t id = std::min(static_cast<std::size_t>(fd), depths_.size() - 2);
+  const double td = fd - static_cast<double>(id);
+  return (1.0 - td) * of(depths_[id], f) + td * of(depths_[id + 1], f);
+}
+
+float IlluminationTable::factor(const ScenePoint& point) const {
+  if (depths_.empty()) return 1.0f;
+  return static_cast<float>(at(point, [](const Depth& d, double f) { return interpolated(d.factor, f); }));
+}
+
+bool IlluminationTable::unfolded(const ScenePoint& point) const {
+  if (depths_.empty()) return false;
+  const double f = std::sqrt(point.tan_x * point.tan_x + point.tan_y * point.tan_y) / step_;
+  return std::all_of(depths_.begin(), depths_.end(), [f](const Depth& d) { return f <= static_cast<double>(d.unfolded); });
+}
+
+void IlluminationTable::widen(const ScenePoint& point, std::vector<PupilDisc>& discs) const {
+  if (!widened_ || discs.empty()) return;
+  const double scale = at(point, [](const Depth& d, double f) { return interpolated(d.disc_scale, f); });
+  if (scale == 1.0) return;
+  for (PupilDisc& d : discs) d.radius *= scale;
+}
+
+}  // namespace lensmith::render_detail

@@ -1,0 +1,97 @@
+// The real lens's brightness across the frame, imposed on the models that only approximate it.
+//
+// A uniformly bright surface photographed through a lens falls off towards the frame's corners as
+// the lens's relative illumination: the projected solid angle of the real entrance pupil (which
+// grows off axis in a retrofocus design), clipped by the real clear apertures, over the image area
+// a pixel's patch of scene maps to. The exact model gets this from its traced rays and follows
+// `lensmith scene render --lens` to about 1 %. The first-order models (paraxial, Seidel) take the
+// solid angle of the paraxial pupil and first-order images of the clear apertures (discs), and the
+// poly model a fit's weights: on a retrofocus framed to 50 deg (lentil 0005) the paraxial model fell
+// to 0.05 of the centre at the frame's side where the truth has 0.31, the Seidel model's discs left
+// a dark ring at 40 deg and a flat 0.72 beyond it, and poly was 12 % dark at mid-field.
+//
+// So the first-order models' discs are widened where they pass less of the pupil than the real
+// lens's clear apertures do (relative to the axis): on that retrofocus beyond 40 deg they stopped
+// every ray where the real lens passes 60 % of the axis's light, and the picture there was whatever
+// the hidden-surface fill made of its neighbours. Each disc's radius is scaled about its centre by
+// the one factor that makes the discs pass the real lens's share (found at the nodes by bisection);
+// the cat's eye keeps the first-order discs' centres, so its shape is an approximation there.
+//
+// And each footprint's light is scaled by R_real / R_model, R a uniform surface's brightness
+// relative to the axis at the same depth: B = L / A, with L the light a point's beam passes (the
+// mean ray weight over the pupil where the rays pass, measured on a fine polar mesh as the renderer
+// measures it, MappedPupilTable::passing_light) and A the image area its pixel maps to
+// (ImageAreaTable). R_model is taken at the source's own field (with its widened discs), R_real
+// where the model's chief ray lands on the output: the brightness the real lens has at that output
+// pixel. So a uniform surface is as bright across the frame as through the real lens, whatever the
+// model's distortion (the paraxial model has none); a lone highlight carries the real lens's light
+// times the model's image area over the lens's (1 to 3 % apart where the Seidel model's distortion
+// is the lens's within its third order). The footprint's shape (cat's eye, aberrations) stays the
+// model's own.
+//
+// Tabulated along the field radius (the lens is round: MappedPupilTable::round_lens) at kFieldNodes
+// radii and kDepthNodes inverse depths across the picture's, read by linear interpolation.
+#pragma once
+
+#include <vector>
+
+#include "lensmith/camera/aperture.h"
+#include "lensmith/camera/ray_model.h"
+#include "image_area_table.h"
+#include "pupil_mesh_table.h"
+
+namespace lensmith::render_detail {
+
+class IlluminationTable {
+ public:
+  static constexpr int kFieldNodes = 48;
+  static constexpr int kDepthNodes = 4;
+  // A footprint's light is scaled by at most this: where the model passes almost nothing (its discs
+  // stop a beam the real lens passes), its shape is not the lens's either.
+  static constexpr double kMaxFactor = 8.0;
+
+  // Whether the table applies: the paraxial, Seidel or poly model of a round lens (no mirrors, tilts
+  // or anamorphic squeeze; MappedPupilTable::round_lens), vignetting on, an aperture that is not a
+  // picture.
+  static bool applies(const RayModel& model, const Aperture& aperture, bool vignetting);
+
+  // Every factor 1.
+  IlluminationTable() = default;
+  // For `model`'s frame and `margin_px` beyond it, inverse depths w_min..w_max (1/mm). `fine` is the
+  // polar mesh the light is measured on; `areas` the model's image areas. Empty where either model
+  // finds no light on the axis.
+  IlluminationTable(const RayModel& model, const PupilMesh& fine, const ImageAreaTable& areas, int margin_px, double w_min,
+                    double w_max, int threads);
+  bool empty() const { return depths_.empty(); }
+  // The factor on the light of a source at `point`.
+  float factor(const ScenePoint& point) const;
+  // The model's discs of `point` (RayModel::clip_discs) widened where they pass less than the real lens.
+  void widen(const ScenePoint& point, std::vector<PupilDisc>& discs) const;
+  // Whether the model's chief rays move outwards with the field up to `point`'s field radius (a
+  // Seidel polynomial folds back beyond the field it was made for, a fisheye's at 60 deg, and lands
+  // such points near the frame's centre); false where the table is empty.
+  bool unfolded(const ScenePoint& point) const;
+
+ private:
+  // One inverse depth's nodes, at field radii (tangent of the field angle) i * step_.
+  struct Depth {
+    std::size_t unfolded = 0;            // nodes [0, unfolded] land further out than the one before
+    std::vector<double> disc_scale;      // the discs' radius factor (>= 1)
+    std::vector<double> model_relative;  // the model's B / B(axis), or -1 where its chief ray lands nowhere
+    std::vector<double> model_rho_px;    // where the model's chief ray lands, output px from the axis's
+    std::vector<double> real_rho_px;     // the exact tracer's, increasing (nodes beyond a fold dropped)
+    std::vector<double> real_relative;   // its B / B(axis) at real_rho_px
+    std::vector<double> factor;          // the light factor at each node
+  };
+  static double node_factor(const Depth& d, std::size_t i);
+  // Interpolates `of` over the nodes at field radius `radius` and inverse depth w.
+  template <typename Of>
+  double at(const ScenePoint& point, Of&& of) const;
+
+  double step_ = 1.0;  // tangent per node
+  double w0_ = 0.0, dw_ = 1.0;
+  std::vector<Depth> depths_;
+  bool widened_ = false;  // some node's discs are widened
+};
+
+}  // namespace lensmith::render_detail
