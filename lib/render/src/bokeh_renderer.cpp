@@ -94,7 +94,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
     }
     areas = render_detail::ImageAreaTable(model, margin, w_min, w_max, threads);
     if (real_illumination) {
-      illumination = render_detail::IlluminationTable(model, meshes.mesh(FootprintScatter::light_mesh()), areas, margin, w_min,
+      illumination = render_detail::IlluminationTable(model, meshes.mesh(render_detail::PupilMeshTable::light_mesh()), areas, margin, w_min,
                                                       w_max, threads);
     }
   }

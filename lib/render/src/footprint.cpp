@@ -67,12 +67,6 @@ constexpr double kShapeTolerancePx = 1.0 / 16.0;
 constexpr float kShapePassingTolerance = 0.004f;
 // Grid cells of an aperture-picture mesh per pixel of footprint size.
 constexpr double kPxPerGridCell = 1.5;
-// The polar mesh on which interpolated rays' clipped light is measured (MappedPupilTable::passing_light):
-// 8 rings of 48 sectors (PupilMeshTable's sector step 5). A white wall's corner through the double
-// Gauss at f/2 (tests/scene's radiometry) 0.2959 with it against the ground truth's 0.2940; 0.302
-// from the footprints' own 4-ring meshes.
-constexpr int kLightRings = 8;
-constexpr int kLightSectorStep = 5;
 // Pupil points: the centre (the chief ray), and the centre with the two axes' unit points (an affine
 // model's map); the unit value a footprint's shape is recorded at (FootprintShape).
 constexpr std::array<PupilPoint, 1> kCentre{{{0.0, 0.0}}};
@@ -751,8 +745,6 @@ void FootprintScatter::clip_discs(const ScenePoint& point, std::vector<PupilDisc
   illumination_.widen(point, discs);
 }
 
-int FootprintScatter::light_mesh() { return PupilMeshTable::polar_mesh(kLightRings, kLightSectorStep); }
-
 FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& scratch, FootprintProbe* probe_out) const {
   std::vector<PupilPoint>& pupil = scratch.pupil;
   std::vector<SensorHit>& hits = scratch.hits;
@@ -924,6 +916,9 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
   }
   p.area = areas_.at(centre.x, centre.y, s.inverse_depth_per_mm);
   p.light = illumination_.factor(point);
+  if (const double share = illumination_.widened_share(point); p.discs && share > 0.0 && p.passing > 0.0f) {
+    p.light = static_cast<float>(p.light * share / p.passing);
+  }
   if (probe_out != nullptr) *probe_out = probe;
   return p;
 }
@@ -1019,9 +1014,12 @@ bool FootprintScatter::follow(const ScatterSource& s, const FootprintPlan& a, co
   const auto f = static_cast<float>(along);
   const PixelPoint centre = source_centre(s);
   out.area = areas_.at(centre.x, centre.y, s.inverse_depth_per_mm);
-  out.light = illumination_.factor(point);
   out.blend = a.blend + f * (b.blend - a.blend);
   out.passing = a.passing + f * (b.passing - a.passing);
+  out.light = illumination_.factor(point);
+  if (const double share = illumination_.widened_share(point); out.discs && share > 0.0 && out.passing > 0.0f) {
+    out.light = static_cast<float>(out.light * share / out.passing);
+  }
   out.shape_source = a_index;
   return true;
 }
@@ -1274,7 +1272,7 @@ void FootprintScatter::record_mesh(const ScenePoint& point, double wavelength_nm
   if (finer_light) {
     // Interpolated rays (exact, poly): the light that passes from the table's finer mesh, this
     // mesh's triangles only distributing it (MappedPupilTable::passing_light says why).
-    const PupilMesh& fine = meshes_.mesh(light_mesh());
+    const PupilMesh& fine = meshes_.mesh(PupilMeshTable::light_mesh());
     if (coarse > 0.0) unlit = table_->passing_light(point, wavelength_nm, fine, scratch.table_cache) / coarse;
   }
   for (const PupilTriangle& tri : mesh.triangles) {

@@ -177,8 +177,6 @@ class FootprintScatter {
   FootprintScatter(const RayModel& model, const Aperture& aperture, const SpectralGroups& groups,
                    const PupilMeshTable& meshes, const ImageAreaTable& areas, const IlluminationTable& illumination,
                    const BokehOptions& options);
-  // The polar mesh the light of a beam is measured on (MappedPupilTable::passing_light, IlluminationTable).
-  static int light_mesh();
 
   // One source's plan; its probe is written to `*probe` where given.
   FootprintPlan plan(const ScatterSource& s, FootprintScratch& scratch, FootprintProbe* probe = nullptr) const;

@@ -21,9 +21,12 @@ constexpr double kRealReach = 2.0;
 // beam, which it then draws as an opaque point that sends no light).
 constexpr double kNothing = 1e-6;
 // The discs are widened where they pass less than this share of what the real lens passes, fully
-// where less than the second.
-constexpr double kWiden = 0.5;
-constexpr double kWidenFully = 0.25;
+// where less than the second. Widened wherever they pass less at all (the Canon 35 mm's corners: 4-8 %
+// in radius), a flat defocused wall there rippled by 3.3 % from pixel to pixel (0.19 % without, 0.30 %
+// with these); from 0.5 (fully at 0.25), the retrofocus's disc edge swept through faster than the
+// widening began, and a flat wall showed a ring of +-4 % at 40 deg (1 % with these).
+constexpr double kWiden = 0.8;
+constexpr double kWidenFully = 0.4;
 // A share the widest discs cannot reach is approached to this fraction of their most.
 constexpr double kReachable = 0.999;
 
@@ -176,8 +179,7 @@ IlluminationTable::IlluminationTable(const RayModel& model, const PupilMesh& fin
       const double real_share = r0.share + (real_f - static_cast<double>(real_i)) * (r1.share - r0.share);
       const double target = model_beam[axis].share * real_share / real_beam[axis].share;
       // Only where the discs are far off (they pass less than kWiden of the real share), fully below
-      // kWidenFully: widened discs change the footprints' shapes from pixel to pixel, and through the
-      // Canon 35 mm (discs 4-8 % too small at its corners) a flat wall rippled by 3 % there.
+      // kWidenFully (see there).
       const double ratio = model_beam[n].share / target;
       if (!(ratio < kWiden)) continue;
       const double blend = std::min(1.0, (kWiden - ratio) / (kWiden - kWidenFully));
@@ -217,6 +219,7 @@ IlluminationTable::IlluminationTable(const RayModel& model, const PupilMesh& fin
     for (std::size_t i = 0; i < kFieldNodes; ++i) {
       const Beam& m = model_beam[first + i];
       depth.disc_scale.push_back(scale[first + i]);
+      depth.model_share.push_back(m.share);
       depth.model_relative.push_back(m.lands && model_area[first + i] > 0.0 ? m.light / model_area[first + i] / model_axis_b : -1.0);
       const double rho = std::hypot(m.x_px - model_axis.x_px, m.y_px - model_axis.y_px);
       depth.model_rho_px.push_back(m.lands ? rho : 0.0);
@@ -268,11 +271,19 @@ bool IlluminationTable::unfolded(const ScenePoint& point) const {
   return std::all_of(depths_.begin(), depths_.end(), [f](const Depth& d) { return f <= static_cast<double>(d.unfolded); });
 }
 
-void IlluminationTable::widen(const ScenePoint& point, std::vector<PupilDisc>& discs) const {
-  if (!widened_ || discs.empty()) return;
+double IlluminationTable::widened_share(const ScenePoint& point) const {
+  if (!widened_) return 0.0;
   const double scale = at(point, [](const Depth& d, double f) { return interpolated(d.disc_scale, f); });
-  if (scale == 1.0) return;
+  if (scale == 1.0) return 0.0;
+  return at(point, [](const Depth& d, double f) { return interpolated(d.model_share, f); });
+}
+
+bool IlluminationTable::widen(const ScenePoint& point, std::vector<PupilDisc>& discs) const {
+  if (!widened_ || discs.empty()) return false;
+  const double scale = at(point, [](const Depth& d, double f) { return interpolated(d.disc_scale, f); });
+  if (scale == 1.0) return false;
   for (PupilDisc& d : discs) d.radius *= scale;
+  return true;
 }
 
 }  // namespace lensmith::render_detail

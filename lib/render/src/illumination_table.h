@@ -10,12 +10,13 @@
 // to 0.05 of the centre at the frame's side where the truth has 0.31, the Seidel model's discs left
 // a dark ring at 40 deg and a flat 0.72 beyond it, and poly was 12 % dark at mid-field.
 //
-// So the first-order models' discs are widened where they pass less of the pupil than the real
-// lens's clear apertures do (relative to the axis): on that retrofocus beyond 40 deg they stopped
-// every ray where the real lens passes 60 % of the axis's light, and the picture there was whatever
-// the hidden-surface fill made of its neighbours. Each disc's radius is scaled about its centre by
-// the one factor that makes the discs pass the real lens's share (found at the nodes by bisection);
-// the cat's eye keeps the first-order discs' centres, so its shape is an approximation there.
+// So the first-order models' discs are widened where they pass far less of the pupil than the real
+// lens's clear apertures do (relative to the axis; below 0.8 of it, fully below 0.4): on that
+// retrofocus beyond 40 deg they stopped every ray where the real lens passes 60 % of the axis's
+// light, and the picture there was whatever the hidden-surface fill made of its neighbours. Each
+// disc's radius is scaled about its centre by the one factor that makes the discs pass the real
+// lens's share (found at the nodes by bisection); the cat's eye keeps the first-order discs'
+// centres, so its shape is an approximation there.
 //
 // And each footprint's light is scaled by R_real / R_model, R a uniform surface's brightness
 // relative to the axis at the same depth: B = L / A, with L the light a point's beam passes (the
@@ -65,8 +66,15 @@ class IlluminationTable {
   bool empty() const { return depths_.empty(); }
   // The factor on the light of a source at `point`.
   float factor(const ScenePoint& point) const;
-  // The model's discs of `point` (RayModel::clip_discs) widened where they pass less than the real lens.
-  void widen(const ScenePoint& point, std::vector<PupilDisc>& discs) const;
+  // The model's discs of `point` (RayModel::clip_discs) widened where they pass less than the real
+  // lens; whether they were.
+  bool widen(const ScenePoint& point, std::vector<PupilDisc>& discs) const;
+  // Where `point`'s discs are widened: the share of the pupil they pass, interpolated between the
+  // nodes' (which the light factor was measured with); 0 where they are not. The share of discs
+  // widened by an interpolated factor is not the interpolated share, and light scaled by the factor
+  // alone rippled by 3 % with the nodes' spacing: a footprint's light is taken at this share instead
+  // of its own (FootprintScatter::plan).
+  double widened_share(const ScenePoint& point) const;
   // Whether the model's chief rays move outwards with the field up to `point`'s field radius (a
   // Seidel polynomial folds back beyond the field it was made for, a fisheye's at 60 deg, and lands
   // such points near the frame's centre); false where the table is empty.
@@ -77,6 +85,7 @@ class IlluminationTable {
   struct Depth {
     std::size_t unfolded = 0;            // nodes [0, unfolded] land further out than the one before
     std::vector<double> disc_scale;      // the discs' radius factor (>= 1)
+    std::vector<double> model_share;     // the share of the pupil the model passes with them
     std::vector<double> model_relative;  // the model's B / B(axis), or -1 where its chief ray lands nowhere
     std::vector<double> model_rho_px;    // where the model's chief ray lands, output px from the axis's
     std::vector<double> real_rho_px;     // the exact tracer's, increasing (nodes beyond a fold dropped)

@@ -5,8 +5,11 @@
 
 #include <algorithm>
 #include <array>
+#include <optional>
 
+#include "illumination_table.h"
 #include "image_area_table.h"
+#include "pupil_mesh_table.h"
 #include "lensmith/core/units.h"
 
 namespace lensmith::render_detail {
@@ -69,6 +72,14 @@ PsfTable::PsfTable(const RayModel& model, const Aperture& aperture, double w_min
   double total_area = 0.0;
   for (double a : area) total_area += a;
   const double wavelength = camera_.reference_wavelength_nm();
+  // The real lens's brightness and clipped share for the models that only approximate them
+  // (illumination_table.h): their throughput scaled to it, their discs widened where far too tight.
+  std::optional<IlluminationTable> illumination;
+  if (options_.vignetting && IlluminationTable::applies(model, aperture, true)) {
+    const PupilMeshTable meshes(aperture);
+    const ImageAreaTable areas(model, margin, w_min, w_max, threads);
+    illumination.emplace(model, meshes.mesh(PupilMeshTable::light_mesh()), areas, margin, w_min, w_max, threads);
+  }
   entries_.resize(static_cast<std::size_t>(kGridX) * kGridY * depths_);
 #pragma omp parallel num_threads(threads)
   {
@@ -84,10 +95,15 @@ PsfTable::PsfTable(const RayModel& model, const Aperture& aperture, double w_min
           const PixelPoint at{gx * cell_x_ - margin_, gy * cell_y_ - margin_};
           const Tangents t = camera_.frame().tangents_at(at);
           const ScenePoint point{t.x, t.y, inverse};
-          model.map(point, wavelength, pupil, hits);
-          // First-order models clip by discs of the pupil, not through map(): each point's share of
-          // its cell inside every disc, across a disc's edge linear over the cell's width.
+          // First-order models clip by discs of the pupil: each point's share of its cell inside every
+          // disc, across a disc's edge linear over the cell's width (map() stops the rays outside the
+          // model's own discs; widened ones are applied here alone).
           model.clip_discs(point, discs);
+          if (illumination && illumination->widen(point, discs)) {
+            model.map_passing(point, wavelength, pupil, hits);
+          } else {
+            model.map(point, wavelength, pupil, hits);
+          }
           std::fill(inside.begin(), inside.end(), 1.0);
           for (std::size_t k = 0; k < hits.size() && !discs.empty(); ++k) {
             for (const PupilDisc& disc : discs) {
@@ -117,7 +133,7 @@ PsfTable::PsfTable(const RayModel& model, const Aperture& aperture, double w_min
             e.dy = static_cast<float>(my - at.y);
           }
           // Without vignetting, the light of the rays that pass as the whole beam's.
-          e.throughput = options_.vignetting ? static_cast<float>(light / total_area) : 1.0f;
+          e.throughput = options_.vignetting ? static_cast<float>(light / total_area * (illumination ? illumination->factor(point) : 1.0f)) : 1.0f;
           entries_[index(gx, gy, d)] = e;
         }
       }
