@@ -101,6 +101,17 @@ Beam trace(const RayModel& model, const ScenePoint& point, double wavelength_nm,
   return beam;
 }
 
+// How far from the output's centre `point`'s chief ray lands (output px), or -1 where it lands nowhere.
+double chief_radius_px(const RayModel& model, const ScenePoint& point, double wavelength_nm) {
+  std::array<SensorHit, 1> chief;
+  const std::array<PupilPoint, 1> centre{PupilPoint{0.0, 0.0}};
+  model.map(point, wavelength_nm, centre, chief);
+  if (!(chief[0].ok || chief[0].unclipped)) return -1.0;
+  const PixelPoint q = model.camera().output_pixel(chief[0].x_mm, chief[0].y_mm);
+  const PixelPoint o = model.camera().output_pixel(0.0, 0.0);
+  return std::hypot(q.x - o.x, q.y - o.y);
+}
+
 // Linear interpolation of ys over increasing xs at x, clamped to the ends.
 double interpolate(const std::vector<double>& xs, const std::vector<double>& ys, double x) {
   if (xs.size() == 1 || x <= xs.front()) return ys.front();
@@ -148,7 +159,31 @@ IlluminationTable::IlluminationTable(const RayModel& model, const PupilMesh& fin
   auto pixel_of = [&](std::size_t n, double reach) {
     return PixelPoint{centre_x + static_cast<double>(n % kFieldNodes) * reach * step_ * frame.focal_length_px(), centre_y};
   };
-  // The real lens at every node, the model on the axis (its share there is what the real lens's
+  // Where the chief rays land: the model's over its nodes, the real lens's over twice their field.
+  // The real lens's pupil is traced only out to the node past the model's farthest landing and past
+  // the model's own field (the discs' widening reads its share there): with every node traced, the
+  // table took 35-39 ms of the 1080p bench's Seidel render (pbrt-dgauss-50mm), about half of them
+  // beyond the frame through a lens of little distortion.
+  std::vector<double> model_rho(nodes, -1.0), real_rho(nodes, -1.0);
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 4)
+  for (std::size_t n = 0; n < nodes; ++n) {
+    model_rho[n] = chief_radius_px(model, point_of(n, 1.0), wavelength_nm);
+    real_rho[n] = chief_radius_px(*exact, point_of(n, kRealReach), wavelength_nm);
+  }
+  std::vector<std::size_t> last_real(static_cast<std::size_t>(depth_nodes), kFieldNodes - 1);
+  for (std::size_t d = 0; d < last_real.size(); ++d) {
+    const std::size_t first = d * kFieldNodes;
+    const double reach = *std::max_element(model_rho.begin() + static_cast<std::ptrdiff_t>(first),
+                                           model_rho.begin() + static_cast<std::ptrdiff_t>(first + kFieldNodes));
+    const auto own_field = static_cast<std::size_t>(std::ceil((kFieldNodes - 1) / kRealReach)) + 1;
+    for (std::size_t i = own_field; i < kFieldNodes; ++i) {
+      if (real_rho[first + i] >= reach) {
+        last_real[d] = std::min<std::size_t>(i + 1, kFieldNodes - 1);
+        break;
+      }
+    }
+  }
+  // The real lens at its nodes, the model on the axis (its share there is what the real lens's
   // relative share scales), then the model at every node with its discs widened to that share.
   std::vector<Beam> model_beam(nodes), real_beam(nodes);
   std::vector<double> model_area(nodes, 1.0), real_area(nodes, 0.0), scale(nodes, 1.0);
@@ -157,10 +192,11 @@ IlluminationTable::IlluminationTable(const RayModel& model, const PupilMesh& fin
     NodeRays rays;
 #pragma omp for schedule(dynamic, 1)
     for (std::size_t n = 0; n < nodes; ++n) {
+      if (n % kFieldNodes == 0) model_beam[n] = trace(model, point_of(n, 1.0), wavelength_nm, fine, rays);
+      if (n % kFieldNodes > last_real[n / kFieldNodes]) continue;  // lands = false: beyond what is read
       const ScenePoint real_point = point_of(n, kRealReach);
       real_beam[n] = trace(*exact, real_point, wavelength_nm, fine, rays);
       if (real_beam[n].lands) real_area[n] = chief_ray_image_area(*exact, pixel_of(n, kRealReach), real_point.inverse_depth_per_mm, 1.0);
-      if (n % kFieldNodes == 0) model_beam[n] = trace(model, point_of(n, 1.0), wavelength_nm, fine, rays);
     }
 #pragma omp for schedule(dynamic, 1)
     for (std::size_t n = 0; n < nodes; ++n) {
