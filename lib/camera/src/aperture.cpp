@@ -179,6 +179,15 @@ std::string Aperture::to_string() const {
   return "aperture";
 }
 
+double disc_clearance(const PupilPoint& p, std::span<const PupilDisc> discs, double radius_scale) {
+  double c = 1.0;
+  for (const PupilDisc& d : discs) {
+    const double dx = p.x - d.x, dy = p.y - d.y;
+    c = std::min(c, 1.0 - std::sqrt(dx * dx + dy * dy) / (radius_scale * d.radius));
+  }
+  return c;
+}
+
 double pupil_polygon_area(const std::vector<PupilPoint>& v) {
   const std::size_t n = v.size();
   if (n == 0) return 0.0;

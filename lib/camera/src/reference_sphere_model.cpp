@@ -197,15 +197,7 @@ void ReferenceSphereModel::map_with(const ScenePoint& point, double wavelength_n
   } else {
     discs.clear();
   }
-  auto clearance = [&](const PupilPoint& q) {
-    double c = 1.0;
-    if (discs.empty()) return c;
-    for (const PupilDisc& d : discs) {
-      const double dx = q.x - d.x, dy = q.y - d.y;
-      c = std::min(c, 1.0 - std::sqrt(dx * dx + dy * dy) / d.radius);
-    }
-    return c;
-  };
+  auto clearance = [&](const PupilPoint& q) { return disc_clearance(q, discs); };
   auto hit = [&](double x_mm, double y_mm, const PupilPoint& q) {
     const double c = clearance(q);
     return SensorHit{x_mm, y_mm, c >= 0.0, true, weight(q), c};

@@ -740,6 +740,16 @@ FootprintScatter::FootprintScatter(const RayModel& model, const Aperture& apertu
   }
 }
 
+float FootprintScatter::plan_light(const ScenePoint& point, const FootprintPlan& p) const {
+  const float factor = illumination_.factor(point);
+  // Widened discs: the light at the share the table's nodes measured (interpolated), not at this
+  // footprint's own (IlluminationTable::widened_share says why).
+  if (const double share = illumination_.widened_share(point); p.discs && share > 0.0 && p.passing > 0.0f) {
+    return static_cast<float>(factor * share / p.passing);
+  }
+  return factor;
+}
+
 void FootprintScatter::clip_discs(const ScenePoint& point, std::vector<PupilDisc>& discs) const {
   model_.clip_discs(point, discs);
   illumination_.widen(point, discs);
@@ -915,10 +925,7 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
     p.passing = static_cast<float>(disc_passing_share(scratch.discs, own_step, scratch));
   }
   p.area = areas_.at(centre.x, centre.y, s.inverse_depth_per_mm);
-  p.light = illumination_.factor(point);
-  if (const double share = illumination_.widened_share(point); p.discs && share > 0.0 && p.passing > 0.0f) {
-    p.light = static_cast<float>(p.light * share / p.passing);
-  }
+  p.light = plan_light(point, p);
   if (probe_out != nullptr) *probe_out = probe;
   return p;
 }
@@ -1016,10 +1023,7 @@ bool FootprintScatter::follow(const ScatterSource& s, const FootprintPlan& a, co
   out.area = areas_.at(centre.x, centre.y, s.inverse_depth_per_mm);
   out.blend = a.blend + f * (b.blend - a.blend);
   out.passing = a.passing + f * (b.passing - a.passing);
-  out.light = illumination_.factor(point);
-  if (const double share = illumination_.widened_share(point); out.discs && share > 0.0 && out.passing > 0.0f) {
-    out.light = static_cast<float>(out.light * share / out.passing);
-  }
+  out.light = plan_light(point, out);
   out.shape_source = a_index;
   return true;
 }
@@ -1218,15 +1222,11 @@ void FootprintScatter::record_mesh(const ScenePoint& point, double wavelength_nm
   FootprintShape& shape = scratch.shape;
   const PupilMesh& mesh = meshes_.mesh(p.mesh);
   map_cached(point, wavelength_nm, 0, p.mesh, mesh.points, hits, scratch, false);
-  if (!scratch.discs.empty()) {
-    // The discs as planned (widened where the real lens passes more: IlluminationTable::widen), not
-    // the model's own, as RayModel::map applies them.
+  if (!scratch.discs.empty() && illumination_.widened_share(point) > 0.0) {
+    // The discs as planned, widened where the real lens passes more (IlluminationTable::widen), not
+    // the model's own, which RayModel::map applies.
     for (std::size_t i = 0; i < mesh.points.size(); ++i) {
-      double c = 1.0;
-      for (const PupilDisc& d : scratch.discs) {
-        const double dx = mesh.points[i].x - d.x, dy = mesh.points[i].y - d.y;
-        c = std::min(c, 1.0 - std::sqrt(dx * dx + dy * dy) / d.radius);
-      }
+      const double c = disc_clearance(mesh.points[i], scratch.discs);
       hits[i].clearance = c;
       hits[i].ok = c >= 0.0;
       hits[i].unclipped = true;

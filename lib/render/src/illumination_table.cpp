@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 
 #include "lensmith/core/units.h"
 #include "mapped_pupil_table.h"
@@ -52,12 +53,7 @@ struct NodeRays {
 void apply_discs(const PupilMesh& fine, double scale, NodeRays& n) {
   n.clearance.resize(n.hits.size());
   for (std::size_t i = 0; i < n.hits.size(); ++i) {
-    double c = n.hits[i].clearance;
-    for (const PupilDisc& d : n.discs) {
-      const double dx = fine.points[i].x - d.x, dy = fine.points[i].y - d.y;
-      c = std::min(c, 1.0 - std::sqrt(dx * dx + dy * dy) / (scale * d.radius));
-    }
-    n.clearance[i] = c;
+    n.clearance[i] = std::min(n.hits[i].clearance, disc_clearance(fine.points[i], n.discs, scale));
   }
 }
 
@@ -81,17 +77,23 @@ void measure(const PupilMesh& fine, const NodeRays& n, Beam& beam) {
   if (total > 0.0) beam.share /= total;
 }
 
-// The chief ray's landing and the fine mesh's rays of `point`, the discs at scale 1.
-Beam trace(const RayModel& model, const ScenePoint& point, double wavelength_nm, const PupilMesh& fine, NodeRays& n) {
-  Beam beam;
+// Where `point`'s chief ray lands (output px), passing or stopped; nothing where it lands nowhere.
+std::optional<PixelPoint> chief_landing(const RayModel& model, const ScenePoint& point, double wavelength_nm) {
   std::array<SensorHit, 1> chief;
   const std::array<PupilPoint, 1> centre{PupilPoint{0.0, 0.0}};
   model.map(point, wavelength_nm, centre, chief);
-  if (!(chief[0].ok || chief[0].unclipped)) return beam;
-  const PixelPoint q = model.camera().output_pixel(chief[0].x_mm, chief[0].y_mm);
+  if (!(chief[0].ok || chief[0].unclipped)) return std::nullopt;
+  return model.camera().output_pixel(chief[0].x_mm, chief[0].y_mm);
+}
+
+// The chief ray's landing and the fine mesh's rays of `point`, the discs at scale 1.
+Beam trace(const RayModel& model, const ScenePoint& point, double wavelength_nm, const PupilMesh& fine, NodeRays& n) {
+  Beam beam;
+  const std::optional<PixelPoint> q = chief_landing(model, point, wavelength_nm);
+  if (!q) return beam;
   beam.lands = true;
-  beam.x_px = q.x;
-  beam.y_px = q.y;
+  beam.x_px = q->x;
+  beam.y_px = q->y;
   model.clip_discs(point, n.discs);
   n.hits.resize(fine.points.size());
   // The traced apertures' clearances (exact, poly); the first-order models' discs are applied here.
@@ -103,13 +105,10 @@ Beam trace(const RayModel& model, const ScenePoint& point, double wavelength_nm,
 
 // How far from the output's centre `point`'s chief ray lands (output px), or -1 where it lands nowhere.
 double chief_radius_px(const RayModel& model, const ScenePoint& point, double wavelength_nm) {
-  std::array<SensorHit, 1> chief;
-  const std::array<PupilPoint, 1> centre{PupilPoint{0.0, 0.0}};
-  model.map(point, wavelength_nm, centre, chief);
-  if (!(chief[0].ok || chief[0].unclipped)) return -1.0;
-  const PixelPoint q = model.camera().output_pixel(chief[0].x_mm, chief[0].y_mm);
+  const std::optional<PixelPoint> q = chief_landing(model, point, wavelength_nm);
+  if (!q) return -1.0;
   const PixelPoint o = model.camera().output_pixel(0.0, 0.0);
-  return std::hypot(q.x - o.x, q.y - o.y);
+  return std::hypot(q->x - o.x, q->y - o.y);
 }
 
 // Linear interpolation of ys over increasing xs at x, clamped to the ends.

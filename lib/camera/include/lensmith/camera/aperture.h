@@ -41,6 +41,11 @@ struct PupilDisc {
   double radius = 0.0;
 };
 
+// How far inside every one of `discs` (their radii scaled by `radius_scale`) pupil point `p` lies,
+// as a fraction of each disc's radius: min over the discs of 1 - |p - c| / R, and at most 1 (the
+// clearance a first-order model gives the ray through `p`, SensorHit::clearance).
+double disc_clearance(const PupilPoint& p, std::span<const PupilDisc> discs, double radius_scale = 1.0);
+
 // Area of a simple polygon of the pupil (shoelace formula), either winding.
 double pupil_polygon_area(const std::vector<PupilPoint>& polygon);
 
