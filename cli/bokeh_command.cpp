@@ -561,6 +561,10 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   std::optional<Camera> cam =
       CameraSpec{o.thin_lens ? thin_focal_mm : std::nullopt, camera, width, height}.camera(kind, lens ? &*lens : nullptr);
   if (!cam->is_thin_lens()) warn_about_aperture(*cam, global);
+  if (lens && cam->is_thin_lens() && cam->real_lens() == nullptr && !o.no_vignetting && !global.quiet) {
+    std::cerr << "note: " << lens_name << " cannot be made at f/" << format_number(cam->f_number())
+              << ": the thin model keeps no falloff across the frame (at the lens's own f-numbers it has the real lens's)\n";
+  }
   extras.squeezed_width = anamorphic_output_width(*cam, extras.data_width, o.desqueeze, global);
   if (extras.squeezed_width > 0 && windows.has_overscan()) {
     throw UsageError(o.image + " has overscan (a data window beyond its display window): an anamorphic lens's picture with overscan "

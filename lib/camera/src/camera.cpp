@@ -95,6 +95,20 @@ Camera Camera::thin_lens(double focal_length_mm, const CameraOptions& options, i
   return c;
 }
 
+Camera Camera::thin_lens_for(const Prescription& lens, const CameraOptions& options, int width_px, int height_px) {
+  const ParaxialSystem paraxial(lens);
+  CameraOptions o = options;
+  if (!o.f_number) o.f_number = paraxial.f_number();
+  Camera c = thin_lens(paraxial.efl_mm(), o, width_px, height_px);
+  try {
+    c.real_lens_ = std::make_shared<const Camera>(from_lens(lens, o, width_px, height_px));
+  } catch (const OptionsError&) {
+    // An f-number beyond the lens's stop: the thin lens alone (IlluminationTable does not apply).
+  } catch (const ComputationError&) {
+  }
+  return c;
+}
+
 std::optional<std::string> Camera::exact_model_only_for(const Prescription& lens) {
   if (const auto why = lens.why_not_rotationally_symmetric()) return *why;
   if (const int mirrors = lens.mirror_count(); mirrors > 0) return "it has " + std::to_string(mirrors) + " mirrors";

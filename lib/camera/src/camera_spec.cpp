@@ -54,12 +54,7 @@ Camera CameraSpec::camera(RayModelKind kind, const Prescription* lens) const {
     return Camera::thin_lens(*thin_lens_focal_length_mm, options, width_px, height_px);
   }
   if (!lens) throw UsageError("a camera needs a lens (a prescription) or a thin lens's focal length");
-  if (kind == RayModelKind::Thin) {
-    const ParaxialSystem paraxial(*lens);
-    CameraOptions o = options;
-    if (!o.f_number) o.f_number = paraxial.f_number();
-    return Camera::thin_lens(paraxial.efl_mm(), o, width_px, height_px);
-  }
+  if (kind == RayModelKind::Thin) return Camera::thin_lens_for(*lens, options, width_px, height_px);
   return Camera::from_lens(*lens, options, width_px, height_px);
 }
 

@@ -740,6 +740,11 @@ FootprintScatter::FootprintScatter(const RayModel& model, const Aperture& apertu
   }
 }
 
+ScenePoint FootprintScatter::scene_point(const ScatterSource& s) const {
+  const Tangents t = camera_.frame().tangents_at(source_centre(s));
+  return {t.x, t.y, s.inverse_depth_per_mm};
+}
+
 float FootprintScatter::plan_light(const ScenePoint& point, const FootprintPlan& p) const {
   const float factor = illumination_.factor(point);
   // Widened discs: the light at the share the table's nodes measured (interpolated), not at this
@@ -759,8 +764,7 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
   std::vector<PupilPoint>& pupil = scratch.pupil;
   std::vector<SensorHit>& hits = scratch.hits;
   const PixelPoint centre = source_centre(s);
-  const Tangents t = camera_.frame().tangents_at(centre);
-  const ScenePoint point{t.x, t.y, s.inverse_depth_per_mm};
+  const ScenePoint point = scene_point(s);
   FootprintPlan p;
   const bool affine = model_.affine_in_pupil() && aperture_.is_uniform_convex();
   // Probe: the pupil centre and its edge (8 points) at the extreme wavelengths and the reference.
@@ -1001,8 +1005,7 @@ bool FootprintScatter::follow(const ScatterSource& s, const FootprintPlan& a, co
                               std::int32_t a_index, FootprintPlan& out) const {
   // Its own chief ray (exact: distortion and lateral colour move a footprint by up to 1/16 px per
   // pixel along a row), a's shape, the rest interpolated between a and b.
-  const Tangents t = camera_.frame().tangents_at(source_centre(s));
-  const ScenePoint point{t.x, t.y, s.inverse_depth_per_mm};
+  const ScenePoint point = scene_point(s);
   std::array<SensorHit, 1> hit;
   if (a.discs) {
     model_.map_passing(point, camera_.reference_wavelength_nm(), kCentre, hit);
@@ -1049,6 +1052,8 @@ void FootprintScatter::plan_range(std::span<const ScatterSource> sources, std::s
       if (planned != end && sources[planned].inverse_depth_per_mm == s.inverse_depth_per_mm &&
           sources[planned].coverage_only == s.coverage_only) {
         plans[i] = moved_plan(plans[planned], sources[planned], s);
+        // A thin model of a real lens: the real lens's brightness where this one lands.
+        if (!illumination_.empty()) plans[i].light = plan_light(scene_point(s), plans[i]);
       } else {
         plans[i] = plan(s, scratch);
         planned = i;
@@ -1149,8 +1154,7 @@ void FootprintScatter::map_shape(const ScatterSource& s, const FootprintPlan& p,
   const int own_subrows = footprint_subrows(p, buffer_subrows);
   std::vector<SensorHit>& hits = scratch.hits;
   std::vector<Point2f>& points = scratch.points;
-  const Tangents t = camera_.frame().tangents_at(source_centre(s));
-  const ScenePoint point{t.x, t.y, s.inverse_depth_per_mm};
+  const ScenePoint point = scene_point(s);
   const double passing = p.passing;
   if (p.discs) {
     clip_discs(point, scratch.discs);
@@ -1359,8 +1363,7 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, s
     if (!p.discs || !options_.vignetting) return;
     // Only where the model's field is not folded back onto the frame's middle (a black point there
     // would darken what the model does draw).
-    const Tangents t = camera_.frame().tangents_at(source_centre(s));
-    if (!illumination_.unfolded(ScenePoint{t.x, t.y, s.inverse_depth_per_mm})) return;
+    if (!illumination_.unfolded(scene_point(s))) return;
     const Point2f at{p.affine_px[0], p.affine_px[1]};
     for (const SpectralGroup& g : groups_.split(p.groups)) {
       const std::array<float, 4> value = group_value(s, g, 1.0f, p, true);
@@ -1388,8 +1391,7 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, s
   const int own_subrows = footprint_subrows(p, buffer.options().subrows);
   std::vector<SensorHit>& hits = scratch.hits;
   std::vector<Point2f>& points = scratch.points;
-  const Tangents t = camera_.frame().tangents_at(source_centre(s));
-  const ScenePoint point{t.x, t.y, s.inverse_depth_per_mm};
+  const ScenePoint point = scene_point(s);
   if (p.discs && p.outline != FootprintPlan::kPoint) {
     clip_discs(point, scratch.discs);
   } else {

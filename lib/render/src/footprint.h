@@ -242,6 +242,8 @@ class FootprintScatter {
   // The model's first-order discs of `point` (RayModel::clip_discs), widened where they pass less of
   // the pupil than the real lens's apertures (IlluminationTable::widen).
   void clip_discs(const ScenePoint& point, std::vector<PupilDisc>& discs) const;
+  // The scene point a source stands for: its pixel centre's tangents at its inverse depth.
+  ScenePoint scene_point(const ScatterSource& s) const;
   // FootprintPlan::light for a plan whose discs and passing share are set.
   float plan_light(const ScenePoint& point, const FootprintPlan& p) const;
   // FootprintPlan::passing for `discs` and a footprint drawn with `own_step`'s sector count.

@@ -132,14 +132,26 @@ double interpolated(const std::vector<double>& v, double f) {
 
 bool IlluminationTable::applies(const RayModel& model, const Aperture& aperture, bool vignetting) {
   const RayModelKind kind = model.kind();
-  return vignetting && (kind == RayModelKind::Paraxial || kind == RayModelKind::Seidel || kind == RayModelKind::Poly) &&
-         aperture.kind() != Aperture::Kind::Mask && MappedPupilTable::round_lens(model.camera());
+  // A thin model stands for a real lens only where it was made for one (Camera::real_lens).
+  const Camera& real = model.camera().real_lens() != nullptr ? *model.camera().real_lens() : model.camera();
+  return vignetting &&
+         (kind == RayModelKind::Thin || kind == RayModelKind::Paraxial || kind == RayModelKind::Seidel || kind == RayModelKind::Poly) &&
+         aperture.kind() != Aperture::Kind::Mask && MappedPupilTable::round_lens(real);
+}
+
+IlluminationTable IlluminationTable::where_applies(const RayModel& model, const Aperture& aperture, bool vignetting, int margin_px,
+                                                   double w_min, double w_max, int threads, bool thin_only) {
+  if ((thin_only && model.kind() != RayModelKind::Thin) || !applies(model, aperture, vignetting)) return {};
+  const PupilMeshTable meshes(aperture);
+  const ImageAreaTable areas(model, margin_px, w_min, w_max, threads);
+  return IlluminationTable(model, meshes.mesh(PupilMeshTable::light_mesh()), areas, margin_px, w_min, w_max, threads);
 }
 
 IlluminationTable::IlluminationTable(const RayModel& model, const PupilMesh& fine, const ImageAreaTable& areas, int margin_px,
                                      double w_min, double w_max, int threads) {
   const Camera& camera = model.camera();
-  const std::unique_ptr<RayModel> exact = make_ray_model(RayModelKind::Exact, camera);
+  const std::unique_ptr<RayModel> exact =
+      make_ray_model(RayModelKind::Exact, camera.real_lens() != nullptr ? *camera.real_lens() : camera);
   const PinholeFrame& frame = camera.frame();
   const double centre_x = 0.5 * frame.width_px(), centre_y = 0.5 * frame.height_px();
   const double reach_px = std::hypot(centre_x + margin_px, centre_y + margin_px);

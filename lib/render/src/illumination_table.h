@@ -6,7 +6,8 @@
 // a pixel's patch of scene maps to. The exact model gets this from its traced rays and follows
 // `lensmith scene render --lens` to about 1 %. The first-order models (paraxial, Seidel) take the
 // solid angle of the paraxial pupil and first-order images of the clear apertures (discs), and the
-// poly model a fit's weights: on a retrofocus framed to 50 deg (lentil 0005) the paraxial model fell
+// poly model a fit's weights, and the thin model of a lens (its EFL and f-number) none at all (flat to
+// the corners where the double Gauss of issue 12 at f/2 falls to 0.65): on a retrofocus framed to 50 deg (lentil 0005) the paraxial model fell
 // to 0.05 of the centre at the frame's side where the truth has 0.31, the Seidel model's discs left
 // a dark ring at 40 deg and a flat 0.72 beyond it, and poly was 12 % dark at mid-field.
 //
@@ -52,9 +53,15 @@ class IlluminationTable {
   static constexpr double kMaxFactor = 8.0;
 
   // Whether the table applies: the paraxial, Seidel or poly model of a round lens (no mirrors, tilts
-  // or anamorphic squeeze; MappedPupilTable::round_lens), vignetting on, an aperture that is not a
-  // picture.
+  // or anamorphic squeeze; MappedPupilTable::round_lens), or the thin model that stands for one
+  // (Camera::real_lens; an ideal thin lens, as CG cameras have it, keeps no falloff), vignetting on,
+  // an aperture that is not a picture.
   static bool applies(const RayModel& model, const Aperture& aperture, bool vignetting);
+  // The table where it applies, with the model's own image areas and the light mesh; empty (every
+  // factor 1) where it does not. `thin_only`: only for the thin model of a real lens (methods that
+  // take the other models' brightness from their own ray weights).
+  static IlluminationTable where_applies(const RayModel& model, const Aperture& aperture, bool vignetting, int margin_px,
+                                         double w_min, double w_max, int threads, bool thin_only = false);
 
   // Every factor 1.
   IlluminationTable() = default;

@@ -19,6 +19,7 @@
 #include "lensmith/core/huge_page_allocator.h"
 #include "lensmith/core/units.h"
 #include "lensmith/color/spectral_quadrature.h"
+#include "illumination_table.h"
 #include "mip_pyramid.h"
 #include "scatter_source.h"
 
@@ -51,6 +52,7 @@ std::vector<double> channel_wavelengths_nm() {
 struct Source {
   ScenePoint point;
   float cone_px = 0.0f;  // the window its colour is read over (mip filter), px
+  float light = 1.0f;    // the thin model of a real lens: that lens's brightness here (IlluminationTable)
 };
 
 // What one view keeps at an output pixel: the nearest source's inverse depth (float bits, ordered
@@ -152,6 +154,16 @@ Image render_lightfield(const Image& image, const DepthMap& depth, const RayMode
       sources[index].cone_px = static_cast<float>(lambda * std::abs(camera.signed_coc_px(w_per_mm)));
     }
   }
+  // The thin model of a real lens has no pupil geometry of its own: the real lens's brightness
+  // across the frame (the other models' comes from their rays' weights).
+  const auto [w_lo, w_hi] = std::minmax_element(inverse.begin(), inverse.end());
+  const render_detail::IlluminationTable illumination =
+      inverse.empty() ? render_detail::IlluminationTable()
+                      : render_detail::IlluminationTable::where_applies(model, aperture, options.vignetting, margin, *w_lo, *w_hi, threads, true);
+  if (!illumination.empty()) {
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (std::size_t i = 0; i < n_sources; ++i) sources[i].light = illumination.factor(sources[i].point);
+  }
   render_detail::MipPyramid mip;
   if (options.mip_filter) {
     std::vector<std::array<float, 4>> base(pixels);
@@ -194,7 +206,7 @@ Image render_lightfield(const Image& image, const DepthMap& depth, const RayMode
             const std::size_t slot = j * n_sources + index;
             landing[slot] = {std::numeric_limits<float>::quiet_NaN(), 0.0f};
             if (!hit.ok) ++stopped;
-            landed_weight[slot] = hit.ok ? static_cast<float>(options.vignetting ? hit.weight : 1.0) : 0.0f;
+            landed_weight[slot] = hit.ok ? (options.vignetting ? static_cast<float>(hit.weight) * s.light : 1.0f) : 0.0f;
             // Without a landing, or without vignetting a stopped ray is no ray.
             if ((!hit.ok && !hit.unclipped) || (!hit.ok && !options.vignetting)) continue;
             const PixelPoint q = camera.output_pixel(hit.x_mm, hit.y_mm);

@@ -14,6 +14,7 @@
 
 #include <Eigen/Dense>
 
+#include "illumination_table.h"
 #include "lens_ray_table.h"
 #include "mip_pyramid.h"
 #include "spectral_groups.h"
@@ -322,6 +323,13 @@ Image render_multiview(const DeepImage& scene, const RayModel& model, const Aper
     layers.connect = static_cast<float>(slope > 0.0 ? kConnectPx / slope : std::numeric_limits<double>::infinity());
   }
   const bool opaque = scene.max_transparency() <= 1e-4;
+  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  // The thin model of a real lens has no pupil geometry of its own: each pixel takes the real lens's
+  // brightness there (at the focus plane's depth, within the scene's; the other models' comes from
+  // their rays' weights).
+  const render_detail::IlluminationTable illumination =
+      render_detail::IlluminationTable::where_applies(model, aperture, options.vignetting, 0, w_min, w_max, threads, true);
+  const double w_light = std::clamp(std::isfinite(camera.focus_distance_mm()) ? 1.0 / camera.focus_distance_mm() : 0.0, w_min, w_max);
 
   // Wavelengths: the scatter path's spectral groups (spectral_groups.h), split into at most
   // kMaxBands bands of neighbouring quadrature nodes, each traced at its middle node and carrying
@@ -367,7 +375,6 @@ Image render_multiview(const DeepImage& scene, const RayModel& model, const Aper
   table_options.vignetting = options.vignetting;
   table_options.threads = options.threads;
   const LensRayTable rays(model, aperture, wavelengths, lens_samples, table_options);
-  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
 
   // Per grid cell and pupil point: do the bands' rays agree at every corner (or all stop there)?
   const int cells_x = rays.nodes_x(), cells_y = rays.nodes_y();
@@ -482,7 +489,11 @@ Image render_multiview(const DeepImage& scene, const RayModel& model, const Aper
       }
       // Vignetting on: the pixel's light is the mean weight over all N samples (stopped rays bring
       // none); off: every passing ray counts alike.
-      const float brightness = options.vignetting ? static_cast<float>(weight_all / static_cast<double>(n_samples)) : 1.0f;
+      float brightness = options.vignetting ? static_cast<float>(weight_all / static_cast<double>(n_samples)) : 1.0f;
+      if (!illumination.empty()) {
+        const Tangents t = camera.frame().tangents_at({x + 0.5, y + 0.5});
+        brightness *= illumination.factor(ScenePoint{t.x, t.y, w_light});
+      }
       rgb *= brightness / static_cast<float>(bands);
       for (int c = 0; c < 3; ++c) px[c] = std::max(0.0f, rgb[c]);
       px[3] = static_cast<float>(std::clamp(coverage / weight_seen, 0.0, 1.0));

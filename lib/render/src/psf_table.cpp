@@ -46,8 +46,12 @@ PsfTable::PsfTable(const RayModel& model, const Aperture& aperture, double w_min
     : camera_(model.camera()), options_(options), margin_(margin_px) {
   options_.lens_psf = options.lens_psf && !model.camera().is_thin_lens();
   const int margin = margin_px;
-  // A thin lens's blur is the uniform disc of its CoC, centred, unvignetted.
-  if (!options_.lens_psf) return;
+  // A thin lens's blur is the uniform disc of its CoC, centred, unvignetted; the thin model of a
+  // real lens has that lens's brightness.
+  if (!options_.lens_psf) {
+    thin_illumination_ = IlluminationTable::where_applies(model, aperture, options_.vignetting, margin, w_min, w_max, threads, true);
+    return;
+  }
   const int w = camera_.frame().width_px(), h = camera_.frame().height_px();
   cell_x_ = static_cast<double>(w + 2 * margin) / (kGridX - 1);
   cell_y_ = static_cast<double>(h + 2 * margin) / (kGridY - 1);
@@ -74,12 +78,7 @@ PsfTable::PsfTable(const RayModel& model, const Aperture& aperture, double w_min
   const double wavelength = camera_.reference_wavelength_nm();
   // The real lens's brightness and clipped share for the models that only approximate them
   // (illumination_table.h): their throughput scaled to it, their discs widened where far too tight.
-  std::optional<IlluminationTable> illumination;
-  if (options_.vignetting && IlluminationTable::applies(model, aperture, true)) {
-    const PupilMeshTable meshes(aperture);
-    const ImageAreaTable areas(model, margin, w_min, w_max, threads);
-    illumination.emplace(model, meshes.mesh(PupilMeshTable::light_mesh()), areas, margin, w_min, w_max, threads);
-  }
+  const IlluminationTable illumination = IlluminationTable::where_applies(model, aperture, options_.vignetting, margin, w_min, w_max, threads);
   entries_.resize(static_cast<std::size_t>(kGridX) * kGridY * depths_);
 #pragma omp parallel num_threads(threads)
   {
@@ -99,7 +98,7 @@ PsfTable::PsfTable(const RayModel& model, const Aperture& aperture, double w_min
           // disc, across a disc's edge linear over the cell's width (map() stops the rays outside the
           // model's own discs; widened ones are applied here alone).
           model.clip_discs(point, discs);
-          if (illumination && illumination->widen(point, discs)) {
+          if (illumination.widen(point, discs)) {
             model.map_passing(point, wavelength, pupil, hits);
           } else {
             model.map(point, wavelength, pupil, hits);
@@ -133,7 +132,7 @@ PsfTable::PsfTable(const RayModel& model, const Aperture& aperture, double w_min
             e.dy = static_cast<float>(my - at.y);
           }
           // Without vignetting, the light of the rays that pass as the whole beam's.
-          e.throughput = options_.vignetting ? static_cast<float>(light / total_area * (illumination ? illumination->factor(point) : 1.0f)) : 1.0f;
+          e.throughput = options_.vignetting ? static_cast<float>(light / total_area * illumination.factor(point)) : 1.0f;
           entries_[index(gx, gy, d)] = e;
         }
       }
@@ -184,6 +183,10 @@ PsfEntry PsfTable::at(double x, double y, double w) const {
     const double radius = 0.5 * camera_.signed_coc_px(w);
     PsfEntry e;
     e.l11 = e.l22 = static_cast<float>(radius * std::sqrt(options_.variance_scale / 4.0));
+    if (!thin_illumination_.empty()) {
+      const Tangents t = camera_.frame().tangents_at(PixelPoint{x, y});
+      e.throughput = thin_illumination_.factor(ScenePoint{t.x, t.y, w});
+    }
     return e;
   }
   const double fx = std::clamp((x + margin_) / cell_x_, 0.0, static_cast<double>(kGridX - 1));

@@ -12,6 +12,7 @@
 
 #include "lensmith/camera/aperture.h"
 #include "lensmith/camera/ray_model.h"
+#include "illumination_table.h"
 
 namespace lensmith::render_detail {
 
@@ -47,7 +48,8 @@ inline Variance variance_of(const PsfEntry& e) {
 
 struct PsfTableOptions {
   // The lens's PSF from the ray model; false (and always for a thin lens): a centred uniform disc
-  // of the CoC, unvignetted.
+  // of the CoC, unvignetted but for the thin model of a real lens (Camera::real_lens), whose
+  // throughput is that lens's brightness across the frame (IlluminationTable).
   bool lens_psf = true;
   bool vignetting = true;  // the throughput is the lens's (false: 1 wherever light passes)
   // The covariance is the light's second moment times this (ewa: 2 / ln 4, the L2-best Gaussian of
@@ -73,6 +75,7 @@ class PsfTable {
   double cell_x_ = 1.0, cell_y_ = 1.0, w0_ = 0.0, dw_ = 1.0;
   int depths_ = 2;
   std::vector<PsfEntry> entries_;
+  IlluminationTable thin_illumination_;  // the thin model of a real lens, vignetting on (else empty)
 };
 
 }  // namespace lensmith::render_detail

@@ -70,6 +70,10 @@ class Camera {
  public:
   // An ideal thin lens of focal length f (mm) at f-number N; pupils and principal planes at z = 0.
   static Camera thin_lens(double focal_length_mm, const CameraOptions& options, int width_px, int height_px);
+  // The thin lens that stands for `lens` (its EFL; its own f-number unless options give one), with
+  // the camera of the real lens at the same options kept as real_lens(). Without one where the real
+  // lens cannot be made so (a stop wider than its surface allows, a focus it cannot image).
+  static Camera thin_lens_for(const Prescription& lens, const CameraOptions& options, int width_px, int height_px);
   // A real lens (materials resolved). Its first-order data is tabulated at 64 wavelengths from
   // 380 to 780 nm. Throws ComputationError for afocal lenses or a focus plane the lens cannot image,
   // OptionsError for an f-number whose stop would be wider than its surface can be (naming the
@@ -88,6 +92,9 @@ class Camera {
   // The prescription at the chosen f-number (aperture spec and stop semi-diameter set to it); null
   // for a thin lens.
   const Prescription* lens() const { return lens_.get(); }
+  // For the thin lens that stands for a prescription (thin_lens_for), that real lens's camera: the
+  // renderer takes the real lens's brightness across the frame from it. Null otherwise.
+  const Camera* real_lens() const { return real_lens_.get(); }
   const PinholeFrame& frame() const { return frame_; }
   const CameraOptions& options() const { return options_; }
   double f_number() const { return f_number_; }
@@ -146,6 +153,7 @@ class Camera {
   void finish();  // sensor, framing scale
 
   std::shared_ptr<const Prescription> lens_;
+  std::shared_ptr<const Camera> real_lens_;
   PinholeFrame frame_;
   CameraOptions options_;
   double f_number_ = 0.0;
