@@ -100,9 +100,35 @@ std::array<double, 2> LensFit::paraxial_outer_position(const ObjectPoint& o, dou
 FitAim LensFit::aim_from_object(const ObjectPoint& o, double stop_x_mm, double stop_y_mm, double wavelength_nm,
                                 std::optional<std::array<double, 2>> guess, const FitAimOptions& options) const {
   options.validate();
+  FitAim aim = aim_from_object_at(o, stop_x_mm, stop_y_mm, wavelength_nm, guess ? *guess : paraxial_outer_position(o, stop_x_mm, stop_y_mm),
+                                  options);
+  if (aim.converged || guess) return aim;
+  // Continuation along the field: where the paraxial entrance pupil is too far from the real one for
+  // Newton to start from (a retrofocus's pupil moves forward and grows off axis: lentil 0005's chief
+  // rays beyond 45 deg of its 55 deg frame corner were left unaimed, and the frame's outer band came
+  // out as the fill's flat grey), the point's direction is approached in kContinuationSteps equal
+  // steps of its tangent, each starting from the last one's solution.
+  constexpr int kContinuationSteps = 8;
+  std::optional<std::array<double, 2>> last;
+  for (int k = 1; k <= kContinuationSteps; ++k) {
+    const double f = static_cast<double>(k) / kContinuationSteps;
+    const ObjectPoint p{f * o.tan_x, f * o.tan_y, o.inverse_depth_per_mm, o.origin_z_mm};
+    const FitAim step = aim_from_object_at(p, stop_x_mm, stop_y_mm, wavelength_nm, last ? *last : paraxial_outer_position(p, stop_x_mm, stop_y_mm),
+                                           options);
+    if (!step.converged) {
+      if (last) return aim;  // lost on the way out: not aimed
+      continue;
+    }
+    if (k == kContinuationSteps) return step;
+    last = std::array<double, 2>{step.ray.x_mm, step.ray.y_mm};
+  }
+  return aim;
+}
+
+FitAim LensFit::aim_from_object_at(const ObjectPoint& o, double stop_x_mm, double stop_y_mm, double wavelength_nm,
+                                   const std::array<double, 2>& start, const FitAimOptions& options) const {
   const double lambda = normalised_wavelength(wavelength_nm);
   const double ps = scales_.outer_position_mm, ds = scales_.outer_direction;
-  const std::array<double, 2> start = guess ? *guess : paraxial_outer_position(o, stop_x_mm, stop_y_mm);
   const FittedMap& map = outer_clip_;
   std::array<double, 2> at;
   std::array<double, 8> jac;

@@ -264,7 +264,8 @@ class LensFit {
                          const FitAimOptions& options = {}) const;
   // Newton on the outer -> clip map: the outer-pupil ray from `object` whose fitted path crosses the
   // stop at (stop_x, stop_y). `guess` is a first outer-pupil position (x, y in mm); empty: the paraxial
-  // entrance-pupil image of the stop point.
+  // entrance-pupil image of the stop point, and where Newton fails from there, the point's direction
+  // approached from the axis in steps (continuation along the field).
   FitAim aim_from_object(const ObjectPoint& object, double stop_x_mm, double stop_y_mm, double wavelength_nm,
                          std::optional<std::array<double, 2>> guess = {}, const FitAimOptions& options = {}) const;
   // The ray from `object` to the point of the front surface above (x, y) (mm), as the outer maps take
@@ -322,6 +323,9 @@ class LensFit {
   std::optional<double> front_sag(double x_mm, double y_mm, double& dz_dx, double& dz_dy) const;
 
  private:
+  // aim_from_object's Newton from outer-pupil position `start` (mm).
+  FitAim aim_from_object_at(const ObjectPoint& object, double stop_x_mm, double stop_y_mm, double wavelength_nm,
+                            const std::array<double, 2>& start, const FitAimOptions& options) const;
   LensFit() = default;
   void set_front_surface(const FrontSurface& front);  // front_ and front_shape_
   // outer_ray_from_object's ray with the derivatives of its direction in the surface point's x, y.
