@@ -561,9 +561,18 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   std::optional<Camera> cam =
       CameraSpec{o.thin_lens ? thin_focal_mm : std::nullopt, camera, width, height}.camera(kind, lens ? &*lens : nullptr);
   if (!cam->is_thin_lens()) warn_about_aperture(*cam, global);
-  if (lens && cam->is_thin_lens() && cam->real_lens() == nullptr && !o.no_vignetting && !global.quiet) {
-    std::cerr << "note: " << lens_name << " cannot be made at f/" << format_number(cam->f_number())
-              << ": the thin model keeps no falloff across the frame (at the lens's own f-numbers it has the real lens's)\n";
+  // The thin model of a lens takes that lens's brightness across the frame where the renderer can
+  // (a round refracting lens it can make at this f-number: IlluminationTable); said where it cannot.
+  if (lens && cam->is_thin_lens() && !o.no_vignetting && !global.quiet) {
+    const Camera* real = cam->real_lens();
+    if (real == nullptr) {
+      std::cerr << "note: " << lens_name << " cannot be made at f/" << format_number(cam->f_number())
+                << ": the thin model keeps no falloff across the frame (at the lens's own f-numbers it has the real lens's)\n";
+    } else if (real->exact_model_only() || real->squeeze() != 1.0) {
+      std::cerr << "note: " << lens_name << ": the thin model keeps no falloff across the frame (it takes a real lens's only from "
+                << "round refracting lenses; " << (real->exact_model_only() ? *real->exact_model_only() : std::string("it is anamorphic"))
+                << "): --model exact has this lens's\n";
+    }
   }
   extras.squeezed_width = anamorphic_output_width(*cam, extras.data_width, o.desqueeze, global);
   if (extras.squeezed_width > 0 && windows.has_overscan()) {

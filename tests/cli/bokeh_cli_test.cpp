@@ -504,6 +504,13 @@ TEST_CASE("lensmith bokeh without --model photographs a mirror lens with the exa
   INFO(poly.err);
   CHECK(poly.exit_code == 0);
   CHECK(value_of(lensmith::read_image_metadata(out), "lensmith:model") == "poly");
+  // The thin model of it renders, and says it keeps no falloff (the real lens's brightness is taken
+  // for round refracting lenses only).
+  const auto thin = run_lensmith("bokeh --image " + image.string() + " --depth " + depth.string() + " --lens " + source +
+                                 "/examples/lenses/cassegrain-500mm.json --focus 30 --model thin -o " + out.string());
+  INFO(thin.err);
+  CHECK(thin.exit_code == 0);
+  CHECK_THAT(thin.err, Catch::Contains("the thin model keeps no falloff") && Catch::Contains("2 mirrors"));
   // And a tilt-shift lens (its elements fitted without the breaks at its ends).
   const auto shifted = run_lensmith("bokeh --image " + image.string() + " --depth " + depth.string() + " --lens " + source +
                                     "/examples/lenses/tilt-shift-50mm.json --focus 3 --model poly -o " + out.string());
