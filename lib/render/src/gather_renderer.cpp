@@ -47,12 +47,12 @@ constexpr double kSharpKernelPx = 2.0;
 // kSharpBlurPx + kBlendBlurPx, linearly between.
 constexpr double kSharpBlurPx = 1.0;
 constexpr double kBlendBlurPx = 2.0;
-// The hybrid's ray mask: Tan et al.'s scale s of the Sobel magnitude (per px of blur per output
-// px), and the least mask value that gets rays.
 // Fixed-point steps from an output pixel to the point the lens moves onto it (the composite's sharp
 // picture): the displacement changes slowly across the frame (a few px over tens), so two steps
 // bring it within a small fraction of a pixel.
 constexpr int kSourceSteps = 2;
+// The hybrid's ray mask: Tan et al.'s scale s of the Sobel magnitude (per px of blur per output
+// px), and the least mask value that gets rays.
 constexpr double kMaskScale = 0.5;
 constexpr double kMinMask = 0.05;
 // A gradient of the blur map below this (px of blur per output px) is a sloping surface, no edge.

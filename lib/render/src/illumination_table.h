@@ -5,11 +5,12 @@
 // grows off axis in a retrofocus design), clipped by the real clear apertures, over the image area
 // a pixel's patch of scene maps to. The exact model gets this from its traced rays and follows
 // `lensmith scene render --lens` to about 1 %. The first-order models (paraxial, Seidel) take the
-// solid angle of the paraxial pupil and first-order images of the clear apertures (discs), and the
-// poly model a fit's weights, and the thin model of a lens (its EFL and f-number) none at all (flat to
-// the corners where the double Gauss of issue 12 at f/2 falls to 0.65): on a retrofocus framed to 50 deg (lentil 0005) the paraxial model fell
-// to 0.05 of the centre at the frame's side where the truth has 0.31, the Seidel model's discs left
-// a dark ring at 40 deg and a flat 0.72 beyond it, and poly was 12 % dark at mid-field.
+// solid angle of the paraxial pupil and first-order images of the clear apertures (discs), the poly
+// model a fit's weights, and the thin model of a lens (its EFL and f-number) nothing at all: it was
+// flat to the corners where the double Gauss of issue 12 at f/2 falls to 0.65. On a retrofocus
+// framed to 50 deg (lentil 0005) the paraxial model fell to 0.05 of the centre at the frame's side
+// where the truth has 0.31, the Seidel model's discs left a dark ring at 40 deg and a flat 0.72
+// beyond it, and poly was 12 % dark at mid-field.
 //
 // So the first-order models' discs are widened where they pass far less of the pupil than the real
 // lens's clear apertures do (relative to the axis; below 0.8 of it, fully below 0.4): on that

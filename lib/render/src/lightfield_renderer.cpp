@@ -156,10 +156,8 @@ Image render_lightfield(const Image& image, const DepthMap& depth, const RayMode
   }
   // The thin model of a real lens has no pupil geometry of its own: the real lens's brightness
   // across the frame (the other models' comes from their rays' weights).
-  const auto [w_lo, w_hi] = std::minmax_element(inverse.begin(), inverse.end());
-  const render_detail::IlluminationTable illumination =
-      inverse.empty() ? render_detail::IlluminationTable()
-                      : render_detail::IlluminationTable::where_applies(model, aperture, options.vignetting, margin, *w_lo, *w_hi, threads, true);
+  const render_detail::IlluminationTable illumination = render_detail::IlluminationTable::where_applies(
+      model, aperture, options.vignetting, margin, depths.w_min, depths.w_max, threads, true);
   if (!illumination.empty()) {
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (std::size_t i = 0; i < n_sources; ++i) sources[i].light = illumination.factor(sources[i].point);
