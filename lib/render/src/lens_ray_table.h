@@ -11,7 +11,8 @@
 //   thin, paraxial, seidel  the ray model's forward map inverted: for the pupil point, the scene
 //                points at the focus plane and at infinity that the model sends to the film point
 //                (Newton on the direction tangents, a few map() calls each), joined by a line; the
-//                models' clear-aperture discs and radiometric weight at the focus-plane point.
+//                models' clear-aperture discs (widened as the scatter's, where the options give the
+//                real lens's illumination) and radiometric weight at the focus-plane point.
 // Rays are computed on a grid of film points every `grid_px` output pixels and interpolated
 // bilinearly in between (the line's parameters are smooth in the film point); a pixel whose cell
 // has a corner where the sample's ray is stopped gets its own ray, so a vignetted beam's edge is
@@ -25,6 +26,7 @@
 
 #include "lensmith/camera/aperture.h"
 #include "lensmith/camera/ray_model.h"
+#include "illumination_table.h"
 
 namespace lensmith {
 
@@ -46,6 +48,9 @@ struct LensRayTableOptions {
   int grid_px = 16;            // film grid step, output pixels (>= 1)
   bool vignetting = true;      // false: every passing ray weighs 1 (the cat's eye kept, its light not)
   int threads = 0;
+  // The first-order models' discs widened where the real lens passes more (IlluminationTable::widen;
+  // kept by the caller), or null.
+  const render_detail::IlluminationTable* illumination = nullptr;
 };
 
 class LensRayTable {
