@@ -382,7 +382,7 @@ TEST_CASE("The first-order models take the real lens's brightness across a retro
   }
 }
 
-TEST_CASE("The thin and poly models and the gather method take the retrofocus's brightness across the frame too",
+TEST_CASE("The thin and poly models, the gather method and the exact model's light field take the retrofocus's brightness across the frame too",
           "[scene][radiometry]") {
   // The same strip. The thin model of the lens (its EFL and f-number) has no pupil geometry and was
   // flat to the frame's side (1.00 where the truth has 0.31); the poly model's fit made in the run

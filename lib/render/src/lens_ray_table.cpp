@@ -138,6 +138,8 @@ class InverseSource final : public LensRayTable::Source {
     model_.clip_discs(near, discs);
     const bool widened = illumination_ != nullptr && illumination_->widen(near, discs);
     if (disc_clearance(rho, discs) < 0.0) return {};
+    // At infinity the model's own discs still stop the ray (as before), but where the focus-plane
+    // point's discs were widened: those would stop what the widened ones pass.
     double t2x = fx / j[1], t2y = fy / j[1];
     SensorHit far;
     if (!solve(fx, fy, rho, 0.0, wavelength_nm, j[1], t2x, t2y, far, !widened)) return {};

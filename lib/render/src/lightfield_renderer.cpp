@@ -159,8 +159,8 @@ Image render_lightfield(const Image& image, const DepthMap& depth, const RayMode
   // it: the thin model of a real lens has no pupil geometry of its own; the first-order models' discs
   // stopped every view at a retrofocus's frame edge (lentil 0005 at f/2.65, 0.308 of the centre in
   // the ground truth, black through the paraxial and Seidel models), so their discs are widened as
-  // the scatter's are, and each source's light scaled by the table's factor. The exact model's own
-  // rays carry it.
+  // the scatter's are, and each source's light scaled by the table's factor, as the poly model's
+  // (its fit's weights). The exact model's own rays carry it.
   const render_detail::IlluminationTable illumination = render_detail::IlluminationTable::where_applies(
       model, aperture, options.vignetting, margin, depths.w_min, depths.w_max, threads);
   if (!illumination.empty()) {
