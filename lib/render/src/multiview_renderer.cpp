@@ -342,6 +342,7 @@ Image render_multiview(const DeepImage& scene, const RayModel& model, const Aper
     areas = render_detail::ImageAreaTable(model, 0, w_min, w_max, threads);
   }
   const double w_light = std::clamp(std::isfinite(camera.focus_distance_mm()) ? 1.0 / camera.focus_distance_mm() : 0.0, w_min, w_max);
+  const auto w_light_f = static_cast<float>(w_light);
 
   // Wavelengths: the scatter path's spectral groups (spectral_groups.h), split into at most
   // kMaxBands bands of neighbouring quadrature nodes, each traced at its middle node and carrying
@@ -452,6 +453,7 @@ Image render_multiview(const DeepImage& scene, const RayModel& model, const Aper
       Eigen::Vector3f common_sum = Eigen::Vector3f::Zero();
       float common_seen = 0.0f;
       double weight_all = 0.0, weight_seen = 0.0, coverage = 0.0;  // bands' rays at 1 / bands each
+      double source_x = 0.0, source_y = 0.0, source_rays = 0.0;
       for (std::size_t i = 0; i < n_samples; ++i) {
         const std::size_t q = 4 * ((offset + i / 4) % base_count) + i % 4;
         const bool all_bands = cell_agrees[q] != 0;
@@ -474,6 +476,10 @@ Image render_multiview(const DeepImage& scene, const RayModel& model, const Aper
             ++lost;
           }
           weight_all += share * ray.weight;
+          // Where the passing rays meet the focus plane: the scene point the model images here.
+          source_x += share * (ray.inf_x + w_light_f * ray.k_x);
+          source_y += share * (ray.inf_y + w_light_f * ray.k_y);
+          source_rays += share;
           weight_seen += share * ray.weight * seen_share;
           coverage += share * ray.weight * (1.0f - r.transmittance);
           const Eigen::Vector3f met = ray.weight * Eigen::Vector3f(r.colour[0], r.colour[1], r.colour[2]);
@@ -504,9 +510,12 @@ Image render_multiview(const DeepImage& scene, const RayModel& model, const Aper
       // none); off: every passing ray counts alike.
       float brightness = options.vignetting ? static_cast<float>(weight_all / static_cast<double>(n_samples)) : 1.0f;
       if (!illumination.empty()) {
-        const Tangents t = camera.frame().tangents_at({x + 0.5, y + 0.5});
+        // At the scene point the pixel images (where its passing rays meet the focus plane; a
+        // barrel moves it outwards from the pixel's own field point), else at the pixel's.
+        const PixelPoint at = source_rays > 0.0 ? PixelPoint{source_x / source_rays, source_y / source_rays} : PixelPoint{x + 0.5, y + 0.5};
+        const Tangents t = camera.frame().tangents_at(at);
         brightness *= illumination.factor(ScenePoint{t.x, t.y, w_light});
-        if (first_order && !areas.empty()) brightness /= std::max(areas.at(x + 0.5, y + 0.5, w_light), 1e-3f);
+        if (first_order && !areas.empty()) brightness /= std::max(areas.at(at.x, at.y, w_light), 1e-3f);
       }
       rgb *= brightness / static_cast<float>(bands);
       for (int c = 0; c < 3; ++c) px[c] = std::max(0.0f, rgb[c]);
