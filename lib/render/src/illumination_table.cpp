@@ -39,6 +39,8 @@ struct Beam {
   double x_px = 0.0, y_px = 0.0;
   double light = 0.0;
   double share = 0.0;
+  // Where its light lands on average (output px; the chief ray's where none passes).
+  double light_x_px = 0.0, light_y_px = 0.0;
 };
 
 // A node's rays on the fine mesh, and the discs that clip them (first-order models).
@@ -60,9 +62,9 @@ void apply_discs(const PupilMesh& fine, double scale, NodeRays& n) {
 // Each triangle passes the share where the linear interpolation of its corners' clearance is >= 0
 // (MappedPupilTable::passing_light measures the same way), at its corners' mean weight for the light;
 // a corner that lands nowhere loses its triangle.
-void measure(const PupilMesh& fine, const NodeRays& n, Beam& beam) {
+void measure(const Camera& camera, const PupilMesh& fine, const NodeRays& n, Beam& beam) {
   beam.light = beam.share = 0.0;
-  double total = 0.0;
+  double total = 0.0, x_mm = 0.0, y_mm = 0.0;
   for (const PupilTriangle& t : fine.triangles) {
     total += t.weight;
     const auto a = static_cast<std::size_t>(t.a), b = static_cast<std::size_t>(t.b), c = static_cast<std::size_t>(t.c);
@@ -71,10 +73,22 @@ void measure(const PupilMesh& fine, const NodeRays& n, Beam& beam) {
     const SensorHit& hc = n.hits[c];
     if (!(ha.ok || ha.unclipped) || !(hb.ok || hb.unclipped) || !(hc.ok || hc.unclipped)) continue;
     const double passing = t.weight * passing_share(n.clearance[a], n.clearance[b], n.clearance[c]);
+    const double light = passing * (ha.weight + hb.weight + hc.weight) / 3.0;
     beam.share += passing;
-    beam.light += passing * (ha.weight + hb.weight + hc.weight) / 3.0;
+    beam.light += light;
+    x_mm += light * (ha.x_mm + hb.x_mm + hc.x_mm) / 3.0;
+    y_mm += light * (ha.y_mm + hb.y_mm + hc.y_mm) / 3.0;
   }
   if (total > 0.0) beam.share /= total;
+  beam.light_x_px = beam.x_px;
+  beam.light_y_px = beam.y_px;
+  if (beam.light > 0.0) {
+    const PixelPoint q = camera.output_pixel(x_mm / beam.light, y_mm / beam.light);
+    if (std::isfinite(q.x) && std::isfinite(q.y)) {
+      beam.light_x_px = q.x;
+      beam.light_y_px = q.y;
+    }
+  }
 }
 
 // Where `point`'s chief ray lands (output px), passing or stopped; nothing where it lands nowhere.
@@ -99,7 +113,7 @@ Beam trace(const RayModel& model, const ScenePoint& point, double wavelength_nm,
   // The traced apertures' clearances (exact, poly); the first-order models' discs are applied here.
   model.map_passing(point, wavelength_nm, fine.points, n.hits);
   apply_discs(fine, 1.0, n);
-  measure(fine, n, beam);
+  measure(model.camera(), fine, n, beam);
   return beam;
 }
 
@@ -234,7 +248,7 @@ IlluminationTable::IlluminationTable(const RayModel& model, const PupilMesh& fin
       double lo = 1.0, hi = kMaxDiscScale;
       Beam b;
       apply_discs(fine, hi, rays);
-      measure(fine, rays, b);
+      measure(camera, fine, rays, b);
       // A target the widest discs cannot reach (the real lens's share grows off axis beyond the
       // first-order discs' most): as near it as they come, not wider than needed.
       const double reachable = std::min(target, kReachable * b.share);
@@ -242,13 +256,13 @@ IlluminationTable::IlluminationTable(const RayModel& model, const PupilMesh& fin
         for (int k = 0; k < kBisections; ++k) {
           const double mid = 0.5 * (lo + hi);
           apply_discs(fine, mid, rays);
-          measure(fine, rays, b);
+          measure(camera, fine, rays, b);
           (b.share < reachable ? lo : hi) = mid;
         }
       }
       scale[n] = 1.0 + blend * (hi - 1.0);
       apply_discs(fine, scale[n], rays);
-      measure(fine, rays, model_beam[n]);
+      measure(camera, fine, rays, model_beam[n]);
     }
   }
   std::vector<Depth> depths(static_cast<std::size_t>(depth_nodes));
@@ -270,19 +284,37 @@ IlluminationTable::IlluminationTable(const RayModel& model, const PupilMesh& fin
       depth.model_relative.push_back(m.lands && model_area[first + i] > 0.0 ? m.light / model_area[first + i] / model_axis_b : -1.0);
       const double rho = std::hypot(m.x_px - model_axis.x_px, m.y_px - model_axis.y_px);
       depth.model_rho_px.push_back(m.lands ? rho : 0.0);
+      depth.model_light_rho_px.push_back(m.lands ? std::hypot(m.light_x_px - model_axis.x_px, m.light_y_px - model_axis.y_px) : 0.0);
       if (m.lands && rho > rho_before && depth.unfolded + 1 == i) depth.unfolded = i;
       rho_before = m.lands ? rho : kInfinity;
     }
-    // The real lens's brightness by where its chief ray lands, up to where it stops landing or folds
+    // The real lens's brightness by where its light lands, up to where it stops landing or folds
     // back (a fisheye's aimer beyond its reach): beyond that the last node's holds. The factor is
     // kept per node (a source's interpolated between them: no search per footprint).
+    std::vector<double> chief_rho;
     for (std::size_t i = 0; i < kFieldNodes; ++i) {
       const Beam& r = real_beam[first + i];
       if (!r.lands || !(real_area[first + i] > 0.0)) break;
-      const double rho = std::hypot(r.x_px - real_axis.x_px, r.y_px - real_axis.y_px);
-      if (!depth.real_rho_px.empty() && !(rho > depth.real_rho_px.back())) break;
+      const double rho = std::hypot(r.light_x_px - real_axis.x_px, r.light_y_px - real_axis.y_px);
+      const double chief = std::hypot(r.x_px - real_axis.x_px, r.y_px - real_axis.y_px);
+      if (!depth.real_rho_px.empty() && !(rho > depth.real_rho_px.back() && chief > chief_rho.back())) break;
       depth.real_rho_px.push_back(rho);
+      chief_rho.push_back(chief);
       depth.real_relative.push_back(r.light / real_area[first + i] / real_axis_b);
+    }
+    // The light spreads over the image area of its own landings, not of the chief rays': where they
+    // part (the cliff) it is stretched along the radius by d(light's radius) / d(chief's) and around
+    // the axis by their ratio (on the axis, its limit: the radial stretch), relative to the axis's.
+    const std::size_t kept = depth.real_rho_px.size();
+    if (kept >= 3) {
+      std::vector<double> stretch(kept, 1.0);
+      for (std::size_t i = 0; i < kept; ++i) {
+        const std::size_t a = i == 0 ? 0 : i - 1, b = std::min(i + 1, kept - 1);
+        const double radial = (depth.real_rho_px[b] - depth.real_rho_px[a]) / (chief_rho[b] - chief_rho[a]);
+        const double around = i == 0 ? radial : depth.real_rho_px[i] / chief_rho[i];
+        if (std::isfinite(radial) && std::isfinite(around) && radial > 0.0 && around > 0.0) stretch[i] = radial * around;
+      }
+      for (std::size_t i = 0; i < kept; ++i) depth.real_relative[i] *= stretch[0] / stretch[i];
     }
     for (std::size_t i = 0; i < kFieldNodes; ++i) depth.factor.push_back(node_factor(depth, i));
     widened_ = widened_ || std::any_of(depth.disc_scale.begin(), depth.disc_scale.end(), [](double k) { return k != 1.0; });
@@ -294,7 +326,7 @@ double IlluminationTable::node_factor(const Depth& d, std::size_t i) {
   const double model = d.model_relative[i];
   if (model < 0.0) return 1.0;             // the model's chief ray lands nowhere: its own light stays
   if (!(model > kNothing)) return 1.0;     // the model passes nothing here (an opaque point that sends no light)
-  return std::clamp(interpolate(d.real_rho_px, d.real_relative, d.model_rho_px[i]) / model, 0.0, kMaxFactor);
+  return std::clamp(interpolate(d.real_rho_px, d.real_relative, d.model_light_rho_px[i]) / model, 0.0, kMaxFactor);
 }
 
 template <typename Of>
