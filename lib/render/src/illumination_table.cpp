@@ -283,8 +283,7 @@ IlluminationTable::IlluminationTable(const RayModel& model, const PupilMesh& fin
       depth.model_share.push_back(m.share);
       depth.model_relative.push_back(m.lands && model_area[first + i] > 0.0 ? m.light / model_area[first + i] / model_axis_b : -1.0);
       const double rho = std::hypot(m.x_px - model_axis.x_px, m.y_px - model_axis.y_px);
-      depth.model_rho_px.push_back(m.lands ? rho : 0.0);
-      depth.model_light_rho_px.push_back(m.lands ? std::hypot(m.light_x_px - model_axis.x_px, m.light_y_px - model_axis.y_px) : 0.0);
+      depth.model_rho_px.push_back(m.lands ? std::hypot(m.light_x_px - model_axis.x_px, m.light_y_px - model_axis.y_px) : 0.0);
       if (m.lands && rho > rho_before && depth.unfolded + 1 == i) depth.unfolded = i;
       rho_before = m.lands ? rho : kInfinity;
     }
@@ -326,7 +325,7 @@ double IlluminationTable::node_factor(const Depth& d, std::size_t i) {
   const double model = d.model_relative[i];
   if (model < 0.0) return 1.0;             // the model's chief ray lands nowhere: its own light stays
   if (!(model > kNothing)) return 1.0;     // the model passes nothing here (an opaque point that sends no light)
-  return std::clamp(interpolate(d.real_rho_px, d.real_relative, d.model_light_rho_px[i]) / model, 0.0, kMaxFactor);
+  return std::clamp(interpolate(d.real_rho_px, d.real_relative, d.model_rho_px[i]) / model, 0.0, kMaxFactor);
 }
 
 template <typename Of>

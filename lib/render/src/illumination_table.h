@@ -30,7 +30,7 @@
 // cliff a beam's passing sliver lands well outside its chief ray (lentil 0005 at 55 deg: 3.7 px out
 // on a 192 px frame), and placed at the chief rays' landings the real lens's light ended 3 px short
 // of the truth's: the thin and paraxial models' frame corner 0.005 of the centre where the ground
-// truth has 0.051 (now 0.040). Its brightness there is its light over the image area of those
+// truth has 0.051 (now 0.039). Its brightness there is its light over the image area of those
 // landings (the chief rays' stretched by how the two part, along the radius and around the axis).
 // So a uniform surface is as bright across the frame as through the real lens, whatever the
 // model's distortion (the paraxial model has none); a lone highlight carries the real lens's light
@@ -101,8 +101,8 @@ class IlluminationTable {
     std::vector<double> disc_scale;      // the discs' radius factor (>= 1)
     std::vector<double> model_share;     // the share of the pupil the model passes with them
     std::vector<double> model_relative;  // the model's B / B(axis), or -1 where its chief ray lands nowhere
-    std::vector<double> model_rho_px;    // where the model's chief ray lands, output px from the axis's
-    std::vector<double> model_light_rho_px;  // where its light lands on average (the chief ray's where none passes)
+    std::vector<double> model_rho_px;    // where the model's light lands on average (its chief ray where none
+                                         // passes), output px from the axis's
     std::vector<double> real_rho_px;     // where the exact tracer's light lands, increasing (nodes beyond a fold dropped)
     std::vector<double> real_relative;   // its B / B(axis) at real_rho_px
     std::vector<double> factor;          // the light factor at each node

@@ -515,7 +515,7 @@ Image render_multiview(const DeepImage& scene, const RayModel& model, const Aper
         const PixelPoint at = source_rays > 0.0 ? PixelPoint{source_x / source_rays, source_y / source_rays} : PixelPoint{x + 0.5, y + 0.5};
         const Tangents t = camera.frame().tangents_at(at);
         brightness *= illumination.factor(ScenePoint{t.x, t.y, w_light});
-        if (first_order && !areas.empty()) brightness /= std::max(areas.at(at.x, at.y, w_light), 1e-3f);
+        if (!areas.empty()) brightness /= std::max(areas.at(at.x, at.y, w_light), 1e-3f);
       }
       rgb *= brightness / static_cast<float>(bands);
       for (int c = 0; c < 3; ++c) px[c] = std::max(0.0f, rgb[c]);
