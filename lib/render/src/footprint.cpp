@@ -1127,6 +1127,9 @@ void FootprintShape::clear() {
   polygons.clear();
   group_end.clear();
   group_triangles.clear();
+  mesh_cells.clear();
+  mesh_edges.clear();
+  mesh_sets.clear();
 }
 
 void FootprintShape::add(std::span<const Point2f> vertices, const std::array<float, 4>& unit_value, int subrows) {
@@ -1201,12 +1204,14 @@ void FootprintScatter::map_shape(const ScatterSource& s, const FootprintPlan& p,
   // One wavelength group's polygons, per unit of its value.
   auto record_group = [&](const SpectralGroup& g) {
     std::size_t triangles = 0;
+    const std::size_t sets = shape.mesh_sets.size();
     if (rings_clipped) {
       deposit_clipped_rings(point, g.wavelength_nm, p, passing, allow_rings, rings_checked, kUnit, shape, own_subrows, scratch,
                             triangles);
     } else {
       record_mesh(point, g.wavelength_nm, p, allow_rings, rings_checked, own_subrows, scratch, triangles);
     }
+    if (shape.mesh_sets.size() == sets) shape.mesh_sets.emplace_back();
     shape.group_end.push_back(shape.polygons.size());
     shape.group_triangles.push_back(triangles);
   };
@@ -1263,8 +1268,12 @@ void FootprintScatter::record_mesh(const ScenePoint& point, double wavelength_nm
   // weights, for the table's finer measure below.
   const bool finer_light = table_ && options_.vignetting;
   double passed = 0.0, coarse = 0.0;
-  for (const PupilTriangle& tri : mesh.triangles) {
+  std::vector<double>& fractions = scratch.fractions;
+  fractions.resize(mesh.triangles.size());
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const PupilTriangle& tri = mesh.triangles[t];
     const double fraction = triangle_passing(tri);
+    fractions[t] = fraction;
     passed += tri.weight * fraction;
     if (finer_light && fraction > 0.0) coarse += tri.weight * fraction * (hits[tri.a].weight + hits[tri.b].weight + hits[tri.c].weight) / 3.0;
   }
@@ -1279,40 +1288,99 @@ void FootprintScatter::record_mesh(const ScenePoint& point, double wavelength_nm
     const PupilMesh& fine = meshes_.mesh(PupilMeshTable::light_mesh());
     if (coarse > 0.0) unlit = table_->passing_light(point, wavelength_nm, fine, scratch.table_cache) / coarse;
   }
-  for (const PupilTriangle& tri : mesh.triangles) {
-    const double fraction = triangle_passing(tri);
+  // The triangles, whole or cut, go down together (SplatBuffer::add_mesh): the same deposit as one by
+  // one, with one entry per shared edge and sub-row instead of two, and no polygon set up per
+  // triangle (a quarter of an exact render's time, perf). A cut edge's crossing of the clearance's
+  // 0 is one point for both its triangles, so that they share its passing part.
+  const PupilMeshTable::Edges& topology = meshes_.edges(p.mesh);
+  scratch.edge_slot.assign(topology.ends.size(), FootprintScratch::kNoSlot);
+  scratch.clip_slot.assign(topology.ends.size(), FootprintScratch::kNoSlot);
+  const auto point_base = static_cast<std::uint32_t>(shape.points.size());
+  shape.points.insert(shape.points.end(), points.begin(), points.end());
+  FootprintShape::MeshSet set;
+  set.cell_begin = static_cast<std::uint32_t>(shape.mesh_cells.size());
+  set.edge_begin = static_cast<std::uint32_t>(shape.mesh_edges.size());
+  auto new_edge = [&](std::uint32_t from, std::uint32_t to) {
+    shape.mesh_edges.push_back({from, to});
+    return static_cast<std::uint32_t>(shape.mesh_edges.size() - 1 - set.edge_begin);
+  };
+  // Where edge e's interpolated clearance crosses 0, from its first end to its second.
+  auto clip_point = [&](std::uint32_t e) {
+    std::uint32_t& slot = scratch.clip_slot[e];
+    if (slot == FootprintScratch::kNoSlot) {
+      const std::size_t u = topology.ends[e][0], v = topology.ends[e][1];
+      const double cu = hits[u].clearance, cv = hits[v].clearance;
+      const auto along = static_cast<float>(cu / (cu - cv));
+      const Point2f& pu = points[u];
+      const Point2f& pv = points[v];
+      slot = static_cast<std::uint32_t>(shape.points.size());
+      shape.points.push_back({pu.x + along * (pv.x - pu.x), pu.y + along * (pv.y - pu.y)});
+    }
+    return slot;
+  };
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const PupilTriangle& tri = mesh.triangles[t];
+    const double fraction = fractions[t];
     if (fraction == 0.0) continue;
     const double ray_weight = options_.vignetting ? (hits[tri.a].weight + hits[tri.b].weight + hits[tri.c].weight) / 3.0 : 1.0;
-    const auto w = static_cast<float>(tri.weight * fraction * ray_weight * unlit);
-    const std::array<float, 4> unit{w, w, w, static_cast<float>(tri.weight * fraction / passed)};
-    const std::array<std::size_t, 3> corner{static_cast<std::size_t>(tri.a), static_cast<std::size_t>(tri.b),
-                                            static_cast<std::size_t>(tri.c)};
-    if (fraction >= 1.0) {
-      const std::array<Point2f, 3> corners{points[corner[0]], points[corner[1]], points[corner[2]]};
-      shape.add(corners, unit, 0);
-    } else {
-      // Its passing part only, where the interpolated clearance is >= 0, mapped by interpolating
-      // the corners' landing points (first order): spread over the whole triangle's image, the
-      // stopped corners' unclipped landings drew a faint skirt around a vignetted point's bokeh
-      // (a highlight of radiance 200 showed it as a disc twice too wide, docs/bokeh.md "Brightness").
-      std::array<Point2f, 4> clipped{};
-      std::size_t count = 0;
-      for (std::size_t i = 0; i < 3; ++i) {
-        const std::size_t j = (i + 1) % 3;
-        const double ci = hits[corner[i]].clearance, cj = hits[corner[j]].clearance;
-        const Point2f& pi = points[corner[i]];
-        const Point2f& pj = points[corner[j]];
-        if (ci >= 0.0) clipped[count++] = pi;
-        if ((ci >= 0.0) != (cj >= 0.0) && count < clipped.size()) {
-          const auto along = static_cast<float>(ci / (ci - cj));
-          clipped[count++] = {pi.x + along * (pj.x - pi.x), pi.y + along * (pj.y - pi.y)};
-        }
+    MeshCell cell;
+    cell.light = static_cast<float>(tri.weight * fraction * ray_weight * unlit);
+    cell.coverage = static_cast<float>(tri.weight * fraction / passed);
+    const std::array<std::uint32_t, 3> corner{static_cast<std::uint32_t>(tri.a), static_cast<std::uint32_t>(tri.b),
+                                              static_cast<std::uint32_t>(tri.c)};
+    const bool whole = fraction >= 1.0;
+    // Its passing part only where it is cut, where the interpolated clearance is >= 0, mapped by
+    // interpolating the corners' landing points (first order): spread over the whole triangle's
+    // image, the stopped corners' unclipped landings drew a faint skirt around a vignetted point's
+    // bokeh (a highlight of radiance 200 showed it as a disc twice too wide, docs/bokeh.md
+    // "Brightness"). Walked a -> b -> c: each passing corner, then the crossing of each edge whose
+    // ends pass and stop; `kind` of each vertex: its corner k, or 3 + the edge k it cuts.
+    std::array<std::uint32_t, MeshCell::kMaxCorners> kind{};
+    cell.corners = 0;
+    for (std::uint32_t k = 0; k < 3; ++k) {
+      const std::uint32_t next = (k + 1) % 3;
+      const bool passes = whole || hits[corner[k]].clearance >= 0.0;
+      const bool next_passes = whole || hits[corner[next]].clearance >= 0.0;
+      if (passes) {
+        cell.corner[cell.corners] = point_base + corner[k];
+        kind[cell.corners++] = k;
       }
-      if (count < 3) continue;
-      shape.add(std::span<const Point2f>(clipped.data(), count), unit, 0);
+      if (passes != next_passes && cell.corners < MeshCell::kMaxCorners) {
+        cell.corner[cell.corners] = clip_point(topology.of_triangle[t][k]);
+        kind[cell.corners++] = 3 + k;
+      }
     }
+    if (cell.corners < 3) continue;
+    for (std::uint32_t j = 0; j < cell.corners; ++j) {
+      const std::uint32_t from = kind[j], to = kind[(j + 1) % cell.corners];
+      if (from < 3 && to < 3) {
+        // Along a whole edge of the triangle.
+        const std::uint32_t e = topology.of_triangle[t][from];
+        std::uint32_t& slot = scratch.edge_slot[e];
+        if (slot == FootprintScratch::kNoSlot) slot = new_edge(point_base + topology.ends[e][0], point_base + topology.ends[e][1]);
+        cell.edge[j] = slot;
+        cell.direction[j] = topology.direction[t][from];
+      } else if (from >= 3 && to >= 3) {
+        // The cut across the triangle: its own.
+        cell.edge[j] = new_edge(cell.corner[j], cell.corner[(j + 1) % cell.corners]);
+        cell.direction[j] = 1;
+      } else {
+        // The passing part of a cut edge, kept from its passing corner to its crossing.
+        const std::uint32_t k = from < 3 ? from : from - 3;
+        const std::uint32_t e = topology.of_triangle[t][k];
+        std::uint32_t& slot = scratch.edge_slot[e];
+        const std::uint32_t passing_corner = from < 3 ? cell.corner[j] : cell.corner[(j + 1) % cell.corners];
+        if (slot == FootprintScratch::kNoSlot) slot = new_edge(passing_corner, clip_point(e));
+        cell.edge[j] = slot;
+        cell.direction[j] = from < 3 ? std::int8_t{1} : std::int8_t{-1};
+      }
+    }
+    shape.mesh_cells.push_back(cell);
     ++triangles;
   }
+  set.cell_count = static_cast<std::uint32_t>(shape.mesh_cells.size() - set.cell_begin);
+  set.edge_count = static_cast<std::uint32_t>(shape.mesh_edges.size() - set.edge_begin);
+  shape.mesh_sets.push_back(set);
 }
 
 void FootprintScatter::draw_shape(const ScatterSource& s, const FootprintPlan& p, SplatBuffer& buffer, FootprintScratch& scratch,
@@ -1328,6 +1396,11 @@ void FootprintScatter::draw_shape(const ScatterSource& s, const FootprintPlan& p
     std::array<float, 4> value = group_value(s, g, share, p, options_.vignetting);
     if (scale != 1.0) {
       for (std::size_t c = 0; c < 3; ++c) value[c] = static_cast<float>(value[c] * scale);
+    }
+    const FootprintShape::MeshSet& set = shape.mesh_sets[group];
+    if (set.cell_count > 0) {
+      buffer.add_mesh(shape.points, std::span(shape.mesh_edges).subspan(set.edge_begin, set.edge_count),
+                      std::span(shape.mesh_cells).subspan(set.cell_begin, set.cell_count), value, {dx, dy});
     }
     const std::size_t begin = group == 0 ? 0 : shape.group_end[group - 1];
     for (std::size_t k = begin; k < shape.group_end[group]; ++k) {

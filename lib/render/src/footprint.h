@@ -7,7 +7,8 @@
 //   polygon is the outline scaled about the pixel's centre (the thin lens), from a stamp
 //   (footprint_stamps.h);
 // - a pupil mesh mapped vertex by vertex: nested ring polygons where the mapped rings nest (the
-//   radial light distribution kept), else triangle by triangle (folds, caustics, vignetting).
+//   radial light distribution kept), else as its triangles, deposited together edge by edge
+//   (SplatBuffer::add_mesh; folds, caustics, vignetting).
 #pragma once
 
 #include <array>
@@ -105,6 +106,19 @@ struct FootprintShape {
   // polygons end, and how many of them were mesh triangles.
   std::vector<std::size_t> group_end;
   std::vector<std::size_t> group_triangles;
+  // A group's mesh triangles, whole or cut where a clear aperture stops part of them, deposited
+  // together (SplatBuffer::add_mesh; one set per group in the same order, empty where there are
+  // none): its cells in `mesh_cells` (light and coverage per unit of the group's value, corners in
+  // `points`) and its edges in `mesh_edges`, which the cells index from the set's first.
+  struct MeshSet {
+    std::uint32_t cell_begin = 0;
+    std::uint32_t cell_count = 0;
+    std::uint32_t edge_begin = 0;
+    std::uint32_t edge_count = 0;
+  };
+  std::vector<MeshCell> mesh_cells;
+  std::vector<std::array<std::uint32_t, 2>> mesh_edges;
+  std::vector<MeshSet> mesh_sets;
 
   void clear();
   void add(std::span<const Point2f> vertices, const std::array<float, 4>& unit_value, int subrows);
@@ -123,6 +137,13 @@ struct FootprintScratch {
   std::vector<PupilPoint> ring_pupil;     // clipped rings' vertices, the centre first
   std::vector<std::size_t> ring_offsets;  // clipped rings: where each ring's vertices end in `pupil`
   std::vector<double> pupil_areas;
+  // record_mesh: each mesh triangle's passing share.
+  std::vector<double> fractions;
+  // record_mesh, per PupilMeshTable::Edges entry: its edge (whole, or its passing part) in the
+  // shape's mesh set, and the point where its clearance crosses 0 in the shape's points (or kNoSlot).
+  std::vector<std::uint32_t> edge_slot;
+  std::vector<std::uint32_t> clip_slot;
+  static constexpr std::uint32_t kNoSlot = ~std::uint32_t{0};
   std::vector<double> ring_weights;
   // Ring polygons to deposit (deposit_nested_rings): the ring (1-based), its light and coverage.
   struct RingDeposit {

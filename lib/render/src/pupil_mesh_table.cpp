@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_map>
 
 #include "lensmith/core/units.h"
 
@@ -23,11 +24,34 @@ int step_index(const std::array<int, N>& steps, double wanted) {
   return static_cast<int>(N) - 1;
 }
 
+PupilMeshTable::Edges mesh_edges(const PupilMesh& mesh) {
+  PupilMeshTable::Edges out;
+  std::unordered_map<std::uint64_t, std::uint32_t> index;
+  index.reserve(mesh.triangles.size() * 2);
+  for (const PupilTriangle& t : mesh.triangles) {
+    const std::array<int, 3> v{t.a, t.b, t.c};
+    std::array<std::uint32_t, 3> of{};
+    std::array<std::int8_t, 3> direction{};
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto p = static_cast<std::uint32_t>(v[k]), q = static_cast<std::uint32_t>(v[(k + 1) % 3]);
+      const std::uint32_t lo = std::min(p, q), hi = std::max(p, q);
+      const auto [it, added] = index.try_emplace((std::uint64_t{lo} << 32) | hi, static_cast<std::uint32_t>(out.ends.size()));
+      if (added) out.ends.push_back({lo, hi});
+      of[k] = it->second;
+      direction[k] = p == lo ? std::int8_t{1} : std::int8_t{-1};
+    }
+    out.of_triangle.push_back(of);
+    out.direction.push_back(direction);
+  }
+  return out;
+}
+
 }  // namespace
 
 PupilMeshTable::PupilMeshTable(const Aperture& aperture) : aperture_(&aperture) {
   const std::size_t count = aperture.kind() == Aperture::Kind::Mask ? kGridSteps.size() : kRingSteps.size() * kSectorSteps.size();
   meshes_.resize(count);
+  edges_.resize(count);
   built_ = std::make_unique<std::once_flag[]>(count);
   if (aperture.kind() == Aperture::Kind::Mask) return;
   for (int sectors : kSectorSteps) {
@@ -57,8 +81,14 @@ const PupilMesh& PupilMeshTable::mesh(int index) const {
     } else {
       meshes_[i] = aperture_->mesh(kRingSteps[i / kSectorSteps.size()], kSectorSteps[i % kSectorSteps.size()]);
     }
+    edges_[i] = mesh_edges(meshes_[i]);
   });
   return meshes_[i];
+}
+
+const PupilMeshTable::Edges& PupilMeshTable::edges(int index) const {
+  mesh(index);
+  return edges_[static_cast<std::size_t>(index)];
 }
 
 int PupilMeshTable::sector_step(double diameter_px) {

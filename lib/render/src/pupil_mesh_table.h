@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <mutex>
 #include <vector>
@@ -36,6 +37,15 @@ class PupilMeshTable {
   static constexpr int kShareSectorStep = 4;  // 32 sectors: a polygon within 0.6 % of the circle's area
   // Made on first use (thread-safe); the table's aperture must outlive it.
   const PupilMesh& mesh(int index) const;
+  // A mesh's edges, for depositing its triangles together (SplatBuffer::add_mesh): each edge's two
+  // vertex indices, and per triangle its edges a-b, b-c, c-a with +1 where the triangle walks the
+  // edge from ends[0] to ends[1], -1 the other way. Made with the mesh.
+  struct Edges {
+    std::vector<std::array<std::uint32_t, 2>> ends;
+    std::vector<std::array<std::uint32_t, 3>> of_triangle;
+    std::vector<std::array<std::int8_t, 3>> direction;
+  };
+  const Edges& edges(int index) const;
   // The outline for a sector step (blades: their corners only).
   const std::vector<PupilPoint>& outline(int sector_step) const { return outlines_[static_cast<std::size_t>(sector_step)]; }
   // The outline with the sector step's vertex count, blades' edges included point by point (for
@@ -57,6 +67,7 @@ class PupilMeshTable {
   const Aperture* aperture_;
   // polar: ring step * sector steps + sector step; masks: grid steps
   mutable std::vector<PupilMesh> meshes_;
+  mutable std::vector<Edges> edges_;
   mutable std::unique_ptr<std::once_flag[]> built_;
   std::vector<std::vector<PupilPoint>> outlines_;  // per sector step
   std::vector<std::vector<PupilPoint>> dense_outlines_;

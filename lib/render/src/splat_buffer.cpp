@@ -263,6 +263,21 @@ bool SplatBuffer::build_chains(std::span<const Point2f> vertices, int subrows) {
   return monotone;
 }
 
+// The pixel rows of the band that sub-row class m of pixel row `pixel_row` reaches with its tent (the
+// row above or below and its own), each as its first differences and its tent weight: add(row, weight).
+template <class Add>
+inline __attribute__((always_inline)) void SplatBuffer::tent_rows(int pixel_row, int subrows, int m, Add&& add) {
+  const int upper = pixel_row + kSubrowTent.upper_offset[subrows][m];
+  const double lower_weight = kSubrowTent.lower_weight[subrows][m];
+  for (int r = 0; r < 2; ++r) {
+    const int row = upper + r;
+    const double row_weight = r == 0 ? 1.0 - lower_weight : lower_weight;
+    // One sub-row per pixel row samples the row's centre, which the tent gives wholly to it.
+    if (row < grid_row_begin_ || row >= grid_row_end_ || row_weight == 0.0) continue;
+    add(diff_.data() + static_cast<std::size_t>(row - grid_row_begin_) * grid_width_ * kChannels, row_weight);
+  }
+}
+
 // One sub-row's span from x_enter (+) to x_leave (-), its tent-filtered x profile as first
 // differences into the two pixel rows the sub-row's tent reaches (sub-row class m of pixel row
 // `pixel_row`); `unit` is the deposit per unit span length.
@@ -272,18 +287,132 @@ inline __attribute__((always_inline)) void SplatBuffer::deposit_span(int pixel_r
   const EndWeights a = end_weights(clamp_end(x_enter, w));
   const EndWeights b = end_weights(clamp_end(x_leave, w));
   const double minus_qb[3] = {-b.q[0], -b.q[1], -b.q[2]};
-  const int upper = pixel_row + kSubrowTent.upper_offset[subrows][m];
-  const double lower_weight = kSubrowTent.lower_weight[subrows][m];
-  for (int r = 0; r < 2; ++r) {
-    const int row = upper + r;
-    const double row_weight = r == 0 ? 1.0 - lower_weight : lower_weight;
-    // One sub-row per pixel row samples the row's centre, which the tent gives wholly to it.
-    if (row < grid_row_begin_ || row >= grid_row_end_ || row_weight == 0.0) continue;
+  tent_rows(pixel_row, subrows, m, [&](double* row_diff, double row_weight) {
     double coef[kChannels];
     for (int c = 0; c < kChannels; ++c) coef[c] = row_weight * unit[c];
-    double* row_diff = diff_.data() + static_cast<std::size_t>(row - grid_row_begin_) * grid_width_ * kChannels;
     add_weights(row_diff, grid_width_, a.first, a.q, coef);
     add_weights(row_diff, grid_width_, b.first, minus_qb, coef);
+  });
+}
+
+inline __attribute__((always_inline)) void SplatBuffer::deposit_end(int pixel_row, int subrows, int m, double x, const double coef[4]) {
+  const EndWeights e = end_weights(clamp_end(x, grid_width_));
+  tent_rows(pixel_row, subrows, m, [&](double* row_diff, double row_weight) {
+    double weighted[kChannels];
+    for (int c = 0; c < kChannels; ++c) weighted[c] = row_weight * coef[c];
+    add_weights(row_diff, grid_width_, e.first, e.q, weighted);
+  });
+}
+
+// Function multi-versioning as add_polygon (below).
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+__attribute__((target_clones("arch=x86-64-v3", "default")))
+#endif
+void SplatBuffer::add_mesh(std::span<const Point2f> vertices, std::span<const std::array<std::uint32_t, 2>> edges,
+                           std::span<const MeshCell> cells, const std::array<float, 4>& value, Point2f offset, int mesh_subrows) {
+  if (mesh_subrows < 0 || mesh_subrows > kMaxSubrows) {
+    throw OptionsError("SplatBuffer::add_mesh: " + std::to_string(mesh_subrows) + " sub-rows: must lie in [1, " +
+                       std::to_string(kMaxSubrows) + "], or 0 for the buffer's own");
+  }
+  const auto out_of_range = [&](std::size_t index, std::size_t size, const char* what) {
+    return OptionsError("SplatBuffer::add_mesh: " + std::string(what) + " " + std::to_string(index) + " of " + std::to_string(size));
+  };
+  const int subrows = mesh_subrows > 0 ? mesh_subrows : options_.subrows;
+  const double s = subrows;
+  if (!finite_value(value) || !std::isfinite(offset.x) || !std::isfinite(offset.y)) {
+    skipped_ += cells.size();
+    return;
+  }
+  const auto cell_x = [&](float x_px) { return (static_cast<double>(x_px) + offset.x) * scale_ + x_offset_; };
+  const auto cell_y = [&](float y_px) { return (static_cast<double>(y_px) + offset.y) * scale_; };
+  // Each edge's sub-rows by the rule of the chains (a sub-row centre c with y_upper <= c < y_lower),
+  // and its x summed over them (count * x at the mean sub-row's y), of which a cell's rasterised area
+  // is the signed sum over its edges: what add_polygon's spans would sum to.
+  edge_runs_.resize(edges.size());
+  for (std::size_t i = 0; i < edges.size(); ++i) {
+    const auto [from, to] = edges[i];
+    if (from >= vertices.size() || to >= vertices.size()) throw out_of_range(std::max(from, to), vertices.size(), "an edge names vertex");
+    const double px = cell_x(vertices[from].x), py = cell_y(vertices[from].y);
+    const double qx = cell_x(vertices[to].x), qy = cell_y(vertices[to].y);
+    EdgeRun& r = edge_runs_[i];
+    r.light = 0.0;
+    r.coverage = 0.0;
+    const bool up = qy < py;
+    r.up = up ? 1.0 : -1.0;
+    r.x = up ? qx : px;
+    r.y = up ? qy : py;
+    const double lower_x = up ? px : qx, lower_y = up ? py : qy;
+    r.first = fast_ceil(r.y * s - 0.5);
+    r.last = fast_ceil(lower_y * s - 0.5);
+    if (!(r.first < r.last)) {
+      // Horizontal, between two sub-rows, or not finite (then so is every area it enters).
+      r.last = r.first;
+      r.slope = 0.0;
+      const bool finite = std::isfinite(px) && std::isfinite(py) && std::isfinite(qx) && std::isfinite(qy);
+      r.x_sum = finite ? 0.0 : std::numeric_limits<double>::quiet_NaN();
+      continue;
+    }
+    r.slope = (lower_x - r.x) / (lower_y - r.y);
+    r.x_sum = (r.last - r.first) * (r.x + r.slope * ((r.first + r.last) / (2.0 * s) - r.y));
+  }
+  // Each cell's density steps onto its edges: walked upwards, an edge has a positively oriented
+  // cell's inside on its +x side, so the cell's indicator steps by direction * up there, and a
+  // sub-row's integral of the steps is -sum step * x.
+  for (const MeshCell& t : cells) {
+    if (t.corners < 3 || t.corners > MeshCell::kMaxCorners) {
+      throw OptionsError("SplatBuffer::add_mesh: a cell of " + std::to_string(t.corners) + " corners: must have 3 or 4");
+    }
+    double signed_area = 0.0;
+    for (std::size_t k = 0; k < t.corners; ++k) {
+      if (t.edge[k] >= edges.size()) throw out_of_range(t.edge[k], edges.size(), "a cell names edge");
+      if (t.corner[k] >= vertices.size()) throw out_of_range(t.corner[k], vertices.size(), "a cell names vertex");
+      const EdgeRun& r = edge_runs_[t.edge[k]];
+      signed_area -= t.direction[k] * r.up * r.x_sum;
+    }
+    signed_area /= s;
+    if (!std::isfinite(signed_area) || !std::isfinite(t.light) || !std::isfinite(t.coverage)) {
+      ++skipped_;
+      continue;
+    }
+    if (std::abs(signed_area) < kPointArea) {
+      double cx = 0.0, cy = 0.0;
+      for (std::size_t k = 0; k < t.corners; ++k) {
+        cx += cell_x(vertices[t.corner[k]].x);
+        cy += cell_y(vertices[t.corner[k]].y);
+      }
+      const double n = t.corners;
+      deposit_grid_point(cx / n, cy / n, {value[0] * t.light, value[1] * t.light, value[2] * t.light, value[3] * t.coverage});
+      continue;
+    }
+    const double light = t.light / signed_area, coverage = t.coverage / signed_area;
+    for (std::size_t k = 0; k < t.corners; ++k) {
+      EdgeRun& r = edge_runs_[t.edge[k]];
+      r.light += t.direction[k] * light;
+      r.coverage += t.direction[k] * coverage;
+    }
+  }
+  // One span end per edge and sub-row, carrying the difference of the densities either side.
+  const double lo = fast_ceil((grid_row_begin_ - 0.5) * s - 0.5);
+  const double hi = fast_ceil((grid_row_end_ + 0.5) * s - 0.5);
+  const double inv_s = 1.0 / s;
+  for (const EdgeRun& r : edge_runs_) {
+    if (r.light == 0.0 && r.coverage == 0.0) continue;
+    const double from = std::max(r.first, lo), to = std::min(r.last, hi);
+    if (!(from < to)) continue;
+    const double l = r.up * r.light * inv_s, c = r.up * r.coverage * inv_s;
+    const double coef[kChannels] = {l * value[0], l * value[1], l * value[2], c * value[3]};
+    const auto s_lo = static_cast<std::int64_t>(from);
+    const auto s_hi = static_cast<std::int64_t>(to);
+    std::int64_t pixel_row = floor_div(s_lo, subrows);
+    auto m = static_cast<int>(s_lo - pixel_row * subrows);
+    for (std::int64_t sub = s_lo; sub < s_hi; ++sub) {
+      const double y = (static_cast<double>(sub) + 0.5) * inv_s;
+      deposit_end(static_cast<int>(pixel_row), subrows, m, r.x + r.slope * (y - r.y), coef);
+      if (++m == subrows) {
+        m = 0;
+        ++pixel_row;
+      }
+    }
   }
 }
 

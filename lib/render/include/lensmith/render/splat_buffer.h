@@ -68,6 +68,20 @@ struct DifferenceStamp {
   friend std::ostream& operator<<(std::ostream& os, const DifferenceStamp& s) { return os << s.to_string(); }
 };
 
+// A cell of a mesh that SplatBuffer::add_mesh deposits: a convex polygon of 3 or 4 corners (indices
+// into the mesh's vertices, in order around it), its edges corner 0-1, 1-2, ..., last-0 (indices into
+// the mesh's edge list) with +1 where it walks an edge from the edge's first end to its second and -1
+// the other way, and the light (times the value's R, G, B) and coverage (times its alpha) it carries.
+struct MeshCell {
+  static constexpr std::size_t kMaxCorners = 4;
+  std::array<std::uint32_t, kMaxCorners> corner{};
+  std::array<std::uint32_t, kMaxCorners> edge{};
+  std::array<std::int8_t, kMaxCorners> direction{};
+  std::uint32_t corners = 3;
+  float light = 0.0f;
+  float coverage = 0.0f;
+};
+
 // Accumulates RGBA energy deposits for rows [row_begin, row_end) of an image width_px wide.
 //
 // Filtering: a polygon P carrying value v deposits into pixel (i, j)
@@ -106,6 +120,17 @@ class SplatBuffer {
   // in the same buffer. Throws OptionsError for a count outside [0, 16].
   void add_polygon(std::span<const Point2f> vertices, const std::array<float, 4>& value, int subrows = 0);
   void add_triangle(Point2f a, Point2f b, Point2f c, const std::array<float, 4>& value);
+  // The cells of a mesh (MeshCell: triangles, or triangles a clear aperture cut to quadrilaterals),
+  // each vertex moved by `offset` px, each depositing exactly what add_polygon of it would (its value
+  // over its rasterised area, a point where that is below add_polygon's threshold), but walked edge
+  // by edge: an edge two cells share takes one entry a sub-row (their densities' difference) where
+  // the cells one by one take two, and no cell is set up as a polygon. `edges` are vertex index
+  // pairs; `value` scales each cell's light (R, G, B) and coverage (alpha). Non-finite input is
+  // skipped and counted as add_polygon's; an index out of range or a corner count outside [3, 4]
+  // throws OptionsError. Costs O(edges + cells + crossings of edges and sub-rows); `subrows` as
+  // add_polygon's.
+  void add_mesh(std::span<const Point2f> vertices, std::span<const std::array<std::uint32_t, 2>> edges,
+                std::span<const MeshCell> cells, const std::array<float, 4>& value, Point2f offset = {}, int subrows = 0);
   // A point deposit with bilinear weights over the 2 x 2 pixels whose centres surround p.
   void add_point(Point2f p, const std::array<float, 4>& value);
   // The stamp's polygon moved by (anchor_x, anchor_y) whole px, carrying `value`; clipped like
@@ -153,6 +178,11 @@ class SplatBuffer {
   // One sub-row (class m of `subrows` per pixel) and its span into the two rows its tent reaches
   // (splat_buffer.cpp).
   void deposit_span(int pixel_row, int subrows, int m, double x_enter, double x_leave, const double unit[4]);
+  template <class Add>
+  void tent_rows(int pixel_row, int subrows, int m, Add&& add);  // splat_buffer.cpp
+  // One span end of weight coef (first differences per channel) at x in sub-row class m of pixel row
+  // `pixel_row`, into the two rows the sub-row's tent reaches.
+  void deposit_end(int pixel_row, int subrows, int m, double x, const double coef[4]);
   void deposit_point(double x_out_px, double y_out_px, const std::array<float, 4>& value);
   void deposit_grid_point(double x_px, double y_px, const std::array<float, 4>& value);  // grid cells
 
@@ -190,6 +220,20 @@ class SplatBuffer {
     double x_leave;
   };
   std::vector<Edge> edges_;
+  // Scratch of add_mesh: each edge's sub-rows and line, its x summed over them (for the cells'
+  // rasterised areas), and the light and coverage density steps across it.
+  struct EdgeRun {
+    double first;  // first sub-row it covers
+    double last;   // exclusive; first == last: it covers none
+    double x;      // upper end
+    double y;
+    double slope;  // dx/dy
+    double up;     // +1 where walking it from its first end to its second goes up (towards -y), else -1
+    double x_sum;
+    double light;
+    double coverage;
+  };
+  std::vector<EdgeRun> edge_runs_;
   std::vector<std::size_t> active_edges_;
   std::vector<double> crossings_;
   std::vector<SubrowSpan> spans_;
