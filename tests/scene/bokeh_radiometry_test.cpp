@@ -338,6 +338,15 @@ TEST_CASE("Barrel distortion brightens the frame's edges as in the ground truth:
   constexpr double kRatio = 0.05;
   const auto exact = make_ray_model(RayModelKind::Exact, strip.camera);
   check_strip_profile(strip, *exact, render_one_wavelength(strip.scene.input, *exact), kRatio);
+  // Lee's multiview through the exact model: each pixel's light from 256 pupil points, not from its
+  // own 32 rays, which drew 0005's frame edge (192 px wide) 0.370 of the centre where the truth has
+  // 0.308 (a bias of the 64 pupil points the whole frame shares; on this strip they stayed within
+  // 0.05). Measured within 0.018 here.
+  MultiviewOptions vo;
+  vo.spectral = false;
+  check_strip_profile(
+      strip, *exact,
+      render_multiview(deep_image_from_flat(strip.scene.input.rgb, strip.scene.input.depth), *exact, Aperture::circular(), vo), kRatio);
 }
 
 TEST_CASE("The first-order models take the real lens's brightness across a retrofocus framed to 50 deg, without a dark ring",
@@ -356,12 +365,14 @@ TEST_CASE("The first-order models take the real lens's brightness across a retro
   // Measured: within 0.017 (paraxial) and 0.030 (Seidel); without the real lens's brightness, 2 px
   // inside the edge, the paraxial model gave 0.14 of the centre and the Seidel model 0.86 against 0.41.
   constexpr double kRatio = 0.06;
-  // The multiview method's paraxial picture is 0.09 too bright at x = 46 (0.69 against 0.60): its 32
-  // rays a pixel measure a cat's eye's share of the pupil to a few per cent, which the real lens's
-  // factor (about 1.9 there, where the real entrance pupil has grown) multiplies. At 0005's frame
-  // side, 192 px wide: 0.813 of the centre with 32 rays, 0.778 with 64, 0.754 with 256, against the
-  // truth's 0.739.
-  constexpr double kMultiviewRatio = 0.10;
+  // The multiview method takes a pixel's light from 256 pupil points: from its own 32 rays the
+  // paraxial picture was 0.09 too bright at x = 46 (0.69 against 0.60), the real lens's factor (about
+  // 1.9 there) multiplying the rays' error in a cat's eye's share. Measured since: paraxial within
+  // 0.011 of the truth. The Seidel model through multiview is 0.35 of the centre 2 px inside the edge
+  // where the truth has 0.41 (within 0.015 elsewhere); its 32 rays had hidden that (0005's frame,
+  // 192 px wide: 0.291 at the edge with 256 rays a pixel before this change, as now, against 0.308).
+  // Noticed, not resolved: the scatter's Seidel picture is within 0.03 there.
+  constexpr double kMultiviewSeidelRatio = 0.07;
   for (RayModelKind kind : {RayModelKind::Paraxial, RayModelKind::Seidel}) {
     const auto model = make_ray_model(kind, strip.camera);
     check_strip_profile(strip, *model, render_one_wavelength(strip.scene.input, *model), kRatio);
@@ -385,7 +396,7 @@ TEST_CASE("The first-order models take the real lens's brightness across a retro
     check_strip_profile(
         strip, *model,
         render_multiview(deep_image_from_flat(strip.scene.input.rgb, strip.scene.input.depth), *model, Aperture::circular(), vo),
-        kMultiviewRatio);
+        kind == RayModelKind::Seidel ? kMultiviewSeidelRatio : kRatio);
   }
 }
 

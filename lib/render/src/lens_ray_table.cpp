@@ -242,6 +242,14 @@ PixelRay LensRayTable::direct_ray(double x_px, double y_px, std::size_t j) const
   return source_->ray(fx, fy, s, wavelengths_nm_[static_cast<std::size_t>(s.node)]);
 }
 
+double LensRayTable::mean_weight(double x_px, double y_px, std::span<const LensSample> samples) const {
+  if (samples.empty()) return 0.0;
+  const auto [fx, fy] = camera_->sensor_point_mm({x_px, y_px});
+  double sum = 0.0;
+  for (const LensSample& s : samples) sum += source_->ray(fx, fy, s, wavelengths_nm_[static_cast<std::size_t>(s.node)]).weight;
+  return sum / static_cast<double>(samples.size());
+}
+
 PixelRay LensRayTable::ray(int x, int y, std::size_t j) const {
   const int ix = x / grid_, iy = y / grid_;
   const int ix1 = std::min(ix + 1, nodes_x_ - 1), iy1 = std::min(iy + 1, nodes_y_ - 1);

@@ -22,6 +22,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "lensmith/camera/aperture.h"
@@ -68,6 +69,10 @@ class LensRayTable {
   // The same computed directly, without the grid (for tests and for cells with stopped corners).
   PixelRay direct_ray(double x_px, double y_px, std::size_t j) const;
   std::size_t direct_rays() const;  // rays computed without interpolation so far (statistics)
+  // The mean ray weight (0 where the lens stops the ray) over `samples`, another pupil set than the
+  // table's (a denser one), from the film point of output pixel position (x_px, y_px): the light the
+  // pixel's beam passes. Computed directly, not from the grid. Thread-safe.
+  double mean_weight(double x_px, double y_px, std::span<const LensSample> samples) const;
 
   // The grid: nodes at output pixel centres every grid_px() pixels; pixel (x, y) lies in the cell
   // whose corners are nodes (x / g, y / g) to (x / g + 1, y / g + 1) (clamped to the last node).
