@@ -44,7 +44,7 @@ constexpr float kChromaticTolerancePx = 0.5f;  // bands closer than this follow 
 // frame edge through the exact model: 0.370 of the centre against the ground truth's 0.308; 256
 // samples a pixel gave 0.325, this grid 0.328). 128 points: 0.331, but the Seidel model's light at
 // the retrofocus strip's edge (tests/scene) fell from 0.350 to 0.337; 16 nodes: 0.028 too bright at
-// 0005's bottom edge. The README's scene (640 x 360): about 0.3 s of its 3.7-4.2 s.
+// 0005's bottom edge. The README's scene (640 x 360, Seidel): about 0.4 s of its 4.0-4.4 s.
 constexpr std::size_t kLightSamples = 256;
 constexpr int kLightGridNodes = 32;
 constexpr int kMinLightStepPx = 4;
@@ -402,7 +402,7 @@ Image render_multiview(const DeepImage& scene, const RayModel& model, const Aper
   const LensRayTable rays(model, aperture, wavelengths, lens_samples, table_options);
 
   // The light of each pixel's beam, from a denser pupil set than its rays' (kLightSamples).
-  const int light_step = std::clamp(std::min(width, height) / kLightGridNodes, kMinLightStepPx, std::max(kMinLightStepPx, std::min(width, height)));
+  const int light_step = std::max(kMinLightStepPx, std::min(width, height) / kLightGridNodes);
   const int light_nx = (width - 1 + light_step - 1) / light_step + 1, light_ny = (height - 1 + light_step - 1) / light_step + 1;
   auto light_node_px = [light_step](int i, int size) { return static_cast<double>(std::min(i * light_step, size - 1)) + 0.5; };
   std::vector<float> light_grid;
