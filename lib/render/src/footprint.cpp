@@ -573,91 +573,6 @@ bool mesh_ring_spans(const PupilMesh& mesh, const std::vector<SensorHit>& hits, 
   return true;
 }
 
-// A polar mesh some of whose outer rays a clear aperture stops (exact, poly: SensorHit::clearance)
-// as nested rings over the part of the pupil that passes, from the same mapped rays: along each
-// spoke (a sector's vertices from the centre out) the beam's edge lies where the linear
-// interpolation of the clearances is 0, as on record_mesh's cut triangles, and ring k reaches k / R
-// of the widest spoke's reach, or its own spoke's where that is shorter (clip_rings' construction,
-// the reach from the rays instead of from discs). The rings' mapped points, pupil points and weights
-// are interpolated along the spokes between the mapped rings (first order, as the cut triangles'
-// corners are). Into scratch.ring_pupil, spoke_points and spoke_hits (the centre first, then R rings
-// of S), and the ring spans, pupil areas and mean weights as mesh_ring_spans makes them. False where
-// the centre ray is stopped, a stopped ray has no landing point, or a spoke passes again beyond where
-// it was stopped (the passing part not star-shaped about the centre): the triangles then.
-bool spoke_clipped_rings(const PupilMesh& mesh, const std::vector<SensorHit>& hits, const std::vector<Point2f>& points,
-                         FootprintScratch& scratch) {
-  if (!hits[0].ok) return false;
-  const int rings = mesh.rings;
-  const auto sectors = static_cast<std::size_t>(mesh.sectors);
-  auto index = [sectors](int k, std::size_t j) { return k == 0 ? std::size_t{0} : 1 + static_cast<std::size_t>(k - 1) * sectors + j; };
-  // Each spoke's reach, in rings (R where nothing on it is stopped).
-  std::vector<double>& reach = scratch.reach;
-  reach.assign(sectors, static_cast<double>(rings));
-  double widest = 0.0;
-  for (std::size_t j = 0; j < sectors; ++j) {
-    bool stopped = false;
-    for (int k = 1; k <= rings; ++k) {
-      const SensorHit& h = hits[index(k, j)];
-      if (stopped) {
-        if (h.ok) return false;
-        continue;
-      }
-      if (h.ok) continue;
-      if (!h.unclipped) return false;
-      const double inner = hits[index(k - 1, j)].clearance, outer = h.clearance;
-      reach[j] = (k - 1) + std::clamp(inner / (inner - outer), 0.0, 1.0);
-      stopped = true;
-    }
-    widest = std::max(widest, reach[j]);
-  }
-  if (!(widest > 0.0)) return false;
-  const std::size_t count = 1 + static_cast<std::size_t>(rings) * sectors;
-  std::vector<PupilPoint>& pupil = scratch.ring_pupil;
-  std::vector<Point2f>& mapped = scratch.spoke_points;
-  std::vector<SensorHit>& spoke_hits = scratch.spoke_hits;
-  pupil.resize(count);
-  mapped.resize(count);
-  spoke_hits.resize(count);
-  pupil[0] = {0.0, 0.0};
-  mapped[0] = points[0];
-  spoke_hits[0] = hits[0];
-  scratch.pupil_areas.assign(1, 0.0);
-  scratch.ring_weights.assign(1, hits[0].weight);
-  const double step = widest / rings;
-  for (int k = 1; k <= rings; ++k) {
-    double weights = 0.0, twice_area = 0.0;
-    for (std::size_t j = 0; j < sectors; ++j) {
-      const double r = std::min(step * k, reach[j]);
-      const int lo = std::min(static_cast<int>(r), rings - 1);
-      const double f = r - lo;
-      const std::size_t a = index(lo, j), b = index(lo + 1, j), v = index(k, j);
-      mapped[v] = {static_cast<float>(points[a].x + f * (static_cast<double>(points[b].x) - points[a].x)),
-                   static_cast<float>(points[a].y + f * (static_cast<double>(points[b].y) - points[a].y))};
-      const PupilPoint& rim = mesh.points[index(rings, j)];
-      pupil[v] = {rim.x * r / rings, rim.y * r / rings};
-      spoke_hits[v].weight = hits[a].weight + f * (hits[b].weight - hits[a].weight);
-      weights += spoke_hits[v].weight;
-    }
-    for (std::size_t j = 0; j < sectors; ++j) {
-      const PupilPoint& u = pupil[index(k, j)];
-      const PupilPoint& w = pupil[index(k, j + 1 == sectors ? 0 : j + 1)];
-      twice_area += u.x * w.y - w.x * u.y;
-    }
-    scratch.pupil_areas.push_back(0.5 * std::abs(twice_area));
-    scratch.ring_weights.push_back(weights / static_cast<double>(sectors));
-  }
-  untangled_ring_spans(mapped, rings, [sectors](int k) {
-    const std::size_t begin = 1 + static_cast<std::size_t>(k - 1) * sectors;
-    return std::pair{begin, begin + sectors};
-  }, scratch);
-  return true;
-}
-
-// Whether any ray of `hits` is stopped or lost.
-bool any_stopped(const std::vector<SensorHit>& hits) {
-  return std::any_of(hits.begin(), hits.end(), [](const SensorHit& h) { return !h.ok; });
-}
-
 bool deposit_ring_polygons(const PupilMesh& mesh, const std::vector<SensorHit>& hits, const std::vector<Point2f>& points,
                            const std::array<float, 4>& value, bool weighted, FootprintShape& out, int subrows, bool shapes_checked,
                            FootprintScratch& scratch) {
@@ -1272,9 +1187,7 @@ void FootprintScatter::map_shape(const ScatterSource& s, const FootprintPlan& p,
           const PixelPoint q = camera_.output_pixel(hits[i].x_mm, hits[i].y_mm);
           points[i] = {static_cast<float>(q.x), static_cast<float>(q.y)};
         }
-        if (!mesh_ring_spans(mesh, hits, points, scratch) && !(any_stopped(hits) && spoke_clipped_rings(mesh, hits, points, scratch))) {
-          return false;
-        }
+        if (!mesh_ring_spans(mesh, hits, points, scratch)) return false;
       }
       return rings_nest(scratch.ring_spans, scratch.areas);
     };
@@ -1334,12 +1247,9 @@ void FootprintScatter::record_mesh(const ScenePoint& point, double wavelength_nm
     const PixelPoint q = camera_.output_pixel(hits[i].x_mm, hits[i].y_mm);
     points[i] = {static_cast<float>(q.x), static_cast<float>(q.y)};
   }
-  if (mesh.sectors > 0 && allow_rings) {
-    if (any_stopped(hits)) {
-      if (record_spoke_rings(point, wavelength_nm, mesh, rings_checked, own_subrows, scratch)) return;
-    } else if (deposit_ring_polygons(mesh, hits, points, kUnit, options_.vignetting, shape, own_subrows, rings_checked, scratch)) {
-      return;
-    }
+  if (mesh.sectors > 0 && allow_rings &&
+      deposit_ring_polygons(mesh, hits, points, kUnit, options_.vignetting, shape, own_subrows, rings_checked, scratch)) {
+    return;
   }
   // A triangle whose corners a clear aperture partly stops (exact, poly) passes the part of its
   // area where the linear interpolation of their clearances is >= 0, in place: the beam's edge
@@ -1471,40 +1381,6 @@ void FootprintScatter::record_mesh(const ScenePoint& point, double wavelength_nm
   set.cell_count = static_cast<std::uint32_t>(shape.mesh_cells.size() - set.cell_begin);
   set.edge_count = static_cast<std::uint32_t>(shape.mesh_edges.size() - set.edge_begin);
   shape.mesh_sets.push_back(set);
-}
-
-bool FootprintScatter::record_spoke_rings(const ScenePoint& point, double wavelength_nm, const PupilMesh& mesh, bool rings_checked,
-                                          int own_subrows, FootprintScratch& scratch) const {
-  if (!spoke_clipped_rings(mesh, scratch.hits, scratch.points, scratch)) return false;
-  const int rings = mesh.rings;
-  const auto sectors = static_cast<std::size_t>(mesh.sectors);
-  const std::vector<double>& areas = scratch.pupil_areas;
-  const std::vector<double>& weights = scratch.ring_weights;
-  // The light in the rings' units: the whole mesh's pupil area (its outer ring's polygon) is the
-  // unvignetted beam's, as record_mesh's triangle weights are; with interpolated rays the light that
-  // passes is the table's finer measure instead (MappedPupilTable::passing_light), the rings only
-  // distributing it, as record_mesh's triangles do.
-  double full_pupil_area = 0.0;
-  for (std::size_t j = 0; j < sectors; ++j) {
-    const PupilPoint& u = mesh.points[1 + static_cast<std::size_t>(rings - 1) * sectors + j];
-    const PupilPoint& w = mesh.points[1 + static_cast<std::size_t>(rings - 1) * sectors + (j + 1 == sectors ? 0 : j + 1)];
-    full_pupil_area += 0.5 * (u.x * w.y - w.x * u.y);
-  }
-  full_pupil_area = std::abs(full_pupil_area);
-  if (table_ && options_.vignetting) {
-    double own = 0.0;
-    for (std::size_t k = 1; k < areas.size(); ++k) own += (areas[k] - areas[k - 1]) * 0.5 * (weights[k - 1] + weights[k]);
-    const double light = table_->passing_light(point, wavelength_nm, meshes_.mesh(PupilMeshTable::light_mesh()), scratch.table_cache);
-    if (!(own > 0.0) || !(light > 0.0)) return false;
-    full_pupil_area = own / light;
-  }
-  auto ring_begin = [sectors](int k) { return 1 + static_cast<std::size_t>(k - 1) * sectors; };
-  auto centroid = [&](double& cx, double& cy) {
-    return fan_light_centroid(scratch.ring_pupil, scratch.spoke_points, scratch.spoke_hits, rings, sectors, ring_begin,
-                              options_.vignetting, cx, cy);
-  };
-  return deposit_nested_rings(scratch.ring_spans, scratch.pupil_areas, scratch.ring_weights, full_pupil_area, kUnit, options_.vignetting,
-                              centroid, scratch.shape, own_subrows, rings_checked, scratch);
 }
 
 void FootprintScatter::draw_shape(const ScatterSource& s, const FootprintPlan& p, SplatBuffer& buffer, FootprintScratch& scratch,

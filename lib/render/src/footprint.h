@@ -7,9 +7,8 @@
 //   polygon is the outline scaled about the pixel's centre (the thin lens), from a stamp
 //   (footprint_stamps.h);
 // - a pupil mesh mapped vertex by vertex: nested ring polygons where the mapped rings nest (the
-//   radial light distribution kept; where a clear aperture stops the outer rays, rings over the
-//   part of the pupil that passes), else as its triangles, deposited together edge by edge
-//   (SplatBuffer::add_mesh; folds, caustics, a cat's eye that leaves out the pupil's centre).
+//   radial light distribution kept), else as its triangles, deposited together edge by edge
+//   (SplatBuffer::add_mesh; folds, caustics, vignetting).
 #pragma once
 
 #include <array>
@@ -136,10 +135,6 @@ struct FootprintScratch {
   std::vector<PupilPoint> clip_work;
   std::vector<double> reach;  // the discs' reach along an outline's vertex directions
   std::vector<PupilPoint> ring_pupil;     // clipped rings' vertices, the centre first
-  // A clipped polar mesh's rings over the part of the pupil that passes (spoke_clipped_rings): their
-  // mapped points and their rays' weights, interpolated along the mesh's spokes, laid out as ring_pupil.
-  std::vector<Point2f> spoke_points;
-  std::vector<SensorHit> spoke_hits;
   std::vector<std::size_t> ring_offsets;  // clipped rings: where each ring's vertices end in `pupil`
   std::vector<double> pupil_areas;
   // record_mesh: each mesh triangle's passing share.
@@ -234,12 +229,6 @@ class FootprintScatter {
   // corners (exact, poly); adds those to `triangles`.
   void record_mesh(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p, bool allow_rings, bool rings_checked,
                    int own_subrows, FootprintScratch& scratch, std::size_t& triangles) const;
-  // record_mesh's rings where a clear aperture stops some of the mesh's rays (exact, poly): nested
-  // rings over the part of the pupil that passes, interpolated from the mesh's mapped rays
-  // (spoke_clipped_rings), with the light of the whole beam that passes; false, depositing nothing,
-  // where they cannot be made or do not nest.
-  bool record_spoke_rings(const ScenePoint& point, double wavelength_nm, const PupilMesh& mesh, bool rings_checked, int own_subrows,
-                          FootprintScratch& scratch) const;
   // plan_range: whether the sources strictly between planned sources a and b (a run of one row)
   // may draw a's shape, and their plans when they do.
   bool shares_shape(std::span<const ScatterSource> sources, std::span<const FootprintPlan> plans, std::size_t a, std::size_t b,
