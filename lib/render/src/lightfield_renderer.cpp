@@ -21,6 +21,7 @@
 #include "lensmith/color/spectral_quadrature.h"
 #include "illumination_table.h"
 #include "image_area_table.h"
+#include "light_grid.h"
 #include "mip_pyramid.h"
 #include "scatter_source.h"
 
@@ -30,14 +31,10 @@ namespace {
 
 // Views warped together: one RayModel::map call per source for all of them.
 constexpr std::size_t kViewBatch = 6;
-// Each source's light is scaled from the views' share of its beam to that of a denser pupil set
-// (this many Halton points), measured on a grid of about kLightGridNodes nodes across the sources'
-// shorter side (at least every kMinLightStepPx) at the focus plane's depth, bilinear in between: the
-// 36 views the whole frame shares measure a cat's eye's share with a bias, as multiview's 64 points
-// did (docs/bokeh.md, "Brightness across the frame").
-constexpr std::size_t kLightSamples = 256;
-constexpr int kLightGridNodes = 32;
-constexpr int kMinLightStepPx = 4;
+// Each source's light is scaled from the views' share of its beam to that of LightGrid's dense
+// pupil set at its nodes, at the focus plane's depth: the 36 views the whole frame shares measure a
+// cat's eye's share with a bias, as multiview's 64 points did (docs/bokeh.md, "Brightness across the
+// frame").
 
 // Per RGB channel, the centroid of its weights over lensmith's spectral quadrature (380-780 nm, 64
 // nodes; negative weights left out): the wavelength whose rays carry that channel's light.
@@ -216,16 +213,13 @@ Image render_lightfield(const Image& image, const DepthMap& depth, const RayMode
   if (options.vignetting) {
     std::vector<PupilPoint> dense;
     std::vector<double> dense_weight;
-    halton_pupil(aperture, kLightSamples, dense, dense_weight);
-    const int step = std::max(kMinLightStepPx, std::min(sw, sh) / kLightGridNodes);
-    const int nx = (sw - 1 + step - 1) / step + 1, ny = (sh - 1 + step - 1) / step + 1;
-    auto node_px = [step](int i, int size) { return std::min(i * step, size - 1); };
+    halton_pupil(aperture, render_detail::kLightSamples, dense, dense_weight);
     const double w_focus =
         std::clamp(std::isfinite(camera.focus_distance_mm()) ? 1.0 / camera.focus_distance_mm() : 0.0, depths.w_min, depths.w_max);
-    std::vector<float> ratio(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny), 1.0f);
+    render_detail::LightGrid ratio(sw, sh, 1.0f);
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-    for (int j = 0; j < ny; ++j) {
-      std::vector<SensorHit> hits(std::max(kLightSamples, n_views));
+    for (int j = 0; j < ratio.nodes_y(); ++j) {
+      std::vector<SensorHit> hits(std::max(render_detail::kLightSamples, n_views));
       std::vector<PupilDisc> discs;
       auto passing = [&](std::span<const PupilPoint> set, std::span<const double> weight, const ScenePoint& point) {
         std::span<SensorHit> out(hits.data(), set.size());
@@ -237,34 +231,18 @@ Image render_lightfield(const Image& image, const DepthMap& depth, const RayMode
         }
         return total > 0.0 ? sum / total : 0.0;
       };
-      for (int i = 0; i < nx; ++i) {
-        const Tangents t = camera.frame().tangents_at({node_px(i, sw) - margin + 0.5, node_px(j, sh) - margin + 0.5});
+      for (int i = 0; i < ratio.nodes_x(); ++i) {
+        const Tangents t = camera.frame().tangents_at({ratio.node_x_px(i) - margin + 0.5, ratio.node_y_px(j) - margin + 0.5});
         const ScenePoint point{t.x, t.y, w_focus};
         const double views = passing(pupil, view_weight, point);
         // Where every view is stopped nothing can be scaled: left as it is.
-        if (views > 1e-6) ratio[static_cast<std::size_t>(j) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i)] =
-            static_cast<float>(passing(dense, dense_weight, point) / views);
+        if (views > 1e-6) ratio.at(i, j) = static_cast<float>(passing(dense, dense_weight, point) / views);
       }
     }
-    auto locate = [&](int p, int size, int nodes, int& i, float& t) {
-      i = std::min(p / step, std::max(nodes - 2, 0));
-      const int a = node_px(i, size), b = node_px(std::min(i + 1, nodes - 1), size);
-      t = b > a ? std::clamp(static_cast<float>(p - a) / static_cast<float>(b - a), 0.0f, 1.0f) : 0.0f;
-    };
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (int y = 0; y < sh; ++y) {
-      int j = 0;
-      float ty = 0.0f;
-      locate(y, sh, ny, j, ty);
-      const int j1 = std::min(j + 1, ny - 1);
       for (int x = 0; x < sw; ++x) {
-        int i = 0;
-        float tx = 0.0f;
-        locate(x, sw, nx, i, tx);
-        const int i1 = std::min(i + 1, nx - 1);
-        const auto at = [&](int a, int b) { return ratio[static_cast<std::size_t>(b) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(a)]; };
-        sources[static_cast<std::size_t>(y) * static_cast<std::size_t>(sw) + static_cast<std::size_t>(x)].light *=
-            (1.0f - ty) * ((1.0f - tx) * at(i, j) + tx * at(i1, j)) + ty * ((1.0f - tx) * at(i, j1) + tx * at(i1, j1));
+        sources[static_cast<std::size_t>(y) * static_cast<std::size_t>(sw) + static_cast<std::size_t>(x)].light *= ratio.sample(x, y);
       }
     }
   }

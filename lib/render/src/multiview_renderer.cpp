@@ -17,6 +17,7 @@
 #include "illumination_table.h"
 #include "image_area_table.h"
 #include "lens_ray_table.h"
+#include "light_grid.h"
 #include "mip_pyramid.h"
 #include "spectral_groups.h"
 #include "lensmith/core/errors.h"
@@ -37,17 +38,11 @@ constexpr double kLayerOverlap = 0.25;         // share of the layer spacing a s
 constexpr double kConnectPx = 1.0;             // neighbouring samples whose signed CoC differs less are one surface (px)
 constexpr std::size_t kMaxBands = 8;           // wavelength bands a pupil point may be traced in
 constexpr float kChromaticTolerancePx = 0.5f;  // bands closer than this follow one ray (BokehOptions' default)
-// A pixel's light (vignetting on) is the mean ray weight over this many pupil points (Halton, the
-// middle band), on a grid of about kLightGridNodes nodes across the frame's shorter side (at least
-// every kMinLightStepPx), bilinear in between: a pixel's own 32 samples, out of 64 pupil points
-// shared by the whole frame, measured a cat's eye's share with a bias of up to 20 % (lentil 0005's
-// frame edge through the exact model: 0.370 of the centre against the ground truth's 0.308; 256
-// samples a pixel gave 0.325, this grid 0.328). 128 points: 0.331, but the Seidel model's light at
-// the retrofocus strip's edge (tests/scene) fell from 0.350 to 0.337; 16 nodes: 0.028 too bright at
-// 0005's bottom edge. The README's scene (640 x 360, Seidel): about 0.4 s of its 4.0-4.4 s.
-constexpr std::size_t kLightSamples = 256;
-constexpr int kLightGridNodes = 32;
-constexpr int kMinLightStepPx = 4;
+// A pixel's light (vignetting on) is the mean ray weight over LightGrid's dense pupil set (Halton,
+// the middle band) at its nodes: a pixel's own 32 samples, out of 64 pupil points shared by the
+// whole frame, measured a cat's eye's share with a bias of up to 20 % (lentil 0005's frame edge
+// through the exact model: 0.370 of the centre against the ground truth's 0.308; 256 samples a
+// pixel gave 0.325, the grid 0.328).
 
 
 // A layer's sample at one pixel: inverse depth (1/mm; < 0: none) and where its colour is.
@@ -401,41 +396,24 @@ Image render_multiview(const DeepImage& scene, const RayModel& model, const Aper
   if (first_order && !illumination.empty()) table_options.illumination = &illumination;
   const LensRayTable rays(model, aperture, wavelengths, lens_samples, table_options);
 
-  // The light of each pixel's beam, from a denser pupil set than its rays' (kLightSamples).
-  const int light_step = std::max(kMinLightStepPx, std::min(width, height) / kLightGridNodes);
-  const int light_nx = (width - 1 + light_step - 1) / light_step + 1, light_ny = (height - 1 + light_step - 1) / light_step + 1;
-  auto light_node_px = [light_step](int i, int size) { return static_cast<double>(std::min(i * light_step, size - 1)) + 0.5; };
-  std::vector<float> light_grid;
+  // The light of each pixel's beam, from a denser pupil set than its rays' (light_grid.h).
+  render_detail::LightGrid light;
   if (options.vignetting) {
+    using render_detail::kLightSamples;
     std::vector<LensSample> dense(kLightSamples);
     for (std::size_t i = 0; i < kLightSamples; ++i) {
       dense[i].u = radical_inverse(i + 1, 2);
       dense[i].v = radical_inverse(i + 1, 3);
       dense[i].node = static_cast<int>(middle_band);
     }
-    light_grid.assign(static_cast<std::size_t>(light_nx) * static_cast<std::size_t>(light_ny), 0.0f);
+    light = render_detail::LightGrid(width, height, 0.0f);
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-    for (int j = 0; j < light_ny; ++j) {
-      for (int i = 0; i < light_nx; ++i) {
-        light_grid[static_cast<std::size_t>(j) * static_cast<std::size_t>(light_nx) + static_cast<std::size_t>(i)] =
-            static_cast<float>(rays.mean_weight(light_node_px(i, width), light_node_px(j, height), dense));
+    for (int j = 0; j < light.nodes_y(); ++j) {
+      for (int i = 0; i < light.nodes_x(); ++i) {
+        light.at(i, j) = static_cast<float>(rays.mean_weight(light.node_x_px(i) + 0.5, light.node_y_px(j) + 0.5, dense));
       }
     }
   }
-  auto pixel_light = [&](int x, int y) {
-    auto locate = [&](int p, int size, int nodes, int& i, float& t) {
-      i = std::min(p / light_step, nodes - 2);
-      const double a = light_node_px(i, size), b = light_node_px(i + 1, size);
-      t = b > a ? static_cast<float>(std::clamp((p + 0.5 - a) / (b - a), 0.0, 1.0)) : 0.0f;
-    };
-    if (light_nx < 2 || light_ny < 2) return light_grid.front();
-    int i = 0, j = 0;
-    float tx = 0.0f, ty = 0.0f;
-    locate(x, width, light_nx, i, tx);
-    locate(y, height, light_ny, j, ty);
-    const auto at = [&](int a, int b) { return light_grid[static_cast<std::size_t>(b) * static_cast<std::size_t>(light_nx) + static_cast<std::size_t>(a)]; };
-    return (1.0f - ty) * ((1.0f - tx) * at(i, j) + tx * at(i + 1, j)) + ty * ((1.0f - tx) * at(i, j + 1) + tx * at(i + 1, j + 1));
-  };
 
   // Per grid cell and pupil point: do the bands' rays agree at every corner (or all stop there)?
   const int cells_x = rays.nodes_x(), cells_y = rays.nodes_y();
@@ -554,7 +532,7 @@ Image render_multiview(const DeepImage& scene, const RayModel& model, const Aper
       }
       // Vignetting on: the pixel's light is the mean weight over the dense pupil set (stopped rays
       // bring none); off: every passing ray counts alike.
-      float brightness = options.vignetting ? pixel_light(x, y) : 1.0f;
+      float brightness = options.vignetting ? light.sample(x, y) : 1.0f;
       if (!illumination.empty()) {
         // At the scene point the pixel images (where its passing rays meet the focus plane; a
         // barrel moves it outwards from the pixel's own field point), else at the pixel's.
