@@ -345,6 +345,8 @@ class PolyModel final : public RayModel {
            std::span<SensorHit> hits) const override;
   std::shared_ptr<const LensFit> fit() const override { return fit_; }
   std::size_t unaimed_rays() const override { return unaimed_.load(std::memory_order_relaxed); }
+  // The fit's training rays pass the clear apertures enlarged by its aperture margin.
+  double landing_clearance_limit() const override { return 1.0 - fit_->options().aperture_margin; }
 
  private:
   void map_raw(const ScenePoint& point, double wavelength_nm, std::span<const PupilPoint> pupil, std::span<SensorHit> hits) const;

@@ -14,6 +14,7 @@
 //             the aperture stop at the requested point: slow, the reference
 #pragma once
 
+#include <limits>
 #include <memory>
 #include <ostream>
 #include <span>
@@ -97,6 +98,12 @@ class RayModel {
   // first-order models, which need no aiming). Such a ray comes back as neither ok nor unclipped:
   // drawn as stopped, it is a failure of the model, not vignetting, and callers report it.
   virtual std::size_t unaimed_rays() const { return 0; }
+  // The lowest clearance (SensorHit::clearance) down to which a stopped ray's landing holds, where it
+  // would land without the clear apertures: the poly model's fit learnt rays within its clear
+  // apertures enlarged by LensFitOptions::aperture_margin only, and beyond that its landings are
+  // extrapolations (a stopped ray's dark view in the light field, 4-7 px from where the beam's other
+  // rays land: docs/bokeh.md). The other models' hold everywhere (minus infinity).
+  virtual double landing_clearance_limit() const { return -std::numeric_limits<double>::infinity(); }
   virtual std::string to_string() const;
   friend std::ostream& operator<<(std::ostream& os, const RayModel& m) { return os << m.to_string(); }
 
