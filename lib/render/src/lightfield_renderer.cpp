@@ -31,10 +31,6 @@ namespace {
 
 // Views warped together: one RayModel::map call per source for all of them.
 constexpr std::size_t kViewBatch = 6;
-// Each source's light is scaled from the views' share of its beam to that of LightGrid's dense
-// pupil set at its nodes, at the focus plane's depth: the 36 views the whole frame shares measure a
-// cat's eye's share with a bias, as multiview's 64 points did (docs/bokeh.md, "Brightness across the
-// frame").
 
 // Per RGB channel, the centroid of its weights over lensmith's spectral quadrature (380-780 nm, 64
 // nodes; negative weights left out): the wavelength whose rays carry that channel's light.
@@ -210,6 +206,10 @@ Image render_lightfield(const Image& image, const DepthMap& depth, const RayMode
       }
     }
   };
+  // Each source's light is scaled from the views' share of its beam to that of LightGrid's dense
+  // pupil set at its nodes, at the focus plane's depth: the 36 views the whole frame shares measure
+  // a cat's eye's share with a bias, as multiview's 64 points did (docs/bokeh.md, "Brightness across
+  // the frame").
   if (options.vignetting) {
     std::vector<PupilPoint> dense;
     std::vector<double> dense_weight;

@@ -38,12 +38,6 @@ constexpr double kLayerOverlap = 0.25;         // share of the layer spacing a s
 constexpr double kConnectPx = 1.0;             // neighbouring samples whose signed CoC differs less are one surface (px)
 constexpr std::size_t kMaxBands = 8;           // wavelength bands a pupil point may be traced in
 constexpr float kChromaticTolerancePx = 0.5f;  // bands closer than this follow one ray (BokehOptions' default)
-// A pixel's light (vignetting on) is the mean ray weight over LightGrid's dense pupil set (Halton,
-// the middle band) at its nodes: a pixel's own 32 samples, out of 64 pupil points shared by the
-// whole frame, measured a cat's eye's share with a bias of up to 20 % (lentil 0005's frame edge
-// through the exact model: 0.370 of the centre against the ground truth's 0.308; 256 samples a
-// pixel gave 0.325, the grid 0.328).
-
 
 // A layer's sample at one pixel: inverse depth (1/mm; < 0: none) and where its colour is.
 struct Cell {
@@ -396,7 +390,11 @@ Image render_multiview(const DeepImage& scene, const RayModel& model, const Aper
   if (first_order && !illumination.empty()) table_options.illumination = &illumination;
   const LensRayTable rays(model, aperture, wavelengths, lens_samples, table_options);
 
-  // The light of each pixel's beam, from a denser pupil set than its rays' (light_grid.h).
+  // The light of each pixel's beam (vignetting on): the mean ray weight over LightGrid's dense pupil
+  // set (Halton, the middle band) at its nodes. A pixel's own 32 samples, out of 64 pupil points
+  // shared by the whole frame, measured a cat's eye's share with a bias of up to 20 % (lentil 0005's
+  // frame edge through the exact model: 0.370 of the centre against the ground truth's 0.308; 256
+  // samples a pixel gave 0.325, the grid 0.328).
   render_detail::LightGrid light;
   if (options.vignetting) {
     using render_detail::kLightSamples;
