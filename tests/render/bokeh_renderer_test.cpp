@@ -12,6 +12,8 @@
 #include "lensmith/render/bokeh_renderer.h"
 #include "lensmith/render/image_metrics.h"
 
+#include "spot_moments.h"
+
 using namespace lensmith;
 
 namespace {
@@ -306,34 +308,6 @@ TEST_CASE("Through a thin lens, pixels at one depth drawn from a neighbour's pla
   CHECK(worst < kSamePicture);
 }
 
-namespace {
-
-struct Moments {
-  double total = 0.0, cx = 0.0, cy = 0.0, rms = 0.0;
-};
-Moments moments(const Image& img, int channel) {
-  Moments m;
-  for (int y = 0; y < img.height; ++y) {
-    for (int x = 0; x < img.width; ++x) {
-      const double v = img.at(x, y, channel);
-      m.total += v;
-      m.cx += v * (x + 0.5);
-      m.cy += v * (y + 0.5);
-    }
-  }
-  m.cx /= m.total;
-  m.cy /= m.total;
-  for (int y = 0; y < img.height; ++y) {
-    for (int x = 0; x < img.width; ++x) {
-      m.rms += img.at(x, y, channel) * (std::pow(x + 0.5 - m.cx, 2) + std::pow(y + 0.5 - m.cy, 2));
-    }
-  }
-  m.rms = std::sqrt(m.rms / m.total);
-  return m;
-}
-
-}  // namespace
-
 TEST_CASE("Through the Biotar at f/5.6, a highlight's bokeh by the Seidel model matches the exact tracer's in place and size",
           "[render]") {
   // Tolerances: centroid within 0.1 px and RMS radius within 4 %, from the centre to 3/4 of the way
@@ -357,26 +331,26 @@ TEST_CASE("Through the Biotar at f/5.6, a highlight's bokeh by the Seidel model 
   o.spectral = false;
   for (const int hx : {w / 2, w / 2 + 40, w / 2 + 70}) {
     const Scene scene = highlight_scene(w, h, 1.2, 3.0, hx, h / 2 - 10);
-    const Moments s = moments(render_bokeh(scene.image, scene.depth, *seidel, Aperture::circular(), o), 1);
-    const Moments e = moments(render_bokeh(scene.image, scene.depth, *exact, Aperture::circular(), o), 1);
-    const Moments p = moments(render_bokeh(scene.image, scene.depth, *paraxial, Aperture::circular(), o), 1);
-    INFO("highlight at x = " << hx << ": centroid seidel (" << s.cx << ", " << s.cy << ") exact (" << e.cx << ", " << e.cy
-                             << ") paraxial (" << p.cx << ", " << p.cy << "), RMS radius seidel " << s.rms
-                             << " px, exact " << e.rms << " px");
-    CHECK(std::hypot(s.cx - e.cx, s.cy - e.cy) < 0.1);
-    CHECK(s.rms == Approx(e.rms).epsilon(kSeidelRmsRadius));
+    const testing::SpotMoments s = testing::spot_moments(render_bokeh(scene.image, scene.depth, *seidel, Aperture::circular(), o), 1);
+    const testing::SpotMoments e = testing::spot_moments(render_bokeh(scene.image, scene.depth, *exact, Aperture::circular(), o), 1);
+    const testing::SpotMoments p = testing::spot_moments(render_bokeh(scene.image, scene.depth, *paraxial, Aperture::circular(), o), 1);
+    INFO("highlight at x = " << hx << ": centroid seidel (" << s.x << ", " << s.y << ") exact (" << e.x << ", " << e.y
+                             << ") paraxial (" << p.x << ", " << p.y << "), RMS radius seidel " << s.rms()
+                             << " px, exact " << e.rms() << " px");
+    CHECK(std::hypot(s.x - e.x, s.y - e.y) < 0.1);
+    CHECK(s.rms() == Approx(e.rms()).epsilon(kSeidelRmsRadius));
     // The light the point sends (cos^4-type falloff off axis, no clipping at f/5.6): the Seidel and
     // paraxial models take it from the paraxial entrance pupil, the exact model from the real one,
     // and both scale theirs to the real lens's brightness (IlluminationTable). The paraxial model has
     // no distortion, so it takes the brightness the real lens has where its chief ray lands: its
     // highlight carries the exact model's light over the real image area of its pixel (3.3 % smaller
     // at x = 150 than on the axis; Seidel's third-order distortion has the lens's area there).
-    CHECK(s.total == Approx(e.total).epsilon(kPupilLight));
+    CHECK(s.light == Approx(e.light).epsilon(kPupilLight));
     const double w_highlight = 1.0 / 1200.0;  // 1/mm
     const double area = chief_ray_image_area(*exact, {hx + 0.5, h / 2 - 10 + 0.5}, w_highlight) /
                         chief_ray_image_area(*exact, {0.5 * w, 0.5 * h}, w_highlight);
     INFO("the real image area of the highlight's pixel, relative to the axis's: " << area);
-    CHECK(p.total == Approx(e.total / area).epsilon(kPupilLight));
+    CHECK(p.light == Approx(e.light / area).epsilon(kPupilLight));
   }
 }
 
@@ -403,14 +377,14 @@ TEST_CASE("A lens opened beyond its clear apertures blurs with the beam they pas
   for (const int hx : {w / 2, w / 2 + 30}) {
     const Scene scene = highlight_scene(w, h, 3.0, 10.0, hx, h / 2);
     BokehStatistics stats;
-    const Moments s = moments(render_bokeh(scene.image, scene.depth, *seidel, Aperture::circular(), o, &stats), 1);
-    const Moments e = moments(render_bokeh(scene.image, scene.depth, *exact, Aperture::circular(), o), 1);
-    INFO("highlight at x = " << hx << ": centroid seidel (" << s.cx << ", " << s.cy << ") exact (" << e.cx << ", " << e.cy
-                             << "), RMS radius seidel " << s.rms << " px, exact " << e.rms << " px, light " << s.total << " / "
-                             << e.total << ", " << stats.triangles << " triangles");
+    const testing::SpotMoments s = testing::spot_moments(render_bokeh(scene.image, scene.depth, *seidel, Aperture::circular(), o, &stats), 1);
+    const testing::SpotMoments e = testing::spot_moments(render_bokeh(scene.image, scene.depth, *exact, Aperture::circular(), o), 1);
+    INFO("highlight at x = " << hx << ": centroid seidel (" << s.x << ", " << s.y << ") exact (" << e.x << ", " << e.y
+                             << "), RMS radius seidel " << s.rms() << " px, exact " << e.rms() << " px, light " << s.light << " / "
+                             << e.light << ", " << stats.triangles << " triangles");
     CHECK(stats.triangles == 0);
-    CHECK(std::hypot(s.cx - e.cx, s.cy - e.cy) < 0.25);
-    CHECK(s.rms == Approx(e.rms).epsilon(kClippedRmsRadius));
+    CHECK(std::hypot(s.x - e.x, s.y - e.y) < 0.25);
+    CHECK(s.rms() == Approx(e.rms()).epsilon(kClippedRmsRadius));
   }
 }
 
@@ -553,7 +527,7 @@ TEST_CASE("A comatic highlight near focus lands where the Seidel model's rays pu
   for (const auto& [hx, hy] : {std::pair{172, 189}, std::pair{470, 180}, std::pair{320, 300}}) {
     for (const double z_m : {1.0, 1.1}) {
       const Scene scene = highlight_scene(w, h, z_m, 1.2, hx, hy);
-      const Moments r = moments(render_bokeh(scene.image, scene.depth, *fitted, Aperture::circular(), o), 1);
+      const testing::SpotMoments r = testing::spot_moments(render_bokeh(scene.image, scene.depth, *fitted, Aperture::circular(), o), 1);
       const Tangents t = cam.frame().tangents_at({hx + 0.5, hy + 0.5});
       fitted->map({t.x, t.y, 1.0 / mm_from_m(z_m)}, cam.reference_wavelength_nm(), pupil, hits);
       double sx = 0.0, sy = 0.0, light = 0.0;
@@ -564,9 +538,9 @@ TEST_CASE("A comatic highlight near focus lands where the Seidel model's rays pu
         sy += hit.weight * q.y;
         light += hit.weight;
       }
-      INFO("highlight at (" << hx << ", " << hy << "), " << z_m << " m: rendered centroid (" << r.cx << ", " << r.cy
+      INFO("highlight at (" << hx << ", " << hy << "), " << z_m << " m: rendered centroid (" << r.x << ", " << r.y
                             << "), the rays' (" << sx / light << ", " << sy / light << ")");
-      CHECK(std::hypot(r.cx - sx / light, r.cy - sy / light) < kCentroidPx);
+      CHECK(std::hypot(r.x - sx / light, r.y - sy / light) < kCentroidPx);
     }
   }
 }
@@ -803,10 +777,10 @@ TEST_CASE("At large blur the sources merged by the coarse grid's cells keep all 
     // (to 0.25 px: the block's other 15 pixels send 1/2000 of its light).
     Image disc = with;
     for (std::size_t i = 0; i < disc.data.size(); ++i) disc.data[i] -= without.data[i];
-    const Moments m = moments(disc, 1);
-    CHECK(m.total == Approx(1000.0).epsilon(kHighlightLight));
-    CHECK(m.cx == Approx(hx + 0.5).margin(kMergedCentroid_px));
-    CHECK(m.cy == Approx(hy + 0.5).margin(kMergedCentroid_px));
+    const testing::SpotMoments m = testing::spot_moments(disc, 1);
+    CHECK(m.light == Approx(1000.0).epsilon(kHighlightLight));
+    CHECK(m.x == Approx(hx + 0.5).margin(kMergedCentroid_px));
+    CHECK(m.y == Approx(hy + 0.5).margin(kMergedCentroid_px));
     CHECK(disc_diameter_px(disc) == Approx(blur_px).margin(kCoarseDiameter_px));
   }
 }

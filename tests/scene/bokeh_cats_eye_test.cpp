@@ -6,6 +6,7 @@
 // its place must be the ground truth's.
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -14,46 +15,9 @@
 #include "lensmith/scene/lens_render.h"
 #include "lensmith/scene/pinhole_render.h"
 
+#include "spot_moments.h"
+
 using namespace lensmith;
-
-namespace {
-
-// A spot's light, centroid and second moments (px) in a window of an image's channel 1.
-struct Spot {
-  double light = 0.0, x = 0.0, y = 0.0;
-  double xx = 0.0, yy = 0.0, xy = 0.0;
-  // The spot's extent along its long and short axes: the square roots of its moment matrix's eigenvalues.
-  double major() const { return std::sqrt(0.5 * (xx + yy) + std::sqrt(0.25 * (xx - yy) * (xx - yy) + xy * xy)); }
-  double minor() const { return std::sqrt(0.5 * (xx + yy) - std::sqrt(0.25 * (xx - yy) * (xx - yy) + xy * xy)); }
-};
-
-Spot spot_in(const Image& img, int x0, int y0, int size) {
-  Spot s;
-  for (int y = y0; y < y0 + size; ++y) {
-    for (int x = x0; x < x0 + size; ++x) {
-      const double v = img.at(x, y, 1);
-      s.light += v;
-      s.x += v * (x + 0.5);
-      s.y += v * (y + 0.5);
-    }
-  }
-  s.x /= s.light;
-  s.y /= s.light;
-  for (int y = y0; y < y0 + size; ++y) {
-    for (int x = x0; x < x0 + size; ++x) {
-      const double v = img.at(x, y, 1), dx = x + 0.5 - s.x, dy = y + 0.5 - s.y;
-      s.xx += v * dx * dx;
-      s.yy += v * dy * dy;
-      s.xy += v * dx * dy;
-    }
-  }
-  s.xx /= s.light;
-  s.yy /= s.light;
-  s.xy /= s.light;
-  return s;
-}
-
-}  // namespace
 
 TEST_CASE("A defocused highlight through a lens whose clear apertures clip its beam has the ground truth's cat's eye, through the exact model",
           "[scene][bokeh]") {
@@ -100,10 +64,12 @@ TEST_CASE("A defocused highlight through a lens whose clear apertures clip its b
   constexpr int kWindow = 24;
   for (const PixelPoint& p : places) {
     // The window around the truth's spot (the lens's distortion moves it from the pinhole's place).
-    const Spot around = spot_in(truth.rgb, static_cast<int>(p.x) - kWindow / 2, static_cast<int>(p.y) - kWindow / 2, kWindow);
+    const testing::SpotMoments around =
+        testing::spot_moments(truth.rgb, 1, static_cast<int>(p.x) - kWindow / 2, static_cast<int>(p.y) - kWindow / 2, kWindow, kWindow);
     const int x0 = static_cast<int>(std::lround(around.x)) - kWindow / 2, y0 = static_cast<int>(std::lround(around.y)) - kWindow / 2;
     REQUIRE((x0 >= 0 && y0 >= 0 && x0 + kWindow <= w && y0 + kWindow <= h));
-    const Spot t = spot_in(truth.rgb, x0, y0, kWindow), m = spot_in(out, x0, y0, kWindow);
+    const testing::SpotMoments t = testing::spot_moments(truth.rgb, 1, x0, y0, kWindow, kWindow);
+    const testing::SpotMoments m = testing::spot_moments(out, 1, x0, y0, kWindow, kWindow);
     INFO("at (" << p.x << ", " << p.y << "): light " << m.light << " against the truth's " << t.light << ", centroid (" << m.x << ", "
                 << m.y << ") against (" << t.x << ", " << t.y << "), extent " << m.major() << " x " << m.minor() << " px against "
                 << t.major() << " x " << t.minor());
