@@ -64,12 +64,14 @@ auto bench_model(RayModelKind kind) {
   return make_ray_model(kind, camera, mo);
 }
 
-void run(benchmark::State& state, RayModelKind kind) {
+// `light_images` false: the exact and poly models' footprints as their mesh triangles (for comparison).
+void run_with(benchmark::State& state, RayModelKind kind, bool light_images) {
   const double blur = static_cast<double>(state.range(0));
   const BenchScene scene = make_scene(blur);
   const auto model = bench_model(kind);
   BokehOptions options;
   options.threads = static_cast<int>(state.range(1));
+  options.light_images = light_images;
   BokehStatistics stats;
   for (auto _ : state) {
     Image out = render_bokeh(scene.image, scene.depth, *model, Aperture::circular(), options, &stats);
@@ -82,7 +84,11 @@ void run(benchmark::State& state, RayModelKind kind) {
   state.counters["footprints/px"] = static_cast<double>(stats.footprints) / pixels;
   state.counters["triangles/px"] = static_cast<double>(stats.triangles) / pixels;
   state.counters["reused/px"] = static_cast<double>(stats.reused_shapes) / pixels;
+  state.counters["light_images"] = static_cast<double>(stats.light_images);
 }
+
+void run(benchmark::State& state, RayModelKind kind) { run_with(state, kind, true); }
+void run_meshes(benchmark::State& state, RayModelKind kind) { run_with(state, kind, false); }
 
 // Yu et al.'s light-field synthesis on the same scene (36 views, their default): its cost is the
 // views' warps, which the blur should not change (their table 1 scales with the views alone).
@@ -171,9 +177,13 @@ BENCHMARK_CAPTURE(run, thin, RayModelKind::Thin)->Apply(args);
 BENCHMARK_CAPTURE(run, paraxial, RayModelKind::Paraxial)->Apply(args);
 BENCHMARK_CAPTURE(run, seidel, RayModelKind::Seidel)->Apply(args);
 // The models that aim every ray (poly: on the fit, made in the run before timing; exact: through the
-// prescription) take minutes a frame here: one blur, 2 threads, one run each.
+// prescription), drawn from light images, take seconds a frame here: one blur, 2 threads, one run each.
 BENCHMARK_CAPTURE(run, poly, RayModelKind::Poly)->Apply(aimed_args);
 BENCHMARK_CAPTURE(run, exact, RayModelKind::Exact)->Apply(aimed_args);
+// The same two models with every footprint's mesh triangles deposited (BokehOptions::light_images
+// off): what they took before light images, about ten times as long.
+BENCHMARK_CAPTURE(run_meshes, poly, RayModelKind::Poly)->Apply(aimed_args);
+BENCHMARK_CAPTURE(run_meshes, exact, RayModelKind::Exact)->Apply(aimed_args);
 BENCHMARK_CAPTURE(run_lightfield, thin, RayModelKind::Thin)->Apply(lightfield_args);
 BENCHMARK_CAPTURE(run_lightfield, seidel, RayModelKind::Seidel)->Apply(lightfield_args);
 BENCHMARK_CAPTURE(run_ewa, thin, RayModelKind::Thin)->Apply(ewa_args);

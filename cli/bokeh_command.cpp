@@ -815,6 +815,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
        << " aperture\n  " << stats.layers << " depth layers " << format_rounded(stats.layer_spacing_px, 3) << " px apart, largest blur "
        << format_rounded(stats.max_abs_coc_px, 3) << " px; " << stats.footprints << " footprints";
   if (stats.triangles > 0) what << " (" << stats.triangles << " triangles)";
+  if (stats.light_images > 0) what << ", drawn from " << stats.light_images << " light images";
   if (stats.reused_shapes > 0) what << ", " << stats.reused_shapes << " drawn from a neighbour's mapped shape";
   if (layered) {
     what << "; layered input: " << stats.deep_samples << " deep samples";

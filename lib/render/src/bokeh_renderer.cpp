@@ -125,6 +125,9 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   std::vector<std::size_t> range_begin;  // of the plan ranges of a layer
   render_detail::MergeScratch merge_scratch;
   render_detail::HiddenScratch hidden_scratch;
+  // Each thread's scratch space, kept from layer to layer (its caches of the table's nodes and light
+  // images among it).
+  std::vector<FootprintScratch> scratches(static_cast<std::size_t>(threads));
 
   for (int l = 0; l < layers.count; ++l) {
     const auto u = static_cast<std::size_t>(l);
@@ -147,7 +150,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
     const std::size_t ranges = range_begin.size() - 1;
 #pragma omp parallel num_threads(threads)
     {
-      FootprintScratch scratch;
+      FootprintScratch& scratch = scratches[static_cast<std::size_t>(omp_get_thread_num())];
 #pragma omp for schedule(dynamic, 1)
       for (std::size_t r = 0; r < ranges; ++r) {
         const std::size_t begin = range_begin[r], end = range_begin[r + 1];
@@ -161,7 +164,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
     // layer over the result so far.
 #pragma omp parallel num_threads(threads)
     {
-      FootprintScratch scratch;
+      FootprintScratch& scratch = scratches[static_cast<std::size_t>(omp_get_thread_num())];
       std::size_t local_footprints = 0, local_triangles = 0, local_reused = 0;
 #pragma omp for schedule(dynamic, 1)
       for (int b = 0; b < bands; ++b) {
@@ -222,6 +225,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   }
   stats.footprints = footprints;
   stats.triangles = triangles;
+  stats.light_images = scatter.light_images();
   stats.reused_shapes = reused;
   stats.unaimed_rays = model.unaimed_rays() - unaimed_before;
   // The lens's image circle, where some pixel is left uncovered (a fisheye's frame corners).

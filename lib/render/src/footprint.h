@@ -15,7 +15,10 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <shared_mutex>
 #include <span>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "lensmith/camera/ray_model.h"
@@ -56,6 +59,8 @@ struct FootprintPlan {
   // Every plan whose chief ray passes has the first two (where a mesh footprint's shape is anchored
   // when a neighbour draws it: FootprintShape) and the weight.
   bool mapped = false;
+  // Drawn from the table's light images (FootprintScatter::deposit_light_images), at full resolution.
+  bool images = false;
   std::array<float, 6> affine_px{};
   float centre_weight = 1.0f;
   // The layer index of the source whose mapped shape this footprint draws, moved to its own chief
@@ -124,6 +129,23 @@ struct FootprintShape {
   void add(std::span<const Point2f> vertices, const std::array<float, 4>& unit_value, int subrows);
 };
 
+// A footprint's light at a MappedPupilTable node (FootprintScatter::light_image): its mesh deposited
+// as the renderer deposits it, at azimuth 0, filtered by the splat buffer's tent and sampled every
+// cell_px; positions are output px from the node's chief ray.
+struct LightImage {
+  bool ok = false;  // false: the node's beam passes no light, or its chief ray is lost
+  double extent_px = 0.0;  // the larger side of the mesh's passing part
+  // A footprint this wide or more (px) is kept as samples of its light filtered by the tent (drawn
+  // turned by SplatBuffer::add_image); a smaller one as the light of its cells, each drawn as a
+  // point (the tent stays the output pixels': turning a filtered point would turn the tent too).
+  bool dense = false;
+  int nx = 0, ny = 0;
+  float origin_x = 0.0f, origin_y = 0.0f;  // sample (0, 0)
+  float cell_px = 0.5f;
+  std::vector<float> samples;  // row-major, per unit of light: their sum times cell_px^2 is 1
+  std::vector<std::array<float, 3>> points;  // x, y (px from the chief ray) and light, per unit of light
+};
+
 // Per-thread scratch space, so planning and deposits allocate nothing once warm.
 struct FootprintScratch {
   std::vector<PupilPoint> pupil;
@@ -172,6 +194,21 @@ struct FootprintScratch {
   void forget_shape() { shape.valid = false; }
   // The mapped-pupil table's nodes this thread used last (FootprintScatter's table, where it has one).
   MappedPupilTable::Cache table_cache;
+  // The light images this thread used last, and the scratch space it makes new ones in.
+  struct LightImageSlot {
+    std::uint64_t key = ~std::uint64_t{0};
+    double wavelength_nm = 0.0;
+    const LightImage* image = nullptr;
+  };
+  std::vector<LightImageSlot> light_images;
+  std::unique_ptr<FootprintScratch> image_scratch;
+  // One footprint's light images to draw (deposit_light_images).
+  struct ImageDraw {
+    const LightImage* image = nullptr;
+    Point2f anchor;
+    std::array<float, 4> value{};
+  };
+  std::vector<ImageDraw> image_draws;
 };
 
 // The plan of source `from` moved to source `to`'s pixel (where its chief ray lands, the rows it
@@ -198,6 +235,8 @@ class FootprintScatter {
   FootprintScatter(const RayModel& model, const Aperture& aperture, const SpectralGroups& groups,
                    const PupilMeshTable& meshes, const ImageAreaTable& areas, const IlluminationTable& illumination,
                    const BokehOptions& options);
+  // Light images made (BokehStatistics::light_images).
+  std::size_t light_images() const;
 
   // One source's plan; its probe is written to `*probe` where given.
   FootprintPlan plan(const ScatterSource& s, FootprintScratch& scratch, FootprintProbe* probe = nullptr) const;
@@ -257,6 +296,21 @@ class FootprintScatter {
   // or basis set), from the table where the render has one.
   void map_set(const ScenePoint& point, double wavelength_nm, int set, std::span<const PupilPoint> pupil, std::span<SensorHit> hits,
                FootprintScratch& scratch) const;
+  // Where a point draws its light images from: the table's nearest node in field radius, and the
+  // nearest of kLightImageDepthSteps steps between its nodes in inverse depth (`depth_step`).
+  struct ImagePlace {
+    std::int64_t field_index = 0, depth_step = 0;
+    double cos_azimuth = 1.0, sin_azimuth = 0.0;
+  };
+  ImagePlace image_place(const ScenePoint& point) const;
+  // The light image of mesh `mesh` at a place and wavelength, made on first use (thread-safe).
+  const LightImage& light_image(int mesh, std::int64_t field_index, std::int64_t depth_step, double wavelength_nm,
+                                FootprintScratch& scratch) const;
+  LightImage make_light_image(int mesh, const ScenePoint& node, double wavelength_nm, FootprintScratch& scratch) const;
+  // A mesh footprint of the table's models drawn from light images (one per wavelength group, from
+  // its image_place, turned to its azimuth and placed at its chief ray); false, drawing nothing,
+  // where an image is missing (its mesh is drawn instead).
+  bool deposit_light_images(const ScatterSource& s, const FootprintPlan& p, SplatBuffer& buffer, FootprintScratch& scratch) const;
   // The clipped rings (clip_rings) mapped at one wavelength: scratch.hits, points, ring_spans, ring_weights.
   void map_clipped_rings(const ScenePoint& point, double wavelength_nm, const FootprintPlan& p, FootprintScratch& scratch,
                          bool keep = false) const;
@@ -289,6 +343,14 @@ class FootprintScatter {
   const IlluminationTable& illumination_;
   // The exact and poly models' maps interpolated over field and depth (BokehOptions::interpolated_rays).
   std::unique_ptr<MappedPupilTable> table_;
+  // Light images by (mesh, node, wavelength), and the output pixels per sensor mm (Camera::output_pixel's
+  // linear part, row-major), which turn an image to a point's azimuth.
+  struct ImageKeyHash {
+    std::size_t operator()(const std::pair<std::uint64_t, double>& k) const;
+  };
+  mutable std::shared_mutex images_mutex_;
+  mutable std::unordered_map<std::pair<std::uint64_t, double>, std::unique_ptr<LightImage>, ImageKeyHash> images_;
+  std::array<double, 4> px_per_mm_{};
 };
 
 }  // namespace lensmith::render_detail

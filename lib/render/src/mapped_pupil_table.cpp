@@ -21,8 +21,10 @@ constexpr std::uint8_t kLost = 0, kLands = 1;
 // A thread's cache of nodes, by a hash of key and wavelength (its top kCacheBits bits). A footprint
 // looks up four nodes for each of its sets (mesh, probe, light) at each of its wavelength groups'
 // wavelengths: with 64 slots the exact model's render of the 480 x 270 bench scene spent 5.5 % of
-// its time in the table's lock (perf), with 1024 (24 KiB a thread) 2.2 %.
-constexpr int kCacheBits = 10;
+// its time in the table's lock (perf), with 1024 (24 KiB a thread) 2.2 %; at 1080p, drawn from
+// light images (the render's other costs gone), 10 % with 1024 (with the images' cache), none
+// found with 16384 (384 KiB a thread, kept from layer to layer).
+constexpr int kCacheBits = 14;
 constexpr std::size_t kCacheSlots = std::size_t{1} << kCacheBits;
 
 std::uint64_t pack_key(int set, std::int64_t field_index, std::int64_t depth_index) {
@@ -95,7 +97,7 @@ const MappedPupilTable::Node& MappedPupilTable::node(int set, double wavelength_
     // Mapped outside the lock (another thread may map the same node meanwhile; the first kept wins).
     auto made = std::make_unique<Node>();
     std::vector<SensorHit> hits(pupil.size());
-    const ScenePoint point{static_cast<double>(field_index) * field_step_, 0.0, static_cast<double>(depth_index) * depth_step_};
+    const ScenePoint point = point_at(static_cast<double>(field_index), static_cast<double>(depth_index));
     model_.map(point, wavelength_nm, pupil, hits);
     if (fine != nullptr) {
       // The light that passes: each triangle's pupil share where its interpolated clearance is >= 0,
@@ -140,6 +142,11 @@ MappedPupilTable::Cell MappedPupilTable::cell(const ScenePoint& point) const {
   cell.i = static_cast<std::int64_t>(i0);
   cell.j = static_cast<std::int64_t>(j0);
   return cell;
+}
+
+MappedPupilTable::Place MappedPupilTable::place(const ScenePoint& point) const {
+  const Cell q = cell(point);
+  return {q.a < 0.5 ? q.i : q.i + 1, static_cast<double>(q.j) + q.b, q.cos_azimuth, q.sin_azimuth};
 }
 
 double MappedPupilTable::passing_light(const ScenePoint& point, double wavelength_nm, const PupilMesh& fine, Cache& cache) const {

@@ -87,6 +87,19 @@ class MappedPupilTable {
   // mesh turns with the point (a white wall's corners 0.302 where the ground truth has 0.294).
   double passing_light(const ScenePoint& point, double wavelength_nm, const PupilMesh& fine, Cache& cache) const;
 
+  // Where a point lies among the nodes: the nearest node in field radius, its inverse depth in
+  // units of the nodes' step, and its azimuth (a node lies on the x axis; the point's hits are the
+  // node's turned by the azimuth). For the light images, drawn from the nearest of finer depth steps
+  // rather than interpolated (FootprintScatter::deposit_light_images).
+  struct Place {
+    std::int64_t field_index = 0;
+    double depth_index = 0.0;
+    double cos_azimuth = 1.0, sin_azimuth = 0.0;
+  };
+  Place place(const ScenePoint& point) const;
+  // The scene point on the x axis at a field and depth index (whole at the nodes).
+  ScenePoint point_at(double field_index, double depth_index) const { return {field_index * field_step_, 0.0, depth_index * depth_step_}; }
+
  private:
   // The node of `set` (pupil points `pupil`; for kLightSet the points of `fine`, reduced to its light).
   const Node& node(int set, double wavelength_nm, std::int64_t field_index, std::int64_t depth_index, std::span<const PupilPoint> pupil,

@@ -4,12 +4,16 @@
 #include "lensmith/render/splat_buffer.h"
 
 #include <algorithm>
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <sstream>
 
 #include "lensmith/core/errors.h"
+#include "lensmith/core/units.h"
 #include "lensmith/render/image.h"
 
 namespace lensmith {
@@ -181,11 +185,13 @@ void SplatBuffer::reset(int row_begin, int row_end) {
   if (row_end == row_begin) grid_row_end_ = grid_row_begin_;
   // assign keeps the capacity: a buffer reused band after band allocates (and faults in) once.
   diff_.assign(static_cast<std::size_t>(grid_width_) * static_cast<std::size_t>(grid_row_end_ - grid_row_begin_) * kChannels, 0.0);
+  dense_used_ = false;
   skipped_ = 0;
 }
 
 void SplatBuffer::clear() {
   std::fill(diff_.begin(), diff_.end(), 0.0);
+  dense_used_ = false;
   skipped_ = 0;
 }
 
@@ -656,6 +662,181 @@ void SplatBuffer::add_stamp(const DifferenceStamp& stamp, int anchor_x, int anch
   }
 }
 
+namespace {
+
+// add_image's samples along a row: `count` pixels from image position (u0, v0) (in samples) in
+// steps of (du, dv), bilinear, clamped to the image; writes up to kImageRowPadding past `count`.
+constexpr std::size_t kImageRowPadding = 8;
+
+
+void sample_image_row_scalar(const float* data, int nx, int ny, float u0, float v0, float du, float dv, std::size_t count, float* out) {
+  const auto um = static_cast<float>(nx - 1), vm = static_cast<float>(ny - 1);
+  for (std::size_t k = 0; k < count; ++k) {
+    const auto t = static_cast<float>(k);
+    const float u = std::min(std::max(u0 + du * t, 0.0f), um), w = std::min(std::max(v0 + dv * t, 0.0f), vm);
+    const int iu = std::min(static_cast<int>(u), nx - 2), iv = std::min(static_cast<int>(w), ny - 2);
+    const float fu = u - static_cast<float>(iu), fv = w - static_cast<float>(iv);
+    const float* s = data + static_cast<std::ptrdiff_t>(iv) * nx + iu;
+    const float top = s[0] + fu * (s[1] - s[0]), bottom = s[nx] + fu * (s[nx + 1] - s[nx]);
+    out[k] = top + fv * (bottom - top);
+  }
+}
+
+#if defined(__GNUC__) && defined(__x86_64__)
+// Eight pixels at a time with AVX2's gathers (the compiler does not vectorise the scalar loop).
+__attribute__((target("avx2,fma"))) void sample_image_row_avx2(const float* data, int nx, int ny, float u0, float v0, float du, float dv,
+                                                               std::size_t count, float* out) {
+  const __m256 zero = _mm256_setzero_ps();
+  const __m256 um = _mm256_set1_ps(static_cast<float>(nx - 1)), vm = _mm256_set1_ps(static_cast<float>(ny - 1));
+  const __m256i last_u = _mm256_set1_epi32(nx - 2), last_v = _mm256_set1_epi32(ny - 2), width = _mm256_set1_epi32(nx);
+  const __m256 step_u = _mm256_set1_ps(du), step_v = _mm256_set1_ps(dv);
+  __m256 t = _mm256_setr_ps(0.0f, 1.0f, 2.0f, 3.0f, 4.0f, 5.0f, 6.0f, 7.0f);
+  const __m256 eight = _mm256_set1_ps(8.0f);
+  const __m256 start_u = _mm256_set1_ps(u0), start_v = _mm256_set1_ps(v0);
+  for (std::size_t k = 0; k < count; k += 8) {
+    const __m256 u = _mm256_min_ps(_mm256_max_ps(_mm256_fmadd_ps(step_u, t, start_u), zero), um);
+    const __m256 w = _mm256_min_ps(_mm256_max_ps(_mm256_fmadd_ps(step_v, t, start_v), zero), vm);
+    const __m256i iu = _mm256_min_epi32(_mm256_cvttps_epi32(u), last_u), iv = _mm256_min_epi32(_mm256_cvttps_epi32(w), last_v);
+    const __m256 fu = _mm256_sub_ps(u, _mm256_cvtepi32_ps(iu)), fv = _mm256_sub_ps(w, _mm256_cvtepi32_ps(iv));
+    const __m256i at = _mm256_add_epi32(_mm256_mullo_epi32(iv, width), iu);
+    const __m256 s00 = _mm256_i32gather_ps(data, at, 4), s01 = _mm256_i32gather_ps(data + 1, at, 4);
+    const __m256 s10 = _mm256_i32gather_ps(data + nx, at, 4), s11 = _mm256_i32gather_ps(data + nx + 1, at, 4);
+    const __m256 top = _mm256_fmadd_ps(fu, _mm256_sub_ps(s01, s00), s00), bottom = _mm256_fmadd_ps(fu, _mm256_sub_ps(s11, s10), s10);
+    _mm256_storeu_ps(out + k, _mm256_fmadd_ps(fv, _mm256_sub_ps(bottom, top), top));
+    t = _mm256_add_ps(t, eight);
+  }
+}
+#endif
+
+void sample_image_row(const float* data, int nx, int ny, float u0, float v0, float du, float dv, std::size_t count, float* out) {
+#if defined(__GNUC__) && defined(__x86_64__)
+  static const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  if (avx2) {
+    sample_image_row_avx2(data, nx, ny, u0, v0, du, dv, count, out);
+    return;
+  }
+#endif
+  sample_image_row_scalar(data, nx, ny, u0, v0, du, dv, count, out);
+}
+
+}  // namespace
+
+void SplatBuffer::use_dense() {
+  if (dense_used_) return;
+  dense_.resize(static_cast<std::size_t>(row_end_ - row_begin_) * static_cast<std::size_t>(width_) * kChannels);
+  std::fill(dense_.begin(), dense_.end(), 0.0f);
+  dense_used_ = true;
+}
+
+void SplatBuffer::add_points(std::span<const std::array<float, 3>> points, const std::array<float, 4>& from_image, Point2f anchor,
+                             const std::array<float, 4>& value) {
+  if (options_.downsample != 1) throw OptionsError("SplatBuffer::add_points: " + to_string() + " is not at full resolution");
+  const bool finite_map = std::isfinite(anchor.x) && std::isfinite(anchor.y) &&
+                          std::all_of(from_image.begin(), from_image.end(), [](float m) { return std::isfinite(m); });
+  if (!finite_value(value) || !finite_map) {
+    ++skipped_;
+    return;
+  }
+  use_dense();
+  // Bilinear weights over the 2 x 2 pixels whose centres surround each point, as add_point's.
+  const std::size_t row_size = static_cast<std::size_t>(width_) * kChannels;
+  for (const auto& [x, y, weight] : points) {
+    const float px = anchor.x + from_image[0] * x + from_image[1] * y - 0.5f;
+    const float py = anchor.y + from_image[2] * x + from_image[3] * y - 0.5f;
+    if (!(py > static_cast<float>(row_begin_) - 1.0f && py < static_cast<float>(row_end_)) || !(px > -1.0f && px < static_cast<float>(width_))) continue;
+    const float x0 = std::floor(px), y0 = std::floor(py);
+    const float fx = px - x0, fy = py - y0;
+    const int i0 = static_cast<int>(x0), j0 = static_cast<int>(y0);
+    const float wx[2] = {1.0f - fx, fx}, wy[2] = {1.0f - fy, fy};
+    for (int r = 0; r < 2; ++r) {
+      const int row = j0 + r;
+      if (row < row_begin_ || row >= row_end_) continue;
+      float* line = dense_.data() + static_cast<std::size_t>(row - row_begin_) * row_size;
+      for (int k = 0; k < 2; ++k) {
+        const int col = i0 + k;
+        if (col < 0 || col >= width_) continue;
+        const float w = weight * wy[r] * wx[k];
+        float* e = line + static_cast<std::size_t>(col) * kChannels;
+        for (int c = 0; c < kChannels; ++c) e[c] += w * value[static_cast<std::size_t>(c)];
+      }
+    }
+  }
+}
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+__attribute__((target_clones("arch=x86-64-v3", "default")))
+#endif
+void SplatBuffer::add_image(std::span<const float> samples, int nx, int ny, float origin_x, float origin_y, float cell_px,
+                            const std::array<float, 4>& to_image, Point2f anchor, const std::array<float, 4>& value) {
+  if (options_.downsample != 1) throw OptionsError("SplatBuffer::add_image: " + to_string() + " is not at full resolution");
+  if (nx < 2 || ny < 2 || samples.size() < static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny)) {
+    throw OptionsError("SplatBuffer::add_image: " + std::to_string(samples.size()) + " samples for a " + std::to_string(nx) + " x " +
+                       std::to_string(ny) + " image (at least 2 x 2)");
+  }
+  const bool finite_map = std::isfinite(origin_x) && std::isfinite(origin_y) && std::isfinite(anchor.x) && std::isfinite(anchor.y) &&
+                          std::all_of(to_image.begin(), to_image.end(), [](float m) { return std::isfinite(m); });
+  if (!finite_value(value) || !finite_map || !(cell_px > 0.0f)) {
+    ++skipped_;
+    return;
+  }
+  // In sample units: (u, v) = A (q - anchor) / cell - origin / cell, A = to_image.
+  const double inv_cell = 1.0 / cell_px;
+  const double a00 = to_image[0] * inv_cell, a01 = to_image[1] * inv_cell, a10 = to_image[2] * inv_cell, a11 = to_image[3] * inv_cell;
+  const double u_at_anchor = -origin_x * inv_cell, v_at_anchor = -origin_y * inv_cell;
+  // The output rectangle around the samples' parallelogram (A's inverse applied to its corners).
+  const double det = a00 * a11 - a01 * a10;
+  if (!(std::abs(det) > 0.0)) {
+    ++skipped_;
+    return;
+  }
+  const double um = static_cast<double>(nx - 1), vm = static_cast<double>(ny - 1);
+  double y_lo = kInfinity, y_hi = -kInfinity;
+  for (const auto& [cu, cv] : {std::pair{0.0, 0.0}, std::pair{um, 0.0}, std::pair{0.0, vm}, std::pair{um, vm}}) {
+    const double du = cu - u_at_anchor, dv = cv - v_at_anchor;
+    const double qy = (-a10 * du + a00 * dv) / det + anchor.y;
+    y_lo = std::min(y_lo, qy);
+    y_hi = std::max(y_hi, qy);
+  }
+  const int row_first = std::max(row_begin_, static_cast<int>(std::ceil(y_lo - 0.5)));
+  const int row_last = std::min(row_end_ - 1, static_cast<int>(std::floor(y_hi - 0.5)));
+  const float vf[kChannels] = {value[0], value[1], value[2], value[3]};
+  const float* data = samples.data();
+  use_dense();
+  const double inverse_a00 = a00 != 0.0 ? 1.0 / a00 : 0.0, inverse_a10 = a10 != 0.0 ? 1.0 / a10 : 0.0;
+  for (int row = row_first; row <= row_last; ++row) {
+    // Along the row's centre line: u = u0 + a00 x, v = v0 + a10 x at x = pixel centre - anchor.x.
+    const double dy = row + 0.5 - anchor.y;
+    const double u0 = u_at_anchor + a01 * dy, v0 = v_at_anchor + a11 * dy;
+    // The pixels whose centres fall inside [0, um] x [0, vm].
+    double x_lo = -kInfinity, x_hi = kInfinity;
+    auto keep_within = [&](double start, double slope, double inverse_slope, double top) {
+      if (slope == 0.0) {
+        if (start < 0.0 || start > top) x_lo = kInfinity;
+        return;
+      }
+      const double t0 = -start * inverse_slope, t1 = (top - start) * inverse_slope;
+      x_lo = std::max(x_lo, std::min(t0, t1));
+      x_hi = std::min(x_hi, std::max(t0, t1));
+    };
+    keep_within(u0, a00, inverse_a00, um);
+    keep_within(v0, a10, inverse_a10, vm);
+    if (!(x_lo <= x_hi)) continue;
+    const int x_first = std::max(0, static_cast<int>(std::ceil(x_lo + anchor.x - 0.5)));
+    const int x_last = std::min(width_ - 1, static_cast<int>(std::floor(x_hi + anchor.x - 0.5)));
+    if (x_first > x_last) continue;
+    // The row's samples (a loop of gathers), then added to its pixels (a vector of four channels each).
+    const auto count = static_cast<std::size_t>(x_last - x_first + 1);
+    if (image_row_.size() < count + kImageRowPadding) image_row_.resize(count + kImageRowPadding);
+    float* row_samples = image_row_.data();
+    const auto fu0 = static_cast<float>(u0 + a00 * (x_first + 0.5 - anchor.x)), fv0 = static_cast<float>(v0 + a10 * (x_first + 0.5 - anchor.x));
+    sample_image_row(data, nx, ny, fu0, fv0, static_cast<float>(a00), static_cast<float>(a10), count, row_samples);
+    float* out = dense_.data() + (static_cast<std::size_t>(row - row_begin_) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x_first)) * kChannels;
+    for (std::size_t k = 0; k < count; ++k) {
+      for (int c = 0; c < kChannels; ++c) out[k * kChannels + static_cast<std::size_t>(c)] += row_samples[k] * vf[c];
+    }
+  }
+}
+
 void SplatBuffer::resolve_into(float* rgba_full_image) const {
   const std::size_t grid_row_size = static_cast<std::size_t>(grid_width_) * kChannels;
   if (options_.downsample == 1) {
@@ -668,6 +849,10 @@ void SplatBuffer::resolve_into(float* rgba_full_image) const {
           sum[c] += d[i + c];
           out[i + c] += static_cast<float>(sum[c]);
         }
+      }
+      if (dense_used_) {
+        const float* e = dense_.data() + static_cast<std::size_t>(row - row_begin_) * grid_row_size;
+        for (std::size_t i = 0; i < grid_row_size; ++i) out[i] += e[i];
       }
     }
     return;

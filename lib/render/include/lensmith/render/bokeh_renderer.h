@@ -68,6 +68,10 @@ struct BokehOptions {
   // and 1 px of blur; docs/bokeh.md), not aimed and traced per pixel. false: every footprint's rays
   // from the model itself, much slower, for checking.
   bool interpolated_rays = true;
+  // true: with interpolated rays, a footprint is drawn from a light image of its table node (the
+  // node's mesh deposited once, filtered, and sampled turned to each pixel's azimuth; docs/bokeh.md,
+  // "Light images"). false: every footprint's mesh triangles deposited, slower, for checking.
+  bool light_images = true;
   // Called with the fraction done (0..1) after each band of rows of each layer, from the rendering
   // threads one at a time (never concurrently): it must not assume the calling thread.
   std::function<void(double)> progress;
@@ -84,6 +88,7 @@ struct BokehStatistics {
   std::size_t redepthed_edge_pixels = 0; // edge pixels whose colour is one surface's, moved to its depth
   std::size_t footprints = 0;       // (pixel, wavelength group) footprints deposited
   std::size_t triangles = 0;        // mesh triangles deposited (seidel, exact, masks)
+  std::size_t light_images = 0;     // light images made (exact, poly: BokehOptions::light_images)
   std::size_t reused_shapes = 0;    // mesh footprints drawn from a neighbour's mapped shape (BokehOptions::reuse_shapes)
   std::size_t clamped_depths = 0;   // pixels brought back to max_blur_px or in front of the lens
   double max_abs_coc_px = 0.0;      // largest |signed CoC| among the source pixels

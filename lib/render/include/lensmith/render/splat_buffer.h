@@ -137,6 +137,20 @@ class SplatBuffer {
   // add_polygon (entries left of the image fold into its first column, those right of it and
   // outside the band are dropped). Full-resolution buffers only (downsample 1: OptionsError).
   void add_stamp(const DifferenceStamp& stamp, int anchor_x, int anchor_y, const std::array<float, 4>& value);
+  // A tabulated light distribution turned and moved: `samples` (nx x ny, row-major) lie at
+  // (origin_x + a cell_px, origin_y + b cell_px) in the image's own frame (px), and the output pixel
+  // whose centre is q receives value times the bilinear interpolation of the samples at
+  // to_image * (q - anchor) (to_image a 2 x 2 matrix, row-major; 0 outside the samples). For light
+  // distributions already filtered by the buffer's tent, sampled finely enough for bilinear
+  // interpolation (FootprintScatter's light images). Full-resolution buffers only (OptionsError);
+  // non-finite input is skipped and counted. Costs O(output pixels covered).
+  void add_image(std::span<const float> samples, int nx, int ny, float origin_x, float origin_y, float cell_px,
+                 const std::array<float, 4>& to_image, Point2f anchor, const std::array<float, 4>& value);
+  // Points (x, y, weight) of a light distribution in its own frame (px), turned and moved as
+  // add_image's samples (output position anchor + from_image * (x, y), from_image row-major): each
+  // deposits value times its weight as add_point does. Full-resolution buffers only (OptionsError).
+  void add_points(std::span<const std::array<float, 3>> points, const std::array<float, 4>& from_image, Point2f anchor,
+                  const std::array<float, 4>& value);
   // The stamp of a polygon (px; its deposit at anchor (0, 0) is add_polygon's of `vertices`)
   // sampled at `subrows` sub-rows per pixel (SplatOptions::subrows' range). Empty (no entries) for
   // a polygon add_polygon would skip; a polygon with no area records as a point.
@@ -237,6 +251,12 @@ class SplatBuffer {
   std::vector<std::size_t> active_edges_;
   std::vector<double> crossings_;
   std::vector<SubrowSpan> spans_;
+  std::vector<float> image_row_;  // add_image: one row's samples
+  // add_image's deposits as values (not differences), added to the picture by resolve_into; sized
+  // and zeroed on a band's first add_image.
+  LargeVector<float> dense_;
+  bool dense_used_ = false;
+  void use_dense();
 };
 
 }  // namespace lensmith
