@@ -167,7 +167,7 @@ void args(benchmark::internal::Benchmark* b) {
 }
 
 void aimed_args(benchmark::internal::Benchmark* b) {
-  b->Args({16, 2});
+  for (const int blur : {4, 16, 128}) b->Args({blur, 2});
   b->ArgNames({"blur_px", "threads"})->Unit(benchmark::kSecond)->Iterations(1)->Repetitions(1)->UseRealTime();
 }
 

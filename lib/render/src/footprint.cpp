@@ -904,6 +904,21 @@ LightImage FootprintScatter::make_light_image(int mesh, const ScenePoint& node, 
   }
   image.nx = static_cast<int>(cw);
   image.ny = static_cast<int>(ch);
+  // The samples with light bounded along the diagonals too (the corners of a disc's square are
+  // empty), widened by 2 (a point interpolated from them lies within a cell of one along each axis).
+  double sum_lo = kInfinity, sum_hi = -kInfinity, difference_lo = kInfinity, difference_hi = -kInfinity;
+  for (std::size_t y = 0; y < ch; ++y) {
+    for (std::size_t x = 0; x < cw; ++x) {
+      if (!(image.samples[y * cw + x] > 0.0f)) continue;
+      const auto a = static_cast<double>(x), b = static_cast<double>(y);
+      sum_lo = std::min(sum_lo, a + b);
+      sum_hi = std::max(sum_hi, a + b);
+      difference_lo = std::min(difference_lo, a - b);
+      difference_hi = std::max(difference_hi, a - b);
+    }
+  }
+  image.diagonals = {static_cast<float>(sum_lo - 2.0), static_cast<float>(sum_hi + 2.0), static_cast<float>(difference_lo - 2.0),
+                     static_cast<float>(difference_hi + 2.0)};
   image.origin_x += static_cast<float>(static_cast<double>(x0) * cell);
   image.origin_y += static_cast<float>(static_cast<double>(y0) * cell);
   image.ok = true;
@@ -988,7 +1003,7 @@ bool FootprintScatter::deposit_light_images(const ScatterSource& s, const Footpr
   for (const FootprintScratch::ImageDraw& d : scratch.image_draws) {
     const LightImage& im = *d.image;
     if (im.dense) {
-      buffer.add_image(im.samples, im.nx, im.ny, im.origin_x, im.origin_y, im.cell_px, to_image, d.anchor, d.value);
+      buffer.add_image(im.samples, im.nx, im.ny, im.origin_x, im.origin_y, im.cell_px, to_image, d.anchor, d.value, im.diagonals);
       continue;
     }
     buffer.add_points(im.points, from_image, d.anchor, d.value);

@@ -143,6 +143,7 @@ struct LightImage {
   float origin_x = 0.0f, origin_y = 0.0f;  // sample (0, 0)
   float cell_px = 0.5f;
   std::vector<float> samples;  // row-major, per unit of light: their sum times cell_px^2 is 1
+  std::array<float, 4> diagonals{};  // bounds of the samples with light (SplatBuffer::add_image)
   std::vector<std::array<float, 3>> points;  // x, y (px from the chief ray) and light, per unit of light
 };
 

@@ -767,7 +767,8 @@ void SplatBuffer::add_points(std::span<const std::array<float, 3>> points, const
 __attribute__((target_clones("arch=x86-64-v3", "default")))
 #endif
 void SplatBuffer::add_image(std::span<const float> samples, int nx, int ny, float origin_x, float origin_y, float cell_px,
-                            const std::array<float, 4>& to_image, Point2f anchor, const std::array<float, 4>& value) {
+                            const std::array<float, 4>& to_image, Point2f anchor, const std::array<float, 4>& value,
+                            const std::array<float, 4>& diagonals) {
   if (options_.downsample != 1) throw OptionsError("SplatBuffer::add_image: " + to_string() + " is not at full resolution");
   if (nx < 2 || ny < 2 || samples.size() < static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny)) {
     throw OptionsError("SplatBuffer::add_image: " + std::to_string(samples.size()) + " samples for a " + std::to_string(nx) + " x " +
@@ -802,24 +803,29 @@ void SplatBuffer::add_image(std::span<const float> samples, int nx, int ny, floa
   const float vf[kChannels] = {value[0], value[1], value[2], value[3]};
   const float* data = samples.data();
   use_dense();
-  const double inverse_a00 = a00 != 0.0 ? 1.0 / a00 : 0.0, inverse_a10 = a10 != 0.0 ? 1.0 / a10 : 0.0;
+  const double sum_slope = a00 + a10, difference_slope = a00 - a10;
+  auto inverse = [](double slope) { return slope != 0.0 ? 1.0 / slope : 0.0; };
+  const double inverse_a00 = inverse(a00), inverse_a10 = inverse(a10), inverse_sum = inverse(sum_slope),
+               inverse_difference = inverse(difference_slope);
   for (int row = row_first; row <= row_last; ++row) {
     // Along the row's centre line: u = u0 + a00 x, v = v0 + a10 x at x = pixel centre - anchor.x.
     const double dy = row + 0.5 - anchor.y;
     const double u0 = u_at_anchor + a01 * dy, v0 = v_at_anchor + a11 * dy;
-    // The pixels whose centres fall inside [0, um] x [0, vm].
+    // The pixels whose centres fall inside [0, um] x [0, vm] and within the diagonal bounds.
     double x_lo = -kInfinity, x_hi = kInfinity;
-    auto keep_within = [&](double start, double slope, double inverse_slope, double top) {
+    auto keep_within = [&](double start, double slope, double inverse_slope, double bottom, double top) {
       if (slope == 0.0) {
-        if (start < 0.0 || start > top) x_lo = kInfinity;
+        if (start < bottom || start > top) x_lo = kInfinity;
         return;
       }
-      const double t0 = -start * inverse_slope, t1 = (top - start) * inverse_slope;
+      const double t0 = (bottom - start) * inverse_slope, t1 = (top - start) * inverse_slope;
       x_lo = std::max(x_lo, std::min(t0, t1));
       x_hi = std::min(x_hi, std::max(t0, t1));
     };
-    keep_within(u0, a00, inverse_a00, um);
-    keep_within(v0, a10, inverse_a10, vm);
+    keep_within(u0, a00, inverse_a00, 0.0, um);
+    keep_within(v0, a10, inverse_a10, 0.0, vm);
+    keep_within(u0 + v0, sum_slope, inverse_sum, diagonals[0], diagonals[1]);
+    keep_within(u0 - v0, difference_slope, inverse_difference, diagonals[2], diagonals[3]);
     if (!(x_lo <= x_hi)) continue;
     const int x_first = std::max(0, static_cast<int>(std::ceil(x_lo + anchor.x - 0.5)));
     const int x_last = std::min(width_ - 1, static_cast<int>(std::floor(x_hi + anchor.x - 0.5)));

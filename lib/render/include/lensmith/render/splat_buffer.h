@@ -7,6 +7,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 #include <cstddef>
 #include <cstdint>
 #include <ostream>
@@ -142,10 +143,15 @@ class SplatBuffer {
   // whose centre is q receives value times the bilinear interpolation of the samples at
   // to_image * (q - anchor) (to_image a 2 x 2 matrix, row-major; 0 outside the samples). For light
   // distributions already filtered by the buffer's tent, sampled finely enough for bilinear
-  // interpolation (FootprintScatter's light images). Full-resolution buffers only (OptionsError);
-  // non-finite input is skipped and counted. Costs O(output pixels covered).
+  // interpolation (FootprintScatter's light images). `diagonals` bound the samples with light (in
+  // samples: a + b within [0], [1] and a - b within [2], [3]), so that the image's empty corners are
+  // not drawn; the default bounds nothing. Full-resolution buffers only (OptionsError); non-finite
+  // input is skipped and counted. Costs O(output pixels covered).
   void add_image(std::span<const float> samples, int nx, int ny, float origin_x, float origin_y, float cell_px,
-                 const std::array<float, 4>& to_image, Point2f anchor, const std::array<float, 4>& value);
+                 const std::array<float, 4>& to_image, Point2f anchor, const std::array<float, 4>& value,
+                 const std::array<float, 4>& diagonals = kNoDiagonals);
+  static constexpr std::array<float, 4> kNoDiagonals{-std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity(),
+                                                    -std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity()};
   // Points (x, y, weight) of a light distribution in its own frame (px), turned and moved as
   // add_image's samples (output position anchor + from_image * (x, y), from_image row-major): each
   // deposits value times its weight as add_point does. Full-resolution buffers only (OptionsError).
