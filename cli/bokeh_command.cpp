@@ -760,6 +760,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   options.vignetting = !o.no_vignetting;
   options.reuse_shapes = !o.no_shape_reuse;
   options.interpolated_rays = !o.rays_per_pixel;
+  options.light_images = !o.mesh_footprints;
   options.spectral = !o.no_spectral;
   options.spectral_samples = o.spectral_samples;
   options.layer_spacing_px = o.layer_spacing_px;

@@ -491,6 +491,9 @@ int main(int argc, char** argv) {
   bokeh_scatter_only.push_back(bokeh_cmd->add_flag("--rays-per-pixel", bokeh.rays_per_pixel,
                       "exact, poly: aim and trace every pixel's footprint rays itself (much slower, for checking). By default a "
                       "rotationally symmetric lens's rays are interpolated from a table every 8 px of field and 1 px of blur"));
+  bokeh_scatter_only.push_back(bokeh_cmd->add_flag("--mesh-footprints", bokeh.mesh_footprints,
+                      "exact, poly: deposit every footprint's mesh triangles (about ten times slower, for checking). By default "
+                      "each footprint is drawn from a light image of its table node, turned to its azimuth"));
   bokeh_cmd->add_flag("--no-spectral", bokeh.no_spectral, "Trace every ray at 587.6 nm and keep RGB as it is (no colour fringes)");
   bokeh_cmd->add_option("--spectral-samples", bokeh.spectral_samples, "Wavelengths of the spectral quadrature (3-64, default 16)")
       ->check(range(3, 64));

@@ -68,7 +68,8 @@ constexpr double kEdgeKeptPx = 8.0;
 constexpr std::size_t kShapeStride = 8;
 constexpr double kShapeTolerancePx = 1.0 / 16.0;
 constexpr float kShapePassingTolerance = 0.004f;
-// Light images (FootprintScatter::make_light_image). Cells of 0.5 px, halved down to 0.125 px while
+// Light images (FootprintScatter::make_light_image). Cells of 0.5 px (of a grid cell at a coarse
+// level), halved down to 0.125 while
 // the footprint spans fewer than kLightImageCellsAcross of them: interpolating the samples blurs by
 // about a cell, which against the output's 1 px tent showed on small footprints (tests/render's
 // three-depth frame through the double Gauss against per-pixel rays: 41.2 dB at 0.5 px, 47.6 at
@@ -77,7 +78,7 @@ constexpr float kShapePassingTolerance = 0.004f;
 constexpr double kMaxLightImageCellPx = 0.5;
 constexpr double kMinLightImageCellPx = 0.125;
 constexpr double kLightImageCellsAcross = 64.0;
-constexpr int kMaxLightImageCells = 256;
+constexpr int kMaxLightImageCells = 512;
 constexpr double kDenseLightImagePx = 6.0;
 // Depth steps of the images per step of the table's nodes (1 px of blur): a footprint takes the
 // nearest image, whose size is then within 1/8 px of its own. Cross-fading the two images around it
@@ -783,7 +784,8 @@ std::size_t FootprintScatter::ImageKeyHash::operator()(const std::pair<std::uint
 // cells recorded as record_mesh records them, deposited into a buffer of cells (a fraction of a
 // pixel) around its chief ray, and kept per unit of light, as samples filtered by the output's tent
 // (dense) or as the cells' light (points).
-LightImage FootprintScatter::make_light_image(int mesh, const ScenePoint& node, double wavelength_nm, FootprintScratch& scratch) const {
+LightImage FootprintScatter::make_light_image(int mesh, const ScenePoint& node, double wavelength_nm, int level,
+                                              FootprintScratch& scratch) const {
   LightImage image;
   FootprintPlan q;
   q.mesh = mesh;
@@ -815,11 +817,12 @@ LightImage FootprintScatter::make_light_image(int mesh, const ScenePoint& node, 
   // output's tent (1 px beyond the mesh, for a dense image) or the cells' own (one cell).
   const double extent = std::max(x_max - x_min, y_max - y_min);
   image.extent_px = extent;
-  double cell = kMaxLightImageCellPx;
-  while (cell > kMinLightImageCellPx && extent < kLightImageCellsAcross * cell) cell *= 0.5;
+  const double grid_cell = 1 << level;
+  double cell = kMaxLightImageCellPx * grid_cell;
+  while (cell > kMinLightImageCellPx * grid_cell && extent < kLightImageCellsAcross * cell) cell *= 0.5;
   image.cell_px = static_cast<float>(cell);
-  image.dense = extent >= kDenseLightImagePx;
-  const double margin = image.dense ? 2.0 : 2.0 * cell;
+  image.dense = level > 0 || extent >= kDenseLightImagePx;
+  const double margin = image.dense ? 2.0 * grid_cell : 2.0 * cell;
   const double ox = -cell * (std::ceil((margin - x_min) / cell) + 0.5), oy = -cell * (std::ceil((margin - y_min) / cell) + 0.5);
   const int nx = static_cast<int>(std::ceil((x_max + margin - ox) / cell)) + 1;
   const int ny = static_cast<int>(std::ceil((y_max + margin - oy) / cell)) + 1;
@@ -854,11 +857,12 @@ LightImage FootprintScatter::make_light_image(int mesh, const ScenePoint& node, 
     image.ok = true;
     return image;
   }
-  // Each cell holds the light of a tent one cell wide around it; the output pixels' tent is that
-  // tent convolved, along each axis, with the triangle of weights (n - |k|) / n^2 at cell steps k
-  // (n cells a pixel), exactly: a box of 1 px is n boxes of one cell. Weighted (n - |k|) / n: the
-  // light an output pixel centred on the cell would receive.
-  const int n = static_cast<int>(std::lround(1.0 / cell));
+  // Each cell holds the light of a tent one cell wide around it; the output pixels' tent (the grid
+  // cells' at a coarse level) is that tent convolved, along each axis, with the triangle of weights
+  // (n - |k|) / n^2 at cell steps k (n cells a pixel or grid cell), exactly: a box of 1 px is n boxes
+  // of one cell. Weighted (n - |k|) / n: the light an output pixel (grid cell) centred on the cell
+  // would receive.
+  const int n = static_cast<int>(std::lround(grid_cell / cell));
   std::vector<double> along(w * h, 0.0);
   for (std::size_t y = 0; y < h; ++y) {
     for (std::size_t x = 0; x < w; ++x) {
@@ -926,9 +930,10 @@ LightImage FootprintScatter::make_light_image(int mesh, const ScenePoint& node, 
 }
 
 const LightImage& FootprintScatter::light_image(int mesh, std::int64_t field_index, std::int64_t depth_step, double wavelength_nm,
-                                                FootprintScratch& scratch) const {
-  // mesh < 2^16, field index < 2^20, depth step within +-2^27 (as the table's own keys).
-  const std::uint64_t key = (static_cast<std::uint64_t>(mesh) << 48) | (static_cast<std::uint64_t>(field_index) << 28) |
+                                                int level, FootprintScratch& scratch) const {
+  // mesh < 2^14 with the level (< 4), field index < 2^20, depth step within +-2^27 (as the table's own keys).
+  const std::uint64_t key = ((static_cast<std::uint64_t>(mesh) * 4 + static_cast<std::uint64_t>(level)) << 48) |
+                            (static_cast<std::uint64_t>(field_index) << 28) |
                             static_cast<std::uint64_t>(depth_step + (std::int64_t{1} << 27));
   if (scratch.light_images.empty()) scratch.light_images.resize(std::size_t{1} << kLightImageCacheBits);
   std::uint64_t bits = 0;
@@ -945,7 +950,7 @@ const LightImage& FootprintScatter::light_image(int mesh, std::int64_t field_ind
     // Made outside the lock (another thread may make the same image meanwhile; the first kept wins).
     if (!scratch.image_scratch) scratch.image_scratch = std::make_unique<FootprintScratch>();
     const ScenePoint at = table_->point_at(static_cast<double>(field_index), static_cast<double>(depth_step) / kLightImageDepthSteps);
-    auto made = std::make_unique<LightImage>(make_light_image(mesh, at, wavelength_nm, *scratch.image_scratch));
+    auto made = std::make_unique<LightImage>(make_light_image(mesh, at, wavelength_nm, level, *scratch.image_scratch));
     std::unique_lock lock(images_mutex_);
     auto [it, inserted] = images_.try_emplace(k, std::move(made));
     found = it->second.get();
@@ -976,7 +981,7 @@ bool FootprintScatter::deposit_light_images(const ScatterSource& s, const Footpr
   const PupilMesh& fine = meshes_.mesh(PupilMeshTable::light_mesh());
   scratch.image_draws.clear();
   auto add_group = [&](const SpectralGroup& g, float share) {
-    const LightImage& image = light_image(p.mesh, n.field_index, n.depth_step, g.wavelength_nm, scratch);
+    const LightImage& image = light_image(p.mesh, n.field_index, n.depth_step, g.wavelength_nm, p.level, scratch);
     if (!image.ok) return false;
     std::array<SensorHit, 1> chief{};
     map_set(point, g.wavelength_nm, MappedPupilTable::kCentreSet, kCentre, chief, scratch);
@@ -1196,14 +1201,16 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
   }
   p.discs = !scratch.discs.empty();
   if (table_ && options_.light_images && p.mesh >= 0 && !p.discs) {
-    // Drawn from light images where the beam's passing part (not its probe, whose stopped rays may
-    // land far out) is small enough for full resolution.
+    // Drawn from light images, at the grid level of the beam's passing part (not of its probe, whose
+    // stopped rays may land far out: an in-focus point's passing beam a few pixels across).
     const ImagePlace n = image_place(point);
-    const LightImage& image = light_image(p.mesh, n.field_index, n.depth_step, groups_.split(p.groups)[0].wavelength_nm, scratch);
-    if (image.ok && image.extent_px < kHalfResolutionPx) {
-      p.images = true;
-      p.level = 0;
+    const double wavelength_nm = groups_.split(p.groups)[0].wavelength_nm;
+    const LightImage* image = &light_image(p.mesh, n.field_index, n.depth_step, wavelength_nm, p.level, scratch);
+    if (image->ok && grid_level(image->extent_px) < p.level) {
+      p.level = grid_level(image->extent_px);
+      image = &light_image(p.mesh, n.field_index, n.depth_step, wavelength_nm, p.level, scratch);
     }
+    p.images = image->ok;
   }
   if (p.discs && aperture_.is_uniform_convex()) {
     const int own_step = p.mesh >= 0 ? PupilMeshTable::sector_step_of_mesh(p.mesh) : p.outline;

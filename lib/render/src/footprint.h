@@ -59,7 +59,7 @@ struct FootprintPlan {
   // Every plan whose chief ray passes has the first two (where a mesh footprint's shape is anchored
   // when a neighbour draws it: FootprintShape) and the weight.
   bool mapped = false;
-  // Drawn from the table's light images (FootprintScatter::deposit_light_images), at full resolution.
+  // Drawn from the table's light images (FootprintScatter::deposit_light_images) at `level`.
   bool images = false;
   std::array<float, 6> affine_px{};
   float centre_weight = 1.0f;
@@ -142,7 +142,7 @@ struct LightImage {
   int nx = 0, ny = 0;
   float origin_x = 0.0f, origin_y = 0.0f;  // sample (0, 0)
   float cell_px = 0.5f;
-  std::vector<float> samples;  // row-major, per unit of light: their sum times cell_px^2 is 1
+  std::vector<float> samples;  // row-major, per unit of light: their sum times (cell_px / grid cell)^2 is 1
   std::array<float, 4> diagonals{};  // bounds of the samples with light (SplatBuffer::add_image)
   std::vector<std::array<float, 3>> points;  // x, y (px from the chief ray) and light, per unit of light
 };
@@ -305,9 +305,10 @@ class FootprintScatter {
   };
   ImagePlace image_place(const ScenePoint& point) const;
   // The light image of mesh `mesh` at a place and wavelength, made on first use (thread-safe).
-  const LightImage& light_image(int mesh, std::int64_t field_index, std::int64_t depth_step, double wavelength_nm,
+  // `level`: the splat grid it is drawn into (FootprintPlan::level), whose cells' tent filters it.
+  const LightImage& light_image(int mesh, std::int64_t field_index, std::int64_t depth_step, double wavelength_nm, int level,
                                 FootprintScratch& scratch) const;
-  LightImage make_light_image(int mesh, const ScenePoint& node, double wavelength_nm, FootprintScratch& scratch) const;
+  LightImage make_light_image(int mesh, const ScenePoint& node, double wavelength_nm, int level, FootprintScratch& scratch) const;
   // A mesh footprint of the table's models drawn from light images (one per wavelength group, from
   // its image_place, turned to its azimuth and placed at its chief ray); false, drawing nothing,
   // where an image is missing (its mesh is drawn instead).

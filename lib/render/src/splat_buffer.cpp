@@ -723,14 +723,13 @@ void sample_image_row(const float* data, int nx, int ny, float u0, float v0, flo
 
 void SplatBuffer::use_dense() {
   if (dense_used_) return;
-  dense_.resize(static_cast<std::size_t>(row_end_ - row_begin_) * static_cast<std::size_t>(width_) * kChannels);
+  dense_.resize(diff_.size());
   std::fill(dense_.begin(), dense_.end(), 0.0f);
   dense_used_ = true;
 }
 
 void SplatBuffer::add_points(std::span<const std::array<float, 3>> points, const std::array<float, 4>& from_image, Point2f anchor,
                              const std::array<float, 4>& value) {
-  if (options_.downsample != 1) throw OptionsError("SplatBuffer::add_points: " + to_string() + " is not at full resolution");
   const bool finite_map = std::isfinite(anchor.x) && std::isfinite(anchor.y) &&
                           std::all_of(from_image.begin(), from_image.end(), [](float m) { return std::isfinite(m); });
   if (!finite_value(value) || !finite_map) {
@@ -738,23 +737,24 @@ void SplatBuffer::add_points(std::span<const std::array<float, 3>> points, const
     return;
   }
   use_dense();
-  // Bilinear weights over the 2 x 2 pixels whose centres surround each point, as add_point's.
-  const std::size_t row_size = static_cast<std::size_t>(width_) * kChannels;
+  // Bilinear weights over the 2 x 2 cells whose centres surround each point, as add_point's.
+  const std::size_t row_size = static_cast<std::size_t>(grid_width_) * kChannels;
+  const auto scale = static_cast<float>(scale_), offset = static_cast<float>(x_offset_);
   for (const auto& [x, y, weight] : points) {
-    const float px = anchor.x + from_image[0] * x + from_image[1] * y - 0.5f;
-    const float py = anchor.y + from_image[2] * x + from_image[3] * y - 0.5f;
-    if (!(py > static_cast<float>(row_begin_) - 1.0f && py < static_cast<float>(row_end_)) || !(px > -1.0f && px < static_cast<float>(width_))) continue;
+    const float px = (anchor.x + from_image[0] * x + from_image[1] * y) * scale + offset - 0.5f;
+    const float py = (anchor.y + from_image[2] * x + from_image[3] * y) * scale - 0.5f;
+    if (!(py > static_cast<float>(grid_row_begin_) - 1.0f && py < static_cast<float>(grid_row_end_)) || !(px > -1.0f && px < static_cast<float>(grid_width_))) continue;
     const float x0 = std::floor(px), y0 = std::floor(py);
     const float fx = px - x0, fy = py - y0;
     const int i0 = static_cast<int>(x0), j0 = static_cast<int>(y0);
     const float wx[2] = {1.0f - fx, fx}, wy[2] = {1.0f - fy, fy};
     for (int r = 0; r < 2; ++r) {
       const int row = j0 + r;
-      if (row < row_begin_ || row >= row_end_) continue;
-      float* line = dense_.data() + static_cast<std::size_t>(row - row_begin_) * row_size;
+      if (row < grid_row_begin_ || row >= grid_row_end_) continue;
+      float* line = dense_.data() + static_cast<std::size_t>(row - grid_row_begin_) * row_size;
       for (int k = 0; k < 2; ++k) {
         const int col = i0 + k;
-        if (col < 0 || col >= width_) continue;
+        if (col < 0 || col >= grid_width_) continue;
         const float w = weight * wy[r] * wx[k];
         float* e = line + static_cast<std::size_t>(col) * kChannels;
         for (int c = 0; c < kChannels; ++c) e[c] += w * value[static_cast<std::size_t>(c)];
@@ -769,7 +769,6 @@ __attribute__((target_clones("arch=x86-64-v3", "default")))
 void SplatBuffer::add_image(std::span<const float> samples, int nx, int ny, float origin_x, float origin_y, float cell_px,
                             const std::array<float, 4>& to_image, Point2f anchor, const std::array<float, 4>& value,
                             const std::array<float, 4>& diagonals) {
-  if (options_.downsample != 1) throw OptionsError("SplatBuffer::add_image: " + to_string() + " is not at full resolution");
   if (nx < 2 || ny < 2 || samples.size() < static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny)) {
     throw OptionsError("SplatBuffer::add_image: " + std::to_string(samples.size()) + " samples for a " + std::to_string(nx) + " x " +
                        std::to_string(ny) + " image (at least 2 x 2)");
@@ -798,8 +797,11 @@ void SplatBuffer::add_image(std::span<const float> samples, int nx, int ny, floa
     y_lo = std::min(y_lo, qy);
     y_hi = std::max(y_hi, qy);
   }
-  const int row_first = std::max(row_begin_, static_cast<int>(std::ceil(y_lo - 0.5)));
-  const int row_last = std::min(row_end_ - 1, static_cast<int>(std::floor(y_hi - 0.5)));
+  // Grid cells (output pixels at full resolution): cell (gx, gy) is centred at output
+  // ((gx + 0.5 - x_offset_) / scale_, (gy + 0.5) / scale_), one cell k = 1 / scale_ px across.
+  const int row_first = std::max(grid_row_begin_, static_cast<int>(std::ceil(y_lo * scale_ - 0.5)));
+  const int row_last = std::min(grid_row_end_ - 1, static_cast<int>(std::floor(y_hi * scale_ - 0.5)));
+  const double k_px = 1.0 / scale_;
   const float vf[kChannels] = {value[0], value[1], value[2], value[3]};
   const float* data = samples.data();
   use_dense();
@@ -808,8 +810,8 @@ void SplatBuffer::add_image(std::span<const float> samples, int nx, int ny, floa
   const double inverse_a00 = inverse(a00), inverse_a10 = inverse(a10), inverse_sum = inverse(sum_slope),
                inverse_difference = inverse(difference_slope);
   for (int row = row_first; row <= row_last; ++row) {
-    // Along the row's centre line: u = u0 + a00 x, v = v0 + a10 x at x = pixel centre - anchor.x.
-    const double dy = row + 0.5 - anchor.y;
+    // Along the row's centre line: u = u0 + a00 x, v = v0 + a10 x at x = cell centre - anchor.x.
+    const double dy = (row + 0.5) * k_px - anchor.y;
     const double u0 = u_at_anchor + a01 * dy, v0 = v_at_anchor + a11 * dy;
     // The pixels whose centres fall inside [0, um] x [0, vm] and within the diagonal bounds.
     double x_lo = -kInfinity, x_hi = kInfinity;
@@ -827,16 +829,17 @@ void SplatBuffer::add_image(std::span<const float> samples, int nx, int ny, floa
     keep_within(u0 + v0, sum_slope, inverse_sum, diagonals[0], diagonals[1]);
     keep_within(u0 - v0, difference_slope, inverse_difference, diagonals[2], diagonals[3]);
     if (!(x_lo <= x_hi)) continue;
-    const int x_first = std::max(0, static_cast<int>(std::ceil(x_lo + anchor.x - 0.5)));
-    const int x_last = std::min(width_ - 1, static_cast<int>(std::floor(x_hi + anchor.x - 0.5)));
+    const int x_first = std::max(0, static_cast<int>(std::ceil((x_lo + anchor.x) * scale_ + x_offset_ - 0.5)));
+    const int x_last = std::min(grid_width_ - 1, static_cast<int>(std::floor((x_hi + anchor.x) * scale_ + x_offset_ - 0.5)));
     if (x_first > x_last) continue;
     // The row's samples (a loop of gathers), then added to its pixels (a vector of four channels each).
     const auto count = static_cast<std::size_t>(x_last - x_first + 1);
     if (image_row_.size() < count + kImageRowPadding) image_row_.resize(count + kImageRowPadding);
     float* row_samples = image_row_.data();
-    const auto fu0 = static_cast<float>(u0 + a00 * (x_first + 0.5 - anchor.x)), fv0 = static_cast<float>(v0 + a10 * (x_first + 0.5 - anchor.x));
-    sample_image_row(data, nx, ny, fu0, fv0, static_cast<float>(a00), static_cast<float>(a10), count, row_samples);
-    float* out = dense_.data() + (static_cast<std::size_t>(row - row_begin_) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x_first)) * kChannels;
+    const double x0 = (x_first + 0.5 - x_offset_) * k_px - anchor.x;
+    const auto fu0 = static_cast<float>(u0 + a00 * x0), fv0 = static_cast<float>(v0 + a10 * x0);
+    sample_image_row(data, nx, ny, fu0, fv0, static_cast<float>(a00 * k_px), static_cast<float>(a10 * k_px), count, row_samples);
+    float* out = dense_.data() + (static_cast<std::size_t>(row - grid_row_begin_) * static_cast<std::size_t>(grid_width_) + static_cast<std::size_t>(x_first)) * kChannels;
     for (std::size_t k = 0; k < count; ++k) {
       for (int c = 0; c < kChannels; ++c) out[k * kChannels + static_cast<std::size_t>(c)] += row_samples[k] * vf[c];
     }
@@ -857,7 +860,7 @@ void SplatBuffer::resolve_into(float* rgba_full_image) const {
         }
       }
       if (dense_used_) {
-        const float* e = dense_.data() + static_cast<std::size_t>(row - row_begin_) * grid_row_size;
+        const float* e = dense_.data() + static_cast<std::size_t>(row - grid_row_begin_) * grid_row_size;
         for (std::size_t i = 0; i < grid_row_size; ++i) out[i] += e[i];
       }
     }
@@ -876,6 +879,9 @@ void SplatBuffer::resolve_into(float* rgba_full_image) const {
         cells[r + i + static_cast<std::size_t>(c)] = sum[c];
       }
     }
+  }
+  if (dense_used_) {
+    for (std::size_t r = 0; r < cells.size(); ++r) cells[r] += dense_[r];
   }
   const double norm = scale_ * scale_;
   const std::size_t out_row_size = static_cast<std::size_t>(width_) * kChannels;

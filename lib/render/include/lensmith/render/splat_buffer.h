@@ -143,10 +143,11 @@ class SplatBuffer {
   // whose centre is q receives value times the bilinear interpolation of the samples at
   // to_image * (q - anchor) (to_image a 2 x 2 matrix, row-major; 0 outside the samples). For light
   // distributions already filtered by the buffer's tent, sampled finely enough for bilinear
-  // interpolation (FootprintScatter's light images). `diagonals` bound the samples with light (in
+  // interpolation (FootprintScatter's light images). In a buffer of coarse cells the cells' centres
+  // sample it, and it must be filtered by the cells' tent. `diagonals` bound the samples with light (in
   // samples: a + b within [0], [1] and a - b within [2], [3]), so that the image's empty corners are
-  // not drawn; the default bounds nothing. Full-resolution buffers only (OptionsError); non-finite
-  // input is skipped and counted. Costs O(output pixels covered).
+  // not drawn; the default bounds nothing. Non-finite input is skipped and counted. Costs O(cells
+  // covered).
   void add_image(std::span<const float> samples, int nx, int ny, float origin_x, float origin_y, float cell_px,
                  const std::array<float, 4>& to_image, Point2f anchor, const std::array<float, 4>& value,
                  const std::array<float, 4>& diagonals = kNoDiagonals);
@@ -154,7 +155,7 @@ class SplatBuffer {
                                                     -std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity()};
   // Points (x, y, weight) of a light distribution in its own frame (px), turned and moved as
   // add_image's samples (output position anchor + from_image * (x, y), from_image row-major): each
-  // deposits value times its weight as add_point does. Full-resolution buffers only (OptionsError).
+  // deposits value times its weight as add_point does.
   void add_points(std::span<const std::array<float, 3>> points, const std::array<float, 4>& from_image, Point2f anchor,
                   const std::array<float, 4>& value);
   // The stamp of a polygon (px; its deposit at anchor (0, 0) is add_polygon's of `vertices`)
