@@ -220,6 +220,9 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
       triangles += local_triangles;
       reused += local_reused;
     }
+    // This layer's light images freed (FootprintScatter::forget_light_images says why).
+    scatter.forget_light_images();
+    for (FootprintScratch& scratch : scratches) scratch.forget_light_images();
     done += layers.members(l).size();
     if (options.progress) options.progress(static_cast<double>(done) / static_cast<double>(sources.size()));
   }

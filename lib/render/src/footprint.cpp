@@ -769,9 +769,9 @@ FootprintScatter::FootprintScatter(const RayModel& model, const Aperture& apertu
   }
 }
 
-std::size_t FootprintScatter::light_images() const {
-  std::shared_lock lock(images_mutex_);
-  return images_.size();
+void FootprintScatter::forget_light_images() const {
+  std::unique_lock lock(images_mutex_);
+  images_.clear();
 }
 
 std::size_t FootprintScatter::ImageKeyHash::operator()(const std::pair<std::uint64_t, double>& k) const {
@@ -953,6 +953,7 @@ const LightImage& FootprintScatter::light_image(int mesh, std::int64_t field_ind
     auto made = std::make_unique<LightImage>(make_light_image(mesh, at, wavelength_nm, level, *scratch.image_scratch));
     std::unique_lock lock(images_mutex_);
     auto [it, inserted] = images_.try_emplace(k, std::move(made));
+    if (inserted) ++images_made_;
     found = it->second.get();
   }
   slot = {key, wavelength_nm, found};

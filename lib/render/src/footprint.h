@@ -11,7 +11,9 @@
 //   (SplatBuffer::add_mesh; folds, caustics, vignetting).
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -193,6 +195,7 @@ struct FootprintScratch {
   // rows, so that what a band draws does not depend on which thread drew which band before.
   FootprintShape shape;
   void forget_shape() { shape.valid = false; }
+  void forget_light_images() { std::fill(light_images.begin(), light_images.end(), LightImageSlot{}); }
   // The mapped-pupil table's nodes this thread used last (FootprintScatter's table, where it has one).
   MappedPupilTable::Cache table_cache;
   // The light images this thread used last, and the scratch space it makes new ones in.
@@ -236,8 +239,13 @@ class FootprintScatter {
   FootprintScatter(const RayModel& model, const Aperture& aperture, const SpectralGroups& groups,
                    const PupilMeshTable& meshes, const ImageAreaTable& areas, const IlluminationTable& illumination,
                    const BokehOptions& options);
-  // Light images made (BokehStatistics::light_images).
-  std::size_t light_images() const;
+  // Light images made (BokehStatistics::light_images), kept or forgotten.
+  std::size_t light_images() const { return images_made_.load(); }
+  // Frees the light images made so far (a layer's; the next layer makes those it needs again): they
+  // are keyed by depth as well as by field, and a frame's layers together would keep hundreds of MB
+  // (a 960 x 540 depth ramp from 0.5 to 10 m: 19,526 images, a 627 MB peak). No thread may hold one:
+  // each thread's scratch forgets its own (FootprintScratch::forget_light_images).
+  void forget_light_images() const;
 
   // One source's plan; its probe is written to `*probe` where given.
   FootprintPlan plan(const ScatterSource& s, FootprintScratch& scratch, FootprintProbe* probe = nullptr) const;
@@ -352,6 +360,7 @@ class FootprintScatter {
   };
   mutable std::shared_mutex images_mutex_;
   mutable std::unordered_map<std::pair<std::uint64_t, double>, std::unique_ptr<LightImage>, ImageKeyHash> images_;
+  mutable std::atomic<std::size_t> images_made_{0};
   std::array<double, 4> px_per_mm_{};
 };
 
