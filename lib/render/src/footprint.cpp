@@ -80,6 +80,9 @@ constexpr double kMinLightImageCellPx = 0.125;
 constexpr double kLightImageCellsAcross = 64.0;
 constexpr int kMaxLightImageCells = 512;
 constexpr double kDenseLightImagePx = 6.0;
+// A dense image whose samples over a turned grid of pixels sum to 1 within this is drawn as sampled,
+// else normalised (LightImage::normalise).
+constexpr double kLatticeRipple = 1e-3;
 // Depth steps of the images per step of the table's nodes (1 px of blur): a footprint takes the
 // nearest image, whose size is then within 1/8 px of its own. Cross-fading the two images around it
 // at the nodes' own step softened its edge (the depth-staircase scene against the ground truth,
@@ -817,6 +820,8 @@ LightImage FootprintScatter::make_light_image(int mesh, const ScenePoint& node, 
   // output's tent (1 px beyond the mesh, for a dense image) or the cells' own (one cell).
   const double extent = std::max(x_max - x_min, y_max - y_min);
   image.extent_px = extent;
+  level = std::min(level, grid_level(extent));
+  image.level = level;
   const double grid_cell = 1 << level;
   double cell = kMaxLightImageCellPx * grid_cell;
   while (cell > kMinLightImageCellPx * grid_cell && extent < kLightImageCellsAcross * cell) cell *= 0.5;
@@ -863,27 +868,30 @@ LightImage FootprintScatter::make_light_image(int mesh, const ScenePoint& node, 
   // of one cell. Weighted (n - |k|) / n: the light an output pixel (grid cell) centred on the cell
   // would receive.
   const int n = static_cast<int>(std::lround(grid_cell / cell));
-  std::vector<double> along(w * h, 0.0);
-  for (std::size_t y = 0; y < h; ++y) {
-    for (std::size_t x = 0; x < w; ++x) {
-      const double e = rgba[(y * w + x) * 4];
-      if (e == 0.0) continue;
-      for (int k = 1 - n; k < n; ++k) {
-        const auto xx = static_cast<std::ptrdiff_t>(x) + k;
-        if (xx >= 0 && xx < static_cast<std::ptrdiff_t>(w)) along[y * w + static_cast<std::size_t>(xx)] += e * (n - std::abs(k)) / n;
-      }
+  // The triangle as two boxes of n cells, one ending at the cell and one starting there (running
+  // sums: O(cells) whatever n), scaled by 1/n.
+  std::vector<double> line(std::max(w, h) + 2 * static_cast<std::size_t>(n), 0.0), boxed(line.size(), 0.0);
+  auto triangle = [n, &line, &boxed](auto&& get, auto&& put, std::size_t count) {
+    std::fill(line.begin(), line.end(), 0.0);
+    for (std::size_t i = 0; i < count; ++i) line[i + static_cast<std::size_t>(n)] = get(i);
+    const std::size_t m = count + 2 * static_cast<std::size_t>(n);
+    double run = 0.0;
+    for (std::size_t i = 0; i < m; ++i) {  // boxed[i] = line[i - n + 1] + ... + line[i]
+      run += line[i] - (i >= static_cast<std::size_t>(n) ? line[i - static_cast<std::size_t>(n)] : 0.0);
+      boxed[i] = run;
     }
+    run = 0.0;
+    for (std::size_t i = m; i-- > 0;) {  // out[i] = boxed[i] + ... + boxed[i + n - 1]
+      run += boxed[i] - (i + static_cast<std::size_t>(n) < m ? boxed[i + static_cast<std::size_t>(n)] : 0.0);
+      if (i >= static_cast<std::size_t>(n) && i < count + static_cast<std::size_t>(n)) put(i - static_cast<std::size_t>(n), run / n);
+    }
+  };
+  std::vector<double> along(w * h, 0.0), both(w * h, 0.0);
+  for (std::size_t y = 0; y < h; ++y) {
+    triangle([&](std::size_t x) { return static_cast<double>(rgba[(y * w + x) * 4]); }, [&](std::size_t x, double v) { along[y * w + x] = v; }, w);
   }
-  std::vector<double> both(w * h, 0.0);
-  for (std::size_t y = 0; y < h; ++y) {
-    for (std::size_t x = 0; x < w; ++x) {
-      const double e = along[y * w + x];
-      if (e == 0.0) continue;
-      for (int k = 1 - n; k < n; ++k) {
-        const auto yy = static_cast<std::ptrdiff_t>(y) + k;
-        if (yy >= 0 && yy < static_cast<std::ptrdiff_t>(h)) both[static_cast<std::size_t>(yy) * w + x] += e * (n - std::abs(k)) / n;
-      }
-    }
+  for (std::size_t x = 0; x < w; ++x) {
+    triangle([&](std::size_t y) { return along[y * w + x]; }, [&](std::size_t y, double v) { both[y * w + x] = v; }, h);
   }
   // Cropped to the samples with light and a border of zeros (which bilinear interpolation needs at
   // the edge of what it draws).
@@ -923,18 +931,47 @@ LightImage FootprintScatter::make_light_image(int mesh, const ScenePoint& node, 
   }
   image.diagonals = {static_cast<float>(sum_lo - 2.0), static_cast<float>(sum_hi + 2.0), static_cast<float>(difference_lo - 2.0),
                      static_cast<float>(difference_hi + 2.0)};
+  // Its samples' sum over grids of cells turned by 0, 22.5 and 45 deg and moved by four sub-cell
+  // offsets: a smooth footprint's is 1 within 1e-4 whatever the turn, and it is drawn as sampled; a
+  // sharp core's is not (a point's, turned by 45 deg, 1.17-1.34), and it is drawn normalised, which
+  // costs sampling it whole in every band it reaches.
+  double ripple = 0.0;
+  for (const double angle : {0.0, kPi / 8.0, kPi / 4.0}) {
+    const double ca = std::cos(angle), sa = std::sin(angle);
+    for (const auto& [ox_g, oy_g] : {std::pair{0.0, 0.0}, std::pair{0.5, 0.0}, std::pair{0.5, 0.5}, std::pair{0.25, 0.75}}) {
+      double lattice = 0.0;
+      const double reach = 0.5 * std::hypot(static_cast<double>(cw), static_cast<double>(ch)) * cell / grid_cell + 2.0;
+      const double cx = image.origin_x + 0.5 * static_cast<double>(cw - 1) * cell, cy = image.origin_y + 0.5 * static_cast<double>(ch - 1) * cell;
+      for (int gy = -static_cast<int>(reach); gy <= static_cast<int>(reach); ++gy) {
+        for (int gx = -static_cast<int>(reach); gx <= static_cast<int>(reach); ++gx) {
+          const double qx = (gx + ox_g) * grid_cell, qy = (gy + oy_g) * grid_cell;  // from the image's centre, px
+          const double u = ((ca * qx + sa * qy + cx) - image.origin_x) / cell, v = ((-sa * qx + ca * qy + cy) - image.origin_y) / cell;
+          if (u < 0.0 || v < 0.0 || u > static_cast<double>(cw - 1) || v > static_cast<double>(ch - 1)) continue;
+          const auto iu = std::min(static_cast<std::size_t>(u), cw - 2), iv = std::min(static_cast<std::size_t>(v), ch - 2);
+          const double fu = u - static_cast<double>(iu), fv = v - static_cast<double>(iv);
+          const float* at = image.samples.data() + iv * cw + iu;
+          lattice += (1.0 - fv) * (at[0] + fu * (at[1] - at[0])) + fv * (at[cw] + fu * (at[cw + 1] - at[cw]));
+        }
+      }
+      ripple = std::max(ripple, std::abs(lattice - 1.0));
+    }
+  }
+  image.normalise = ripple > kLatticeRipple;
   image.origin_x += static_cast<float>(static_cast<double>(x0) * cell);
   image.origin_y += static_cast<float>(static_cast<double>(y0) * cell);
   image.ok = true;
   return image;
 }
 
+std::uint64_t FootprintScatter::key_of(int mesh, std::int64_t field_index, std::int64_t depth_step, int level) {
+  // mesh < 2^14 with the level (< 4), field index < 2^20, depth step within +-2^27 (as the table's own keys).
+  return ((static_cast<std::uint64_t>(mesh) * 4 + static_cast<std::uint64_t>(level)) << 48) | (static_cast<std::uint64_t>(field_index) << 28) |
+         static_cast<std::uint64_t>(depth_step + (std::int64_t{1} << 27));
+}
+
 const LightImage& FootprintScatter::light_image(int mesh, std::int64_t field_index, std::int64_t depth_step, double wavelength_nm,
                                                 int level, FootprintScratch& scratch) const {
-  // mesh < 2^14 with the level (< 4), field index < 2^20, depth step within +-2^27 (as the table's own keys).
-  const std::uint64_t key = ((static_cast<std::uint64_t>(mesh) * 4 + static_cast<std::uint64_t>(level)) << 48) |
-                            (static_cast<std::uint64_t>(field_index) << 28) |
-                            static_cast<std::uint64_t>(depth_step + (std::int64_t{1} << 27));
+  const std::uint64_t key = key_of(mesh, field_index, depth_step, level);
   if (scratch.light_images.empty()) scratch.light_images.resize(std::size_t{1} << kLightImageCacheBits);
   std::uint64_t bits = 0;
   std::memcpy(&bits, &wavelength_nm, sizeof bits);
@@ -950,10 +987,15 @@ const LightImage& FootprintScatter::light_image(int mesh, std::int64_t field_ind
     // Made outside the lock (another thread may make the same image meanwhile; the first kept wins).
     if (!scratch.image_scratch) scratch.image_scratch = std::make_unique<FootprintScratch>();
     const ScenePoint at = table_->point_at(static_cast<double>(field_index), static_cast<double>(depth_step) / kLightImageDepthSteps);
-    auto made = std::make_unique<LightImage>(make_light_image(mesh, at, wavelength_nm, level, *scratch.image_scratch));
+    auto made = std::make_shared<const LightImage>(make_light_image(mesh, at, wavelength_nm, level, *scratch.image_scratch));
     std::unique_lock lock(images_mutex_);
-    auto [it, inserted] = images_.try_emplace(k, std::move(made));
-    if (inserted) ++images_made_;
+    auto [it, inserted] = images_.try_emplace(k, made);
+    if (inserted) {
+      ++images_made_;
+      // Made at a finer level than asked (its passing beam is smaller than its probe said): the same
+      // image serves that level's key too, which the footprints drawn at it look up.
+      if (made->level != level) images_.try_emplace({key_of(mesh, field_index, depth_step, made->level), wavelength_nm}, made);
+    }
     found = it->second.get();
   }
   slot = {key, wavelength_nm, found};
@@ -1009,7 +1051,7 @@ bool FootprintScatter::deposit_light_images(const ScatterSource& s, const Footpr
   for (const FootprintScratch::ImageDraw& d : scratch.image_draws) {
     const LightImage& im = *d.image;
     if (im.dense) {
-      buffer.add_image(im.samples, im.nx, im.ny, im.origin_x, im.origin_y, im.cell_px, to_image, d.anchor, d.value, im.diagonals);
+      buffer.add_image(im.samples, im.nx, im.ny, im.origin_x, im.origin_y, im.cell_px, to_image, d.anchor, d.value, im.diagonals, im.normalise);
       continue;
     }
     buffer.add_points(im.points, from_image, d.anchor, d.value);
@@ -1206,12 +1248,11 @@ FootprintPlan FootprintScatter::plan(const ScatterSource& s, FootprintScratch& s
     // stopped rays may land far out: an in-focus point's passing beam a few pixels across).
     const ImagePlace n = image_place(point);
     const double wavelength_nm = groups_.split(p.groups)[0].wavelength_nm;
-    const LightImage* image = &light_image(p.mesh, n.field_index, n.depth_step, wavelength_nm, p.level, scratch);
-    if (image->ok && grid_level(image->extent_px) < p.level) {
-      p.level = grid_level(image->extent_px);
-      image = &light_image(p.mesh, n.field_index, n.depth_step, wavelength_nm, p.level, scratch);
+    const LightImage& image = light_image(p.mesh, n.field_index, n.depth_step, wavelength_nm, p.level, scratch);
+    if (image.ok) {
+      p.images = true;
+      p.level = image.level;
     }
-    p.images = image->ok;
   }
   if (p.discs && aperture_.is_uniform_convex()) {
     const int own_step = p.mesh >= 0 ? PupilMeshTable::sector_step_of_mesh(p.mesh) : p.outline;

@@ -137,6 +137,7 @@ struct FootprintShape {
 struct LightImage {
   bool ok = false;  // false: the node's beam passes no light, or its chief ray is lost
   double extent_px = 0.0;  // the larger side of the mesh's passing part
+  int level = 0;           // the splat grid it is for: the one asked, or finer where the passing part is small
   // A footprint this wide or more (px) is kept as samples of its light filtered by the tent (drawn
   // turned by SplatBuffer::add_image); a smaller one as the light of its cells, each drawn as a
   // point (the tent stays the output pixels': turning a filtered point would turn the tent too).
@@ -146,6 +147,9 @@ struct LightImage {
   float cell_px = 0.5f;
   std::vector<float> samples;  // row-major, per unit of light: their sum times (cell_px / grid cell)^2 is 1
   std::array<float, 4> diagonals{};  // bounds of the samples with light (SplatBuffer::add_image)
+  // Whether its samples over a grid of pixels, turned and moved, may sum to other than 1 by more than
+  // kLatticeRipple (a sharp core's do: a turned tent is not the pixels' tent): drawn normalised.
+  bool normalise = true;
   std::vector<std::array<float, 3>> points;  // x, y (px from the chief ray) and light, per unit of light
 };
 
@@ -317,6 +321,7 @@ class FootprintScatter {
   const LightImage& light_image(int mesh, std::int64_t field_index, std::int64_t depth_step, double wavelength_nm, int level,
                                 FootprintScratch& scratch) const;
   LightImage make_light_image(int mesh, const ScenePoint& node, double wavelength_nm, int level, FootprintScratch& scratch) const;
+  static std::uint64_t key_of(int mesh, std::int64_t field_index, std::int64_t depth_step, int level);
   // A mesh footprint of the table's models drawn from light images (one per wavelength group, from
   // its image_place, turned to its azimuth and placed at its chief ray); false, drawing nothing,
   // where an image is missing (its mesh is drawn instead).
@@ -359,7 +364,7 @@ class FootprintScatter {
     std::size_t operator()(const std::pair<std::uint64_t, double>& k) const;
   };
   mutable std::shared_mutex images_mutex_;
-  mutable std::unordered_map<std::pair<std::uint64_t, double>, std::unique_ptr<LightImage>, ImageKeyHash> images_;
+  mutable std::unordered_map<std::pair<std::uint64_t, double>, std::shared_ptr<const LightImage>, ImageKeyHash> images_;
   mutable std::atomic<std::size_t> images_made_{0};
   std::array<double, 4> px_per_mm_{};
 };

@@ -25,6 +25,8 @@ constexpr std::uint8_t kLost = 0, kLands = 1;
 // light images (the render's other costs gone), 10 % with 1024 (with the images' cache), none
 // found with 16384 (384 KiB a thread, kept from layer to layer).
 constexpr int kCacheBits = 14;
+// A point within this (in node steps) of a node is on it (Cell).
+constexpr double kOnNode = 1e-9;
 constexpr std::size_t kCacheSlots = std::size_t{1} << kCacheBits;
 
 std::uint64_t pack_key(int set, std::int64_t field_index, std::int64_t depth_index) {
@@ -135,7 +137,11 @@ MappedPupilTable::Cell MappedPupilTable::cell(const ScenePoint& point) const {
     cell.cos_azimuth = point.tan_x / r;
     cell.sin_azimuth = point.tan_y / r;
   }
-  const double fi = r / field_step_, fj = point.inverse_depth_per_mm / depth_step_;
+  double fi = r / field_step_, fj = point.inverse_depth_per_mm / depth_step_;
+  // A point on a node (the light images' are, in field) lies on it exactly, so that the nodes beyond
+  // it, of weight 0, are not mapped for it (map, passing_light).
+  if (std::abs(fi - std::round(fi)) < kOnNode) fi = std::round(fi);
+  if (std::abs(fj - std::round(fj)) < kOnNode) fj = std::round(fj);
   const double i0 = std::floor(fi), j0 = std::floor(fj);
   cell.a = fi - i0;
   cell.b = fj - j0;
@@ -153,9 +159,9 @@ double MappedPupilTable::passing_light(const ScenePoint& point, double wavelengt
   const Cell q = cell(point);
   const std::span<const PupilPoint> pupil(fine.points);
   const double l00 = node(kLightSet, wavelength_nm, q.i, q.j, pupil, cache, &fine).light;
-  const double l10 = node(kLightSet, wavelength_nm, q.i + 1, q.j, pupil, cache, &fine).light;
-  const double l01 = node(kLightSet, wavelength_nm, q.i, q.j + 1, pupil, cache, &fine).light;
-  const double l11 = node(kLightSet, wavelength_nm, q.i + 1, q.j + 1, pupil, cache, &fine).light;
+  const double l10 = q.a != 0.0 ? node(kLightSet, wavelength_nm, q.i + 1, q.j, pupil, cache, &fine).light : 0.0;
+  const double l01 = q.b != 0.0 ? node(kLightSet, wavelength_nm, q.i, q.j + 1, pupil, cache, &fine).light : 0.0;
+  const double l11 = q.a != 0.0 && q.b != 0.0 ? node(kLightSet, wavelength_nm, q.i + 1, q.j + 1, pupil, cache, &fine).light : 0.0;
   return (1.0 - q.a) * (1.0 - q.b) * l00 + q.a * (1.0 - q.b) * l10 + (1.0 - q.a) * q.b * l01 + q.a * q.b * l11;
 }
 
@@ -164,10 +170,11 @@ void MappedPupilTable::map(const ScenePoint& point, double wavelength_nm, int se
   const Cell q = cell(point);
   const double a = q.a, b = q.b, c = q.cos_azimuth, s = q.sin_azimuth;
   const std::int64_t i = q.i, j = q.j;
+  // A node of weight 0 (a point on a node's field or depth) is not needed: its neighbour stands in.
   const Node& n00 = node(set, wavelength_nm, i, j, pupil, cache);
-  const Node& n10 = node(set, wavelength_nm, i + 1, j, pupil, cache);
-  const Node& n01 = node(set, wavelength_nm, i, j + 1, pupil, cache);
-  const Node& n11 = node(set, wavelength_nm, i + 1, j + 1, pupil, cache);
+  const Node& n10 = a != 0.0 ? node(set, wavelength_nm, i + 1, j, pupil, cache) : n00;
+  const Node& n01 = b != 0.0 ? node(set, wavelength_nm, i, j + 1, pupil, cache) : n00;
+  const Node& n11 = a != 0.0 && b != 0.0 ? node(set, wavelength_nm, i + 1, j + 1, pupil, cache) : a != 0.0 ? n10 : n01;
   const auto w00 = static_cast<float>((1.0 - a) * (1.0 - b)), w10 = static_cast<float>(a * (1.0 - b));
   const auto w01 = static_cast<float>((1.0 - a) * b), w11 = static_cast<float>(a * b);
   for (std::size_t k = 0; k < hits.size(); ++k) {

@@ -669,7 +669,8 @@ namespace {
 constexpr std::size_t kImageRowPadding = 8;
 
 
-void sample_image_row_scalar(const float* data, int nx, int ny, float u0, float v0, float du, float dv, std::size_t count, float* out) {
+float sample_image_row_scalar(const float* data, int nx, int ny, float u0, float v0, float du, float dv, std::size_t count, float* out) {
+  float sum = 0.0f;
   const auto um = static_cast<float>(nx - 1), vm = static_cast<float>(ny - 1);
   for (std::size_t k = 0; k < count; ++k) {
     const auto t = static_cast<float>(k);
@@ -679,13 +680,17 @@ void sample_image_row_scalar(const float* data, int nx, int ny, float u0, float 
     const float* s = data + static_cast<std::ptrdiff_t>(iv) * nx + iu;
     const float top = s[0] + fu * (s[1] - s[0]), bottom = s[nx] + fu * (s[nx + 1] - s[nx]);
     out[k] = top + fv * (bottom - top);
+    sum += out[k];
   }
+  return sum;
 }
 
 #if defined(__GNUC__) && defined(__x86_64__)
 // Eight pixels at a time with AVX2's gathers (the compiler does not vectorise the scalar loop).
-__attribute__((target("avx2,fma"))) void sample_image_row_avx2(const float* data, int nx, int ny, float u0, float v0, float du, float dv,
-                                                               std::size_t count, float* out) {
+__attribute__((target("avx2,fma"))) float sample_image_row_avx2(const float* data, int nx, int ny, float u0, float v0, float du, float dv,
+                                                                std::size_t count, float* out) {
+  __m256 sum = _mm256_setzero_ps();
+  const __m256 end = _mm256_set1_ps(static_cast<float>(count));
   const __m256 zero = _mm256_setzero_ps();
   const __m256 um = _mm256_set1_ps(static_cast<float>(nx - 1)), vm = _mm256_set1_ps(static_cast<float>(ny - 1));
   const __m256i last_u = _mm256_set1_epi32(nx - 2), last_v = _mm256_set1_epi32(ny - 2), width = _mm256_set1_epi32(nx);
@@ -702,21 +707,24 @@ __attribute__((target("avx2,fma"))) void sample_image_row_avx2(const float* data
     const __m256 s00 = _mm256_i32gather_ps(data, at, 4), s01 = _mm256_i32gather_ps(data + 1, at, 4);
     const __m256 s10 = _mm256_i32gather_ps(data + nx, at, 4), s11 = _mm256_i32gather_ps(data + nx + 1, at, 4);
     const __m256 top = _mm256_fmadd_ps(fu, _mm256_sub_ps(s01, s00), s00), bottom = _mm256_fmadd_ps(fu, _mm256_sub_ps(s11, s10), s10);
-    _mm256_storeu_ps(out + k, _mm256_fmadd_ps(fv, _mm256_sub_ps(bottom, top), top));
+    const __m256 sample = _mm256_fmadd_ps(fv, _mm256_sub_ps(bottom, top), top);
+    _mm256_storeu_ps(out + k, sample);
+    sum = _mm256_add_ps(sum, _mm256_and_ps(sample, _mm256_cmp_ps(t, end, _CMP_LT_OQ)));  // the padding past count left out
     t = _mm256_add_ps(t, eight);
   }
+  const __m128 half = _mm_add_ps(_mm256_castps256_ps128(sum), _mm256_extractf128_ps(sum, 1));
+  const __m128 pair = _mm_add_ps(half, _mm_movehl_ps(half, half));
+  return _mm_cvtss_f32(_mm_add_ss(pair, _mm_shuffle_ps(pair, pair, 1)));
 }
 #endif
 
-void sample_image_row(const float* data, int nx, int ny, float u0, float v0, float du, float dv, std::size_t count, float* out) {
+// Returns the samples' sum.
+float sample_image_row(const float* data, int nx, int ny, float u0, float v0, float du, float dv, std::size_t count, float* out) {
 #if defined(__GNUC__) && defined(__x86_64__)
   static const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  if (avx2) {
-    sample_image_row_avx2(data, nx, ny, u0, v0, du, dv, count, out);
-    return;
-  }
+  if (avx2) return sample_image_row_avx2(data, nx, ny, u0, v0, du, dv, count, out);
 #endif
-  sample_image_row_scalar(data, nx, ny, u0, v0, du, dv, count, out);
+  return sample_image_row_scalar(data, nx, ny, u0, v0, du, dv, count, out);
 }
 
 }  // namespace
@@ -768,7 +776,7 @@ __attribute__((target_clones("arch=x86-64-v3", "default")))
 #endif
 void SplatBuffer::add_image(std::span<const float> samples, int nx, int ny, float origin_x, float origin_y, float cell_px,
                             const std::array<float, 4>& to_image, Point2f anchor, const std::array<float, 4>& value,
-                            const std::array<float, 4>& diagonals) {
+                            const std::array<float, 4>& diagonals, bool normalise) {
   if (nx < 2 || ny < 2 || samples.size() < static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny)) {
     throw OptionsError("SplatBuffer::add_image: " + std::to_string(samples.size()) + " samples for a " + std::to_string(nx) + " x " +
                        std::to_string(ny) + " image (at least 2 x 2)");
@@ -790,56 +798,91 @@ void SplatBuffer::add_image(std::span<const float> samples, int nx, int ny, floa
     return;
   }
   const double um = static_cast<double>(nx - 1), vm = static_cast<double>(ny - 1);
-  double y_lo = kInfinity, y_hi = -kInfinity;
+  double x_lo = kInfinity, x_hi = -kInfinity, y_lo = kInfinity, y_hi = -kInfinity;
   for (const auto& [cu, cv] : {std::pair{0.0, 0.0}, std::pair{um, 0.0}, std::pair{0.0, vm}, std::pair{um, vm}}) {
     const double du = cu - u_at_anchor, dv = cv - v_at_anchor;
-    const double qy = (-a10 * du + a00 * dv) / det + anchor.y;
+    const double qx = (a11 * du - a01 * dv) / det + anchor.x, qy = (-a10 * du + a00 * dv) / det + anchor.y;
+    x_lo = std::min(x_lo, qx);
+    x_hi = std::max(x_hi, qx);
     y_lo = std::min(y_lo, qy);
     y_hi = std::max(y_hi, qy);
   }
   // Grid cells (output pixels at full resolution): cell (gx, gy) is centred at output
-  // ((gx + 0.5 - x_offset_) / scale_, (gy + 0.5) / scale_), one cell k = 1 / scale_ px across.
-  const int row_first = std::max(grid_row_begin_, static_cast<int>(std::ceil(y_lo * scale_ - 0.5)));
-  const int row_last = std::min(grid_row_end_ - 1, static_cast<int>(std::floor(y_hi * scale_ - 0.5)));
+  // ((gx + 0.5 - x_offset_) / scale_, (gy + 0.5) / scale_), one cell k = 1 / scale_ px across. Every
+  // cell the image reaches is sampled, in and out of the band and the frame, so that the deposit can
+  // be normalised to exactly its value: a tent turned with the image is not the cells' tent, and its
+  // samples over the cells sum to 1 only on average (a point's, turned by 45 deg, to 1.17-1.34 as it
+  // moves across a cell), where add_polygon deposits exactly its value.
+  int row_first = static_cast<int>(std::ceil(y_lo * scale_ - 0.5));
+  int row_last = static_cast<int>(std::floor(y_hi * scale_ - 0.5));
+  // Nothing to draw here: the image lies wholly above or below the band (a renderer hands a band
+  // every footprint its planned rows overlap, planned wide), or beside the frame.
+  if (row_last < grid_row_begin_ || row_first >= grid_row_end_) return;
+  if (std::floor(x_hi * scale_ + x_offset_ - 0.5) < 0.0 || std::ceil(x_lo * scale_ + x_offset_ - 0.5) > grid_width_ - 1) return;
+  if (!normalise) {  // the band's rows alone
+    row_first = std::max(row_first, grid_row_begin_);
+    row_last = std::min(row_last, grid_row_end_ - 1);
+  }
   const double k_px = 1.0 / scale_;
-  const float vf[kChannels] = {value[0], value[1], value[2], value[3]};
   const float* data = samples.data();
-  use_dense();
   const double sum_slope = a00 + a10, difference_slope = a00 - a10;
   auto inverse = [](double slope) { return slope != 0.0 ? 1.0 / slope : 0.0; };
   const double inverse_a00 = inverse(a00), inverse_a10 = inverse(a10), inverse_sum = inverse(sum_slope),
                inverse_difference = inverse(difference_slope);
+  image_spans_.clear();
+  std::size_t used = 0;
+  double total = 0.0;
   for (int row = row_first; row <= row_last; ++row) {
     // Along the row's centre line: u = u0 + a00 x, v = v0 + a10 x at x = cell centre - anchor.x.
     const double dy = (row + 0.5) * k_px - anchor.y;
     const double u0 = u_at_anchor + a01 * dy, v0 = v_at_anchor + a11 * dy;
-    // The pixels whose centres fall inside [0, um] x [0, vm] and within the diagonal bounds.
-    double x_lo = -kInfinity, x_hi = kInfinity;
+    // The cells whose centres fall inside [0, um] x [0, vm] and within the diagonal bounds.
+    double t_lo = -kInfinity, t_hi = kInfinity;
     auto keep_within = [&](double start, double slope, double inverse_slope, double bottom, double top) {
       if (slope == 0.0) {
-        if (start < bottom || start > top) x_lo = kInfinity;
+        if (start < bottom || start > top) t_lo = kInfinity;
         return;
       }
       const double t0 = (bottom - start) * inverse_slope, t1 = (top - start) * inverse_slope;
-      x_lo = std::max(x_lo, std::min(t0, t1));
-      x_hi = std::min(x_hi, std::max(t0, t1));
+      t_lo = std::max(t_lo, std::min(t0, t1));
+      t_hi = std::min(t_hi, std::max(t0, t1));
     };
     keep_within(u0, a00, inverse_a00, 0.0, um);
     keep_within(v0, a10, inverse_a10, 0.0, vm);
     keep_within(u0 + v0, sum_slope, inverse_sum, diagonals[0], diagonals[1]);
     keep_within(u0 - v0, difference_slope, inverse_difference, diagonals[2], diagonals[3]);
-    if (!(x_lo <= x_hi)) continue;
-    const int x_first = std::max(0, static_cast<int>(std::ceil((x_lo + anchor.x) * scale_ + x_offset_ - 0.5)));
-    const int x_last = std::min(grid_width_ - 1, static_cast<int>(std::floor((x_hi + anchor.x) * scale_ + x_offset_ - 0.5)));
+    if (!(t_lo <= t_hi)) continue;
+    int x_first = static_cast<int>(std::ceil((t_lo + anchor.x) * scale_ + x_offset_ - 0.5));
+    int x_last = static_cast<int>(std::floor((t_hi + anchor.x) * scale_ + x_offset_ - 0.5));
+    if (!normalise) {  // the frame's cells alone
+      x_first = std::max(x_first, 0);
+      x_last = std::min(x_last, grid_width_ - 1);
+    }
     if (x_first > x_last) continue;
-    // The row's samples (a loop of gathers), then added to its pixels (a vector of four channels each).
+    // The row's samples (a loop of gathers), kept for the adding below.
     const auto count = static_cast<std::size_t>(x_last - x_first + 1);
-    if (image_row_.size() < count + kImageRowPadding) image_row_.resize(count + kImageRowPadding);
-    float* row_samples = image_row_.data();
+    if (image_row_.size() < used + count + kImageRowPadding) image_row_.resize(2 * (used + count + kImageRowPadding));
     const double x0 = (x_first + 0.5 - x_offset_) * k_px - anchor.x;
     const auto fu0 = static_cast<float>(u0 + a00 * x0), fv0 = static_cast<float>(v0 + a10 * x0);
-    sample_image_row(data, nx, ny, fu0, fv0, static_cast<float>(a00 * k_px), static_cast<float>(a10 * k_px), count, row_samples);
-    float* out = dense_.data() + (static_cast<std::size_t>(row - grid_row_begin_) * static_cast<std::size_t>(grid_width_) + static_cast<std::size_t>(x_first)) * kChannels;
+    total += sample_image_row(data, nx, ny, fu0, fv0, static_cast<float>(a00 * k_px), static_cast<float>(a10 * k_px), count,
+                              image_row_.data() + used);
+    image_spans_.push_back({row, x_first, static_cast<std::uint32_t>(used), static_cast<std::uint32_t>(count)});
+    used += count;
+  }
+  if (!(total > 0.0)) return;
+  // Then added to the band's cells in the frame (a vector of four channels each).
+  const auto norm = normalise ? static_cast<float>(1.0 / total) : 1.0f;
+  const float vf[kChannels] = {value[0] * norm, value[1] * norm, value[2] * norm, value[3] * norm};
+  use_dense();
+  for (const ImageSpan& span : image_spans_) {
+    if (span.row < grid_row_begin_ || span.row >= grid_row_end_) continue;
+    const int x_first = std::max(0, span.x_first);
+    const int x_last = std::min(grid_width_ - 1, span.x_first + static_cast<int>(span.count) - 1);
+    if (x_first > x_last) continue;
+    const float* row_samples = image_row_.data() + span.offset + (x_first - span.x_first);
+    float* out = dense_.data() + (static_cast<std::size_t>(span.row - grid_row_begin_) * static_cast<std::size_t>(grid_width_) +
+                                  static_cast<std::size_t>(x_first)) * kChannels;
+    const auto count = static_cast<std::size_t>(x_last - x_first + 1);
     for (std::size_t k = 0; k < count; ++k) {
       for (int c = 0; c < kChannels; ++c) out[k * kChannels + static_cast<std::size_t>(c)] += row_samples[k] * vf[c];
     }

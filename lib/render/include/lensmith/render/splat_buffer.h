@@ -141,8 +141,10 @@ class SplatBuffer {
   // A tabulated light distribution turned and moved: `samples` (nx x ny, row-major) lie at
   // (origin_x + a cell_px, origin_y + b cell_px) in the image's own frame (px), and the output pixel
   // whose centre is q receives value times the bilinear interpolation of the samples at
-  // to_image * (q - anchor) (to_image a 2 x 2 matrix, row-major; 0 outside the samples). For light
-  // distributions already filtered by the buffer's tent, sampled finely enough for bilinear
+  // to_image * (q - anchor) (to_image a 2 x 2 matrix, row-major; 0 outside the samples); with
+  // `normalise`, scaled so that all the pixels it reaches, in and out of the band and the frame,
+  // receive exactly `value` (as add_polygon's; the image is then sampled whole). For
+  // light distributions already filtered by the buffer's tent, sampled finely enough for bilinear
   // interpolation (FootprintScatter's light images). In a buffer of coarse cells the cells' centres
   // sample it, and it must be filtered by the cells' tent. `diagonals` bound the samples with light (in
   // samples: a + b within [0], [1] and a - b within [2], [3]), so that the image's empty corners are
@@ -150,7 +152,7 @@ class SplatBuffer {
   // covered).
   void add_image(std::span<const float> samples, int nx, int ny, float origin_x, float origin_y, float cell_px,
                  const std::array<float, 4>& to_image, Point2f anchor, const std::array<float, 4>& value,
-                 const std::array<float, 4>& diagonals = kNoDiagonals);
+                 const std::array<float, 4>& diagonals = kNoDiagonals, bool normalise = true);
   static constexpr std::array<float, 4> kNoDiagonals{-std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity(),
                                                     -std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity()};
   // Points (x, y, weight) of a light distribution in its own frame (px), turned and moved as
@@ -258,7 +260,12 @@ class SplatBuffer {
   std::vector<std::size_t> active_edges_;
   std::vector<double> crossings_;
   std::vector<SubrowSpan> spans_;
-  std::vector<float> image_row_;  // add_image: one row's samples
+  std::vector<float> image_row_;  // add_image: its rows' samples, one after the other
+  struct ImageSpan {
+    int row = 0, x_first = 0;  // grid cells
+    std::uint32_t offset = 0, count = 0;  // its samples in image_row_
+  };
+  std::vector<ImageSpan> image_spans_;
   // add_image's deposits as values (not differences), added to the picture by resolve_into; sized
   // and zeroed on a band's first add_image.
   LargeVector<float> dense_;
