@@ -698,14 +698,29 @@ __attribute__((target("avx2,fma"))) float sample_image_row_avx2(const float* dat
   __m256 t = _mm256_setr_ps(0.0f, 1.0f, 2.0f, 3.0f, 4.0f, 5.0f, 6.0f, 7.0f);
   const __m256 eight = _mm256_set1_ps(8.0f);
   const __m256 start_u = _mm256_set1_ps(u0), start_v = _mm256_set1_ps(v0);
+  const __m256i pair_order = _mm256_setr_epi32(0, 1, 4, 5, 2, 3, 6, 7);
+  // The masked form with every lane on (the plain one leaves its source undefined, which GCC 12 warns of).
+  const __m256d no_pair = _mm256_setzero_pd(), all_pairs = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+  // The gathers read bytes (the pairs of floats as doubles): the pointers' type is the intrinsic's.
+  const auto* top_row = reinterpret_cast<const double*>(data);
+  const auto* bottom_row = reinterpret_cast<const double*>(data + nx);
   for (std::size_t k = 0; k < count; k += 8) {
     const __m256 u = _mm256_min_ps(_mm256_max_ps(_mm256_fmadd_ps(step_u, t, start_u), zero), um);
     const __m256 w = _mm256_min_ps(_mm256_max_ps(_mm256_fmadd_ps(step_v, t, start_v), zero), vm);
     const __m256i iu = _mm256_min_epi32(_mm256_cvttps_epi32(u), last_u), iv = _mm256_min_epi32(_mm256_cvttps_epi32(w), last_v);
     const __m256 fu = _mm256_sub_ps(u, _mm256_cvtepi32_ps(iu)), fv = _mm256_sub_ps(w, _mm256_cvtepi32_ps(iv));
-    const __m256i at = _mm256_add_epi32(_mm256_mullo_epi32(iv, width), iu);
-    const __m256 s00 = _mm256_i32gather_ps(data, at, 4), s01 = _mm256_i32gather_ps(data + 1, at, 4);
-    const __m256 s10 = _mm256_i32gather_ps(data + nx, at, 4), s11 = _mm256_i32gather_ps(data + nx + 1, at, 4);
+    // Each sample's horizontal neighbours as one 8-byte element (gathers need no alignment): half the
+    // elements of four float gathers. The indices go in the order (0, 1, 4, 5 | 2, 3, 6, 7), so that
+    // shuffling the two halves' pairs gives the samples back in order.
+    const __m256i at = _mm256_permutevar8x32_epi32(_mm256_add_epi32(_mm256_mullo_epi32(iv, width), iu), pair_order);
+    const __m128i at_lo = _mm256_castsi256_si128(at), at_hi = _mm256_extracti128_si256(at, 1);
+    const __m256 top_lo = _mm256_castpd_ps(_mm256_mask_i32gather_pd(no_pair, top_row, at_lo, all_pairs, 4));
+    const __m256 top_hi = _mm256_castpd_ps(_mm256_mask_i32gather_pd(no_pair, top_row, at_hi, all_pairs, 4));
+    const __m256 bottom_lo = _mm256_castpd_ps(_mm256_mask_i32gather_pd(no_pair, bottom_row, at_lo, all_pairs, 4));
+    const __m256 bottom_hi = _mm256_castpd_ps(_mm256_mask_i32gather_pd(no_pair, bottom_row, at_hi, all_pairs, 4));
+    const __m256 s00 = _mm256_shuffle_ps(top_lo, top_hi, _MM_SHUFFLE(2, 0, 2, 0)), s01 = _mm256_shuffle_ps(top_lo, top_hi, _MM_SHUFFLE(3, 1, 3, 1));
+    const __m256 s10 = _mm256_shuffle_ps(bottom_lo, bottom_hi, _MM_SHUFFLE(2, 0, 2, 0)),
+                 s11 = _mm256_shuffle_ps(bottom_lo, bottom_hi, _MM_SHUFFLE(3, 1, 3, 1));
     const __m256 top = _mm256_fmadd_ps(fu, _mm256_sub_ps(s01, s00), s00), bottom = _mm256_fmadd_ps(fu, _mm256_sub_ps(s11, s10), s10);
     const __m256 sample = _mm256_fmadd_ps(fv, _mm256_sub_ps(bottom, top), top);
     _mm256_storeu_ps(out + k, sample);
@@ -829,44 +844,59 @@ void SplatBuffer::add_image(std::span<const float> samples, int nx, int ny, floa
   auto inverse = [](double slope) { return slope != 0.0 ? 1.0 / slope : 0.0; };
   const double inverse_a00 = inverse(a00), inverse_a10 = inverse(a10), inverse_sum = inverse(sum_slope),
                inverse_difference = inverse(difference_slope);
+  // Each row's cells first, for all rows in one short loop, then the rows' samples (interleaved row
+  // by row, this bookkeeping took about as long as the samples' gathers). Along a row's centre line
+  // u = u0 + a00 x, v = v0 + a10 x at x = cell centre - anchor.x; its cells are those whose centres
+  // fall inside [0, um] x [0, vm] and within the diagonal bounds: each bound an interval of x, or
+  // along a bound's own direction (slope 0) all of the row or none of it.
+  const int rows = row_last - row_first + 1;
+  if (rows <= 0) return;
+  image_row_cells_.resize(4 * static_cast<std::size_t>(rows));
+  double* const cell_first = image_row_cells_.data();
+  double* const cell_last = cell_first + rows;
+  double* const row_u = cell_last + rows;
+  double* const row_v = row_u + rows;
+  const double x_lowest = normalise ? -kInfinity : 0.0, x_highest = normalise ? kInfinity : static_cast<double>(grid_width_ - 1);
+  const double x_shift = x_offset_ - 0.5;
+  const double scale = scale_, anchor_x = anchor.x, anchor_y = anchor.y;
+  const double inverses[4] = {inverse_a00, inverse_a10, inverse_sum, inverse_difference};
+  const double bottoms[4] = {0.0, 0.0, diagonals[0], diagonals[2]}, tops[4] = {um, vm, diagonals[1], diagonals[3]};
+  const bool sloped[4] = {a00 != 0.0, a10 != 0.0, sum_slope != 0.0, difference_slope != 0.0};
+  for (int i = 0; i < rows; ++i) {
+    const double dy = (row_first + i + 0.5) * k_px - anchor_y;
+    const double u0 = u_at_anchor + a01 * dy, v0 = v_at_anchor + a11 * dy;
+    double t_lo = -kInfinity, t_hi = kInfinity;
+    const double starts[4] = {u0, v0, u0 + v0, u0 - v0};
+    for (int c = 0; c < 4; ++c) {
+      const double t0 = (bottoms[c] - starts[c]) * inverses[c], t1 = (tops[c] - starts[c]) * inverses[c];
+      const bool outside = (starts[c] < bottoms[c]) | (starts[c] > tops[c]);
+      const double lo = sloped[c] ? std::min(t0, t1) : (outside ? kInfinity : -kInfinity);
+      const double hi = sloped[c] ? std::max(t0, t1) : kInfinity;
+      t_lo = std::max(t_lo, lo);
+      t_hi = std::min(t_hi, hi);
+    }
+    // An empty row (t_lo > t_hi) ends with cell_first > cell_last, and so does one whose cells all
+    // lie beside the frame where only the frame's are drawn.
+    const double first = std::ceil((t_lo + anchor_x) * scale + x_shift), last = std::floor((t_hi + anchor_x) * scale + x_shift);
+    cell_first[i] = std::max(first, x_lowest);
+    cell_last[i] = t_lo <= t_hi ? std::min(last, x_highest) : -kInfinity;
+    row_u[i] = u0;
+    row_v[i] = v0;
+  }
   image_spans_.clear();
   std::size_t used = 0;
   double total = 0.0;
-  for (int row = row_first; row <= row_last; ++row) {
-    // Along the row's centre line: u = u0 + a00 x, v = v0 + a10 x at x = cell centre - anchor.x.
-    const double dy = (row + 0.5) * k_px - anchor.y;
-    const double u0 = u_at_anchor + a01 * dy, v0 = v_at_anchor + a11 * dy;
-    // The cells whose centres fall inside [0, um] x [0, vm] and within the diagonal bounds.
-    double t_lo = -kInfinity, t_hi = kInfinity;
-    auto keep_within = [&](double start, double slope, double inverse_slope, double bottom, double top) {
-      if (slope == 0.0) {
-        if (start < bottom || start > top) t_lo = kInfinity;
-        return;
-      }
-      const double t0 = (bottom - start) * inverse_slope, t1 = (top - start) * inverse_slope;
-      t_lo = std::max(t_lo, std::min(t0, t1));
-      t_hi = std::min(t_hi, std::max(t0, t1));
-    };
-    keep_within(u0, a00, inverse_a00, 0.0, um);
-    keep_within(v0, a10, inverse_a10, 0.0, vm);
-    keep_within(u0 + v0, sum_slope, inverse_sum, diagonals[0], diagonals[1]);
-    keep_within(u0 - v0, difference_slope, inverse_difference, diagonals[2], diagonals[3]);
-    if (!(t_lo <= t_hi)) continue;
-    int x_first = static_cast<int>(std::ceil((t_lo + anchor.x) * scale_ + x_offset_ - 0.5));
-    int x_last = static_cast<int>(std::floor((t_hi + anchor.x) * scale_ + x_offset_ - 0.5));
-    if (!normalise) {  // the frame's cells alone
-      x_first = std::max(x_first, 0);
-      x_last = std::min(x_last, grid_width_ - 1);
-    }
-    if (x_first > x_last) continue;
+  for (int i = 0; i < rows; ++i) {
+    if (!(cell_first[i] <= cell_last[i])) continue;
+    const int x_first = static_cast<int>(cell_first[i]), x_last = static_cast<int>(cell_last[i]);
     // The row's samples (a loop of gathers), kept for the adding below.
     const auto count = static_cast<std::size_t>(x_last - x_first + 1);
     if (image_row_.size() < used + count + kImageRowPadding) image_row_.resize(2 * (used + count + kImageRowPadding));
-    const double x0 = (x_first + 0.5 - x_offset_) * k_px - anchor.x;
-    const auto fu0 = static_cast<float>(u0 + a00 * x0), fv0 = static_cast<float>(v0 + a10 * x0);
+    const double x0 = (x_first + 0.5 - x_offset_) * k_px - anchor_x;
+    const auto fu0 = static_cast<float>(row_u[i] + a00 * x0), fv0 = static_cast<float>(row_v[i] + a10 * x0);
     total += sample_image_row(data, nx, ny, fu0, fv0, static_cast<float>(a00 * k_px), static_cast<float>(a10 * k_px), count,
                               image_row_.data() + used);
-    image_spans_.push_back({row, x_first, static_cast<std::uint32_t>(used), static_cast<std::uint32_t>(count)});
+    image_spans_.push_back({row_first + i, x_first, static_cast<std::uint32_t>(used), static_cast<std::uint32_t>(count)});
     used += count;
   }
   if (!(total > 0.0)) return;

@@ -261,6 +261,7 @@ class SplatBuffer {
   std::vector<double> crossings_;
   std::vector<SubrowSpan> spans_;
   std::vector<float> image_row_;  // add_image: its rows' samples, one after the other
+  std::vector<double> image_row_cells_;  // add_image: its rows' first and last cells and (u, v) at x = 0
   struct ImageSpan {
     int row = 0, x_first = 0;  // grid cells
     std::uint32_t offset = 0, count = 0;  // its samples in image_row_
