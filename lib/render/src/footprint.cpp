@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstring>
 #include <mutex>
-#include <shared_mutex>
 #include <span>
 #include <utility>
 
@@ -755,7 +754,7 @@ FootprintScatter::FootprintScatter(const RayModel& model, const Aperture& apertu
                                    const PupilMeshTable& meshes, const ImageAreaTable& areas, const IlluminationTable& illumination,
                                    const BokehOptions& options)
     : model_(model), camera_(model.camera()), aperture_(aperture), groups_(groups), meshes_(meshes), options_(options),
-      stamps_(meshes, 0.5 * kHalfResolutionPx + kStampMarginPx), areas_(areas), illumination_(illumination) {
+      stamps_(meshes, 0.5 * kHalfResolutionPx + kStampMarginPx), areas_(areas), illumination_(illumination), images_(kLightImageCacheBits) {
   if (options.interpolated_rays && MappedPupilTable::applies(model, aperture)) table_ = std::make_unique<MappedPupilTable>(model);
   {
     const PixelPoint o = camera_.output_pixel(0.0, 0.0), ex = camera_.output_pixel(1.0, 0.0), ey = camera_.output_pixel(0.0, 1.0);
@@ -772,16 +771,7 @@ FootprintScatter::FootprintScatter(const RayModel& model, const Aperture& apertu
   }
 }
 
-void FootprintScatter::forget_light_images() const {
-  std::unique_lock lock(images_mutex_);
-  images_.clear();
-}
-
-std::size_t FootprintScatter::ImageKeyHash::operator()(const std::pair<std::uint64_t, double>& k) const {
-  std::uint64_t bits = 0;
-  std::memcpy(&bits, &k.second, sizeof bits);
-  return std::hash<std::uint64_t>{}(k.first * 0x9E3779B97F4A7C15ull ^ bits);
-}
+void FootprintScatter::forget_light_images() const { images_.clear(); }
 
 // The footprint of `node` (a point on the table's x axis) as the mesh path would draw it: its mesh's
 // cells recorded as record_mesh records them, deposited into a buffer of cells (a fraction of a
@@ -971,35 +961,17 @@ std::uint64_t FootprintScatter::key_of(int mesh, std::int64_t field_index, std::
 
 const LightImage& FootprintScatter::light_image(int mesh, std::int64_t field_index, std::int64_t depth_step, double wavelength_nm,
                                                 int level, FootprintScratch& scratch) const {
-  const std::uint64_t key = key_of(mesh, field_index, depth_step, level);
-  if (scratch.light_images.empty()) scratch.light_images.resize(std::size_t{1} << kLightImageCacheBits);
-  std::uint64_t bits = 0;
-  std::memcpy(&bits, &wavelength_nm, sizeof bits);
-  FootprintScratch::LightImageSlot& slot = scratch.light_images[(key * 0x9E3779B97F4A7C15ull ^ bits) >> (64 - kLightImageCacheBits)];
-  if (slot.key == key && slot.wavelength_nm == wavelength_nm) return *slot.image;
-  const std::pair<std::uint64_t, double> k{key, wavelength_nm};
-  const LightImage* found = nullptr;
-  {
-    std::shared_lock lock(images_mutex_);
-    if (auto it = images_.find(k); it != images_.end()) found = it->second.get();
-  }
-  if (found == nullptr) {
-    // Made outside the lock (another thread may make the same image meanwhile; the first kept wins).
+  const auto make = [&] {
     if (!scratch.image_scratch) scratch.image_scratch = std::make_unique<FootprintScratch>();
     const ScenePoint at = table_->point_at(static_cast<double>(field_index), static_cast<double>(depth_step) / kLightImageDepthSteps);
-    auto made = std::make_shared<const LightImage>(make_light_image(mesh, at, wavelength_nm, level, *scratch.image_scratch));
-    std::unique_lock lock(images_mutex_);
-    auto [it, inserted] = images_.try_emplace(k, made);
-    if (inserted) {
-      ++images_made_;
-      // Made at a finer level than asked (its passing beam is smaller than its probe said): the same
-      // image serves that level's key too, which the footprints drawn at it look up.
-      if (made->level != level) images_.try_emplace({key_of(mesh, field_index, depth_step, made->level), wavelength_nm}, made);
-    }
-    found = it->second.get();
-  }
-  slot = {key, wavelength_nm, found};
-  return *found;
+    return make_light_image(mesh, at, wavelength_nm, level, *scratch.image_scratch);
+  };
+  // Made at a finer level than asked (its passing beam is smaller than its probe said): the same
+  // image serves that level's key too, which the footprints drawn at it look up.
+  const auto also_key = [&](const LightImage& made) {
+    return made.level != level ? std::optional<std::uint64_t>(key_of(mesh, field_index, depth_step, made.level)) : std::nullopt;
+  };
+  return images_.get(key_of(mesh, field_index, depth_step, level), wavelength_nm, scratch.light_images, make, also_key);
 }
 
 FootprintScatter::ImagePlace FootprintScatter::image_place(const ScenePoint& point) const {

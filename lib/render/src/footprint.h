@@ -17,9 +17,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
-#include <shared_mutex>
 #include <span>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -31,6 +29,7 @@
 #include "mapped_pupil_table.h"
 #include "pupil_mesh_table.h"
 #include "scatter_source.h"
+#include "shared_memo.h"
 #include "spectral_groups.h"
 
 namespace lensmith::render_detail {
@@ -199,16 +198,11 @@ struct FootprintScratch {
   // rows, so that what a band draws does not depend on which thread drew which band before.
   FootprintShape shape;
   void forget_shape() { shape.valid = false; }
-  void forget_light_images() { std::fill(light_images.begin(), light_images.end(), LightImageSlot{}); }
+  void forget_light_images() { light_images.forget(); }
   // The mapped-pupil table's nodes this thread used last (FootprintScatter's table, where it has one).
   MappedPupilTable::Cache table_cache;
   // The light images this thread used last, and the scratch space it makes new ones in.
-  struct LightImageSlot {
-    std::uint64_t key = ~std::uint64_t{0};
-    double wavelength_nm = 0.0;
-    const LightImage* image = nullptr;
-  };
-  std::vector<LightImageSlot> light_images;
+  SharedMemo<LightImage>::ThreadSlots light_images;
   std::unique_ptr<FootprintScratch> image_scratch;
   // One footprint's light images to draw (deposit_light_images).
   struct ImageDraw {
@@ -244,7 +238,7 @@ class FootprintScatter {
                    const PupilMeshTable& meshes, const ImageAreaTable& areas, const IlluminationTable& illumination,
                    const BokehOptions& options);
   // Light images made (BokehStatistics::light_images), kept or forgotten.
-  std::size_t light_images() const { return images_made_.load(); }
+  std::size_t light_images() const { return images_.made(); }
   // Frees the light images made so far (a layer's; the next layer makes those it needs again): they
   // are keyed by depth as well as by field, and a frame's layers together would keep hundreds of MB
   // (a 960 x 540 depth ramp from 0.5 to 10 m: 19,526 images, a 627 MB peak). No thread may hold one:
@@ -360,12 +354,7 @@ class FootprintScatter {
   std::unique_ptr<MappedPupilTable> table_;
   // Light images by (mesh, node, wavelength), and the output pixels per sensor mm (Camera::output_pixel's
   // linear part, row-major), which turn an image to a point's azimuth.
-  struct ImageKeyHash {
-    std::size_t operator()(const std::pair<std::uint64_t, double>& k) const;
-  };
-  mutable std::shared_mutex images_mutex_;
-  mutable std::unordered_map<std::pair<std::uint64_t, double>, std::shared_ptr<const LightImage>, ImageKeyHash> images_;
-  mutable std::atomic<std::size_t> images_made_{0};
+  SharedMemo<LightImage> images_;
   std::array<double, 4> px_per_mm_{};
 };
 

@@ -27,7 +27,6 @@ constexpr std::uint8_t kLost = 0, kLands = 1;
 constexpr int kCacheBits = 14;
 // A point within this (in node steps) of a node is on it (Cell).
 constexpr double kOnNode = 1e-9;
-constexpr std::size_t kCacheSlots = std::size_t{1} << kCacheBits;
 
 std::uint64_t pack_key(int set, std::int64_t field_index, std::int64_t depth_index) {
   // set < 2^16, field index < 2^20, depth index within +-2^27.
@@ -42,12 +41,6 @@ struct MappedPupilTable::Node {
   std::vector<std::uint8_t> lands;  // kLost or kLands
   double light = 0.0;               // kLightSet's
 };
-
-std::size_t MappedPupilTable::KeyHash::operator()(const std::pair<std::uint64_t, double>& k) const {
-  std::uint64_t bits = 0;
-  std::memcpy(&bits, &k.second, sizeof bits);
-  return std::hash<std::uint64_t>{}(k.first * 0x9E3779B97F4A7C15ull ^ bits);
-}
 
 bool MappedPupilTable::round_lens(const Camera& camera) {
   if (camera.lens() == nullptr || camera.exact_model_only() || camera.squeeze() != 1.0) return false;
@@ -64,7 +57,7 @@ bool MappedPupilTable::applies(const RayModel& model, const Aperture& aperture) 
          round_lens(model.camera());
 }
 
-MappedPupilTable::MappedPupilTable(const RayModel& model) : model_(model) {
+MappedPupilTable::MappedPupilTable(const RayModel& model) : model_(model), nodes_(kCacheBits) {
   const Camera& camera = model.camera();
   // At most kFieldStepPx, and at most 1/kFieldNodes of the frame's half-diagonal: a small frame's
   // pixel spans more of the field, and the clear apertures' edges move across a beam with the field.
@@ -83,21 +76,8 @@ MappedPupilTable::~MappedPupilTable() = default;
 
 const MappedPupilTable::Node& MappedPupilTable::node(int set, double wavelength_nm, std::int64_t field_index, std::int64_t depth_index,
                                                      std::span<const PupilPoint> pupil, Cache& cache, const PupilMesh* fine) const {
-  const std::uint64_t key = pack_key(set, field_index, depth_index);
-  if (cache.slots.empty()) cache.slots.resize(kCacheSlots);
-  std::uint64_t bits = 0;
-  std::memcpy(&bits, &wavelength_nm, sizeof bits);
-  Cache::Slot& slot = cache.slots[(key * 0x9E3779B97F4A7C15ull ^ bits) >> (64 - kCacheBits)];
-  if (slot.key == key && slot.wavelength_nm == wavelength_nm) return *slot.node;
-  const std::pair<std::uint64_t, double> k{key, wavelength_nm};
-  const Node* found = nullptr;
-  {
-    std::shared_lock lock(mutex_);
-    if (auto it = nodes_.find(k); it != nodes_.end()) found = it->second.get();
-  }
-  if (found == nullptr) {
-    // Mapped outside the lock (another thread may map the same node meanwhile; the first kept wins).
-    auto made = std::make_unique<Node>();
+  return nodes_.get(pack_key(set, field_index, depth_index), wavelength_nm, cache, [&] {
+    Node made;
     std::vector<SensorHit> hits(pupil.size());
     const ScenePoint point = point_at(static_cast<double>(field_index), static_cast<double>(depth_index));
     model_.map(point, wavelength_nm, pupil, hits);
@@ -109,24 +89,20 @@ const MappedPupilTable::Node& MappedPupilTable::node(int set, double wavelength_
         const SensorHit& hb = hits[static_cast<std::size_t>(t.b)];
         const SensorHit& hc = hits[static_cast<std::size_t>(t.c)];
         if (!(ha.ok || ha.unclipped) || !(hb.ok || hb.unclipped) || !(hc.ok || hc.unclipped)) continue;
-        made->light += t.weight * passing_share(ha.clearance, hb.clearance, hc.clearance) * (ha.weight + hb.weight + hc.weight) / 3.0;
+        made.light += t.weight * passing_share(ha.clearance, hb.clearance, hc.clearance) * (ha.weight + hb.weight + hc.weight) / 3.0;
       }
       hits.clear();
     }
-    made->hits.resize(hits.size());
-    made->lands.resize(hits.size());
+    made.hits.resize(hits.size());
+    made.lands.resize(hits.size());
     for (std::size_t i = 0; i < hits.size(); ++i) {
       const SensorHit& h = hits[i];
       const bool lands = h.ok || h.unclipped;
-      made->lands[i] = lands ? kLands : kLost;
-      made->hits[i] = {static_cast<float>(h.x_mm), static_cast<float>(h.y_mm), static_cast<float>(h.clearance), static_cast<float>(h.weight)};
+      made.lands[i] = lands ? kLands : kLost;
+      made.hits[i] = {static_cast<float>(h.x_mm), static_cast<float>(h.y_mm), static_cast<float>(h.clearance), static_cast<float>(h.weight)};
     }
-    std::unique_lock lock(mutex_);
-    auto [it, inserted] = nodes_.try_emplace(k, std::move(made));
-    found = it->second.get();
-  }
-  slot = {key, wavelength_nm, found};
-  return *found;
+    return made;
+  });
 }
 
 MappedPupilTable::Cell MappedPupilTable::cell(const ScenePoint& point) const {

@@ -25,14 +25,11 @@
 #pragma once
 
 #include <cstdint>
-#include <memory>
-#include <mutex>
-#include <shared_mutex>
 #include <span>
-#include <unordered_map>
 #include <vector>
 
 #include "lensmith/camera/ray_model.h"
+#include "shared_memo.h"
 
 namespace lensmith::render_detail {
 
@@ -64,14 +61,7 @@ class MappedPupilTable {
   struct Node;
   // A thread's recently used nodes, so that most lookups take no lock (one per thread, e.g. in its
   // scratch space; it must not outlive the table).
-  struct Cache {
-    struct Slot {
-      std::uint64_t key = ~std::uint64_t{0};
-      double wavelength_nm = 0.0;
-      const Node* node = nullptr;
-    };
-    std::vector<Slot> slots;
-  };
+  using Cache = SharedMemo<Node>::ThreadSlots;
 
   // The hits of pupil set `set` (whose points are `pupil`, the same for every call with that set)
   // for `point` at `wavelength_nm`: the model's map of the set turned by the point's azimuth (see
@@ -115,11 +105,7 @@ class MappedPupilTable {
   const RayModel& model_;
   double field_step_ = 0.0;  // direction tangent per node
   double depth_step_ = 0.0;  // inverse depth (1/mm) per node
-  mutable std::shared_mutex mutex_;
-  struct KeyHash {
-    std::size_t operator()(const std::pair<std::uint64_t, double>& k) const;
-  };
-  mutable std::unordered_map<std::pair<std::uint64_t, double>, std::unique_ptr<Node>, KeyHash> nodes_;
+  SharedMemo<Node> nodes_;
 };
 
 }  // namespace lensmith::render_detail
