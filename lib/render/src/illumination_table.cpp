@@ -5,6 +5,8 @@
 #include <memory>
 #include <optional>
 
+#include "lensmith/camera/lens_camera.h"
+#include "lensmith/core/errors.h"
 #include "lensmith/core/units.h"
 #include "mapped_pupil_table.h"
 
@@ -30,6 +32,15 @@ constexpr double kWiden = 0.8;
 constexpr double kWidenFully = 0.4;
 // A share the widest discs cannot reach is approached to this fraction of their most.
 constexpr double kReachable = 0.999;
+// The real lens's brightness is measured at this many output radii from the frame's centre to
+// kSensorReach times its corner's (with the margin), each on kPupilRings x kPupilSectors points of
+// equal area on the pupil disc LensCamera samples: 147,456 rays, about 20 ms on two threads (the
+// README job). On lentil 0004 at f/2.8 the curve is within 0.1 % of one on 96 x 256 points (24 x 64:
+// 0.3 %, 10 ms).
+constexpr int kSensorRadii = 48;
+constexpr double kSensorReach = 1.05;
+constexpr double kGoldenFraction = 0.6180339887498949;
+constexpr int kPupilRings = 32, kPupilSectors = 96;
 
 // What a node measures of one model: where the chief ray lands (output px), and of a uniform
 // surface's point the light it sends through the pupil (the mean over the unit pupil of the rays'
@@ -117,14 +128,6 @@ Beam trace(const RayModel& model, const ScenePoint& point, double wavelength_nm,
   return beam;
 }
 
-// How far from the output's centre `point`'s chief ray lands (output px), or -1 where it lands nowhere.
-double chief_radius_px(const RayModel& model, const ScenePoint& point, double wavelength_nm) {
-  const std::optional<PixelPoint> q = chief_landing(model, point, wavelength_nm);
-  if (!q) return -1.0;
-  const PixelPoint o = model.camera().output_pixel(0.0, 0.0);
-  return std::hypot(q->x - o.x, q->y - o.y);
-}
-
 // Linear interpolation of ys over increasing xs at x, clamped to the ends.
 double interpolate(const std::vector<double>& xs, const std::vector<double>& ys, double x) {
   if (xs.size() == 1 || x <= xs.front()) return ys.front();
@@ -175,58 +178,34 @@ IlluminationTable::IlluminationTable(const RayModel& model, const PupilMesh& fin
   dw_ = depth_nodes > 1 ? (w_max - w_min) / (depth_nodes - 1) : 1.0;
   const double wavelength_nm = camera.reference_wavelength_nm();
   const auto nodes = static_cast<std::size_t>(depth_nodes) * kFieldNodes;
-  // Node n at kRealReach times the model's field step for the real lens: where its barrel distortion
-  // is strong it images the frame's corner from beyond the field the model's nodes span (lentil
-  // 0005: 16 %).
+  // Node n at kRealReach times the model's field step for the real lens (its share of the pupil, for
+  // the discs' widening).
   auto point_of = [&](std::size_t n, double reach) {
     return ScenePoint{static_cast<double>(n % kFieldNodes) * reach * step_, 0.0, w0_ + static_cast<double>(n / kFieldNodes) * dw_};
   };
-  auto pixel_of = [&](std::size_t n, double reach) {
-    return PixelPoint{centre_x + static_cast<double>(n % kFieldNodes) * reach * step_ * frame.focal_length_px(), centre_y};
+  auto pixel_of = [&](std::size_t n) {
+    return PixelPoint{centre_x + static_cast<double>(n % kFieldNodes) * step_ * frame.focal_length_px(), centre_y};
   };
-  // Where the chief rays land: the model's over its nodes, the real lens's over twice their field.
-  // The real lens's pupil is traced only out to the node past the model's farthest landing and past
-  // the model's own field (the discs' widening reads its share there): with every node traced, the
-  // table took 35-39 ms of the 1080p bench's Seidel render (pbrt-dgauss-50mm), about half of them
-  // beyond the frame through a lens of little distortion.
-  std::vector<double> model_rho(nodes, -1.0), real_rho(nodes, -1.0);
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 4)
-  for (std::size_t n = 0; n < nodes; ++n) {
-    model_rho[n] = chief_radius_px(model, point_of(n, 1.0), wavelength_nm);
-    real_rho[n] = chief_radius_px(*exact, point_of(n, kRealReach), wavelength_nm);
-  }
-  std::vector<std::size_t> last_real(static_cast<std::size_t>(depth_nodes), kFieldNodes - 1);
-  for (std::size_t d = 0; d < last_real.size(); ++d) {
-    const std::size_t first = d * kFieldNodes;
-    const double reach = *std::max_element(model_rho.begin() + static_cast<std::ptrdiff_t>(first),
-                                           model_rho.begin() + static_cast<std::ptrdiff_t>(first + kFieldNodes));
-    const auto own_field = static_cast<std::size_t>(std::ceil((kFieldNodes - 1) / kRealReach)) + 1;
-    for (std::size_t i = own_field; i < kFieldNodes; ++i) {
-      if (real_rho[first + i] >= reach) {
-        last_real[d] = std::min<std::size_t>(i + 1, kFieldNodes - 1);
-        break;
-      }
-    }
-  }
+  // The real lens's share of the pupil is read (the discs' widening) out to the model's own field,
+  // the real lens's node past it.
+  const auto own_field = static_cast<std::size_t>(std::ceil((kFieldNodes - 1) / kRealReach)) + 1;
   // The real lens at its nodes, the model on the axis (its share there is what the real lens's
   // relative share scales), then the model at every node with its discs widened to that share.
   std::vector<Beam> model_beam(nodes), real_beam(nodes);
-  std::vector<double> model_area(nodes, 1.0), real_area(nodes, 0.0), scale(nodes, 1.0);
+  std::vector<double> model_area(nodes, 1.0), scale(nodes, 1.0);
 #pragma omp parallel num_threads(threads)
   {
     NodeRays rays;
 #pragma omp for schedule(dynamic, 1)
     for (std::size_t n = 0; n < nodes; ++n) {
       if (n % kFieldNodes == 0) model_beam[n] = trace(model, point_of(n, 1.0), wavelength_nm, fine, rays);
-      if (n % kFieldNodes > last_real[n / kFieldNodes]) continue;  // lands = false: beyond what is read
-      const ScenePoint real_point = point_of(n, kRealReach);
-      real_beam[n] = trace(*exact, real_point, wavelength_nm, fine, rays);
-      if (real_beam[n].lands) real_area[n] = chief_ray_image_area(*exact, pixel_of(n, kRealReach), real_point.inverse_depth_per_mm, 1.0);
+      if (n % kFieldNodes > own_field) continue;  // lands = false: beyond what is read
+      real_beam[n] = trace(*exact, point_of(n, kRealReach), wavelength_nm, fine, rays);
     }
 #pragma omp for schedule(dynamic, 1)
     for (std::size_t n = 0; n < nodes; ++n) {
       const std::size_t axis = n - n % kFieldNodes;
-      const PixelPoint pixel = pixel_of(n, 1.0);
+      const PixelPoint pixel = pixel_of(n);
       model_area[n] = areas.at(pixel.x, pixel.y, point_of(n, 1.0).inverse_depth_per_mm);
       if (n == axis) continue;
       model_beam[n] = trace(model, point_of(n, 1.0), wavelength_nm, fine, rays);
@@ -265,16 +244,52 @@ IlluminationTable::IlluminationTable(const RayModel& model, const PupilMesh& fin
       measure(camera, fine, rays, model_beam[n]);
     }
   }
+  // The real lens's brightness at the film, as `lensmith scene render --lens` measures it: a film
+  // point's irradiance from a uniform surface is the mean over the pupil of its rays' weights where
+  // they pass (LensCamera: cos^4 / D^2 over the sampled disc, pbrt-v4's RealisticCamera). Taken at
+  // the film rather than from the object side (a point's light over the image area its pixel maps
+  // to), it needs no image areas and holds at every depth (every ray that reaches a film point from a
+  // uniform surface brings the same radiance, however far the surface). The object side's estimate,
+  // the beams' light over the chief rays' image area stretched to where their light lands, left the
+  // first-order models 0.011-0.033 of the centre brighter than the truth at the frame's edge on
+  // lentil 0001, 0009 and 0010 wide open, where the exact model is within 0.012: its stretch moved
+  // with a light centroid that a 0.1 px error at the frame's edge turns into 1-2 %.
+  std::vector<double> sensor_rho_px(kSensorRadii), sensor_light(kSensorRadii, 0.0);
+  std::optional<LensCamera> film;
+  try {
+    film.emplace(camera.real_lens() != nullptr ? *camera.real_lens() : camera, std::span<const double>(&wavelength_nm, 1));
+  } catch (const ComputationError&) {
+    return;  // empty: no ray from the film's centre passes the lens
+  }
+  const double sensor_step_px = kSensorReach * reach_px / (kSensorRadii - 1);
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
+  for (int k = 0; k < kSensorRadii; ++k) {
+    const double rho = k * sensor_step_px;
+    const std::array<double, 2> at = film->film_point_mm(centre_x + rho, centre_y);
+    double sum = 0.0;
+    for (int j = 0; j < kPupilSectors; ++j) {
+      // Each sector's rings offset by the golden ratio's multiples: rings at the same radii in every
+      // sector counted a stop concentric with them by whole rings (0.6 % off on the axis at 96 rings).
+      const double offset = std::fmod((j + 0.5) * kGoldenFraction, 1.0);
+      for (int i = 0; i < kPupilRings; ++i) {
+        const CameraRaySample ray = film->sample_ray(at[0], at[1], (i + offset) / kPupilRings, (j + 0.5) / kPupilSectors, wavelength_nm);
+        if (ray.ok()) sum += ray.ray.weight;
+      }
+    }
+    sensor_rho_px[static_cast<std::size_t>(k)] = rho;
+    sensor_light[static_cast<std::size_t>(k)] = sum / (kPupilRings * kPupilSectors);
+  }
+  if (!(sensor_light[0] > 0.0)) return;
+  real_rho_px_ = sensor_rho_px;
+  for (const double light : sensor_light) real_relative_.push_back(light / sensor_light[0]);
   std::vector<Depth> depths(static_cast<std::size_t>(depth_nodes));
   for (int d = 0; d < depth_nodes; ++d) {
     const std::size_t first = static_cast<std::size_t>(d) * kFieldNodes;
     const Beam& model_axis = model_beam[first];
     const Beam& real_axis = real_beam[first];
-    if (!model_axis.lands || !real_axis.lands || !(model_axis.light > 0.0) || !(real_axis.light > 0.0) || !(real_area[first] > 0.0)) {
-      return;  // empty: nothing to scale against
-    }
-    // Brightness B = L / A relative to the axis's; where the output's centre is, from the axes.
-    const double model_axis_b = model_axis.light / model_area[first], real_axis_b = real_axis.light / real_area[first];
+    if (!model_axis.lands || !real_axis.lands || !(model_axis.light > 0.0)) return;  // empty: nothing to scale against
+    // The model's brightness B = L / A relative to the axis's.
+    const double model_axis_b = model_axis.light / model_area[first];
     Depth& depth = depths[static_cast<std::size_t>(d)];
     double rho_before = -1.0;
     for (std::size_t i = 0; i < kFieldNodes; ++i) {
@@ -287,45 +302,18 @@ IlluminationTable::IlluminationTable(const RayModel& model, const PupilMesh& fin
       if (m.lands && rho > rho_before && depth.unfolded + 1 == i) depth.unfolded = i;
       rho_before = m.lands ? rho : kInfinity;
     }
-    // The real lens's brightness by where its light lands, up to where it stops landing or folds
-    // back (a fisheye's aimer beyond its reach): beyond that the last node's holds. The factor is
-    // kept per node (a source's interpolated between them: no search per footprint).
-    std::vector<double> chief_rho;
-    for (std::size_t i = 0; i < kFieldNodes; ++i) {
-      const Beam& r = real_beam[first + i];
-      if (!r.lands || !(real_area[first + i] > 0.0)) break;
-      const double rho = std::hypot(r.light_x_px - real_axis.x_px, r.light_y_px - real_axis.y_px);
-      const double chief = std::hypot(r.x_px - real_axis.x_px, r.y_px - real_axis.y_px);
-      if (!depth.real_rho_px.empty() && !(rho > depth.real_rho_px.back() && chief > chief_rho.back())) break;
-      depth.real_rho_px.push_back(rho);
-      chief_rho.push_back(chief);
-      depth.real_relative.push_back(r.light / real_area[first + i] / real_axis_b);
-    }
-    // The light spreads over the image area of its own landings, not of the chief rays': where they
-    // part (the cliff) it is stretched along the radius by d(light's radius) / d(chief's) and around
-    // the axis by their ratio (on the axis, its limit: the radial stretch), relative to the axis's.
-    const std::size_t kept = depth.real_rho_px.size();
-    if (kept >= 3) {
-      std::vector<double> stretch(kept, 1.0);
-      for (std::size_t i = 0; i < kept; ++i) {
-        const std::size_t a = i == 0 ? 0 : i - 1, b = std::min(i + 1, kept - 1);
-        const double radial = (depth.real_rho_px[b] - depth.real_rho_px[a]) / (chief_rho[b] - chief_rho[a]);
-        const double around = i == 0 ? radial : depth.real_rho_px[i] / chief_rho[i];
-        if (std::isfinite(radial) && std::isfinite(around) && radial > 0.0 && around > 0.0) stretch[i] = radial * around;
-      }
-      for (std::size_t i = 0; i < kept; ++i) depth.real_relative[i] *= stretch[0] / stretch[i];
-    }
+    // The factor is kept per node (a source's interpolated between them: no search per footprint).
     for (std::size_t i = 0; i < kFieldNodes; ++i) depth.factor.push_back(node_factor(depth, i));
     widened_ = widened_ || std::any_of(depth.disc_scale.begin(), depth.disc_scale.end(), [](double k) { return k != 1.0; });
   }
   depths_ = std::move(depths);
 }
 
-double IlluminationTable::node_factor(const Depth& d, std::size_t i) {
+double IlluminationTable::node_factor(const Depth& d, std::size_t i) const {
   const double model = d.model_relative[i];
   if (model < 0.0) return 1.0;             // the model's chief ray lands nowhere: its own light stays
   if (!(model > kNothing)) return 1.0;     // the model passes nothing here (an opaque point that sends no light)
-  return std::clamp(interpolate(d.real_rho_px, d.real_relative, d.model_rho_px[i]) / model, 0.0, kMaxFactor);
+  return std::clamp(interpolate(real_rho_px_, real_relative_, d.model_rho_px[i]) / model, 0.0, kMaxFactor);
 }
 
 template <typename Of>

@@ -21,22 +21,27 @@
 // centres, so its shape is an approximation there.
 //
 // And each footprint's light is scaled by R_real / R_model, R a uniform surface's brightness
-// relative to the axis at the same depth: B = L / A, with L the light a point's beam passes (the
-// mean ray weight over the pupil where the rays pass, measured on a fine polar mesh as the renderer
-// measures it, MappedPupilTable::passing_light) and A the image area its pixel maps to
-// (ImageAreaTable). R_model is taken at the source's own field (with its widened discs), R_real
-// where the model's light lands on the output on average: the brightness the real lens has at that
-// output pixel, the real lens's own brightness placed where its light lands, too. Near a vignetting
+// relative to the axis's. R_model is the model's own at the source's field and depth (with its
+// widened discs): B = L / A, with L the light a point's beam passes (the mean ray weight over the
+// pupil where the rays pass, measured on a fine polar mesh as the renderer measures it,
+// MappedPupilTable::passing_light) and A the image area its pixel maps to (ImageAreaTable). R_real
+// is the real lens's brightness at the output pixel where the model's light lands on average,
+// measured at the film as the ground truth measures it (`lensmith scene render --lens`, LensCamera:
+// a film point's irradiance is the mean over the pupil of its rays' weights where they pass). So a
+// uniform surface is as bright across the frame as through the real lens, whatever the model's
+// distortion (the paraxial model has none), and at every depth (every ray that reaches a film point
+// from a uniform surface brings the same radiance, however far the surface is). Near a vignetting
 // cliff a beam's passing sliver lands well outside its chief ray (lentil 0005 at 55 deg: 3.7 px out
-// on a 192 px frame), and placed at the chief rays' landings the real lens's light ended 3 px short
-// of the truth's: the thin and paraxial models' frame corner 0.005 of the centre where the ground
-// truth has 0.051 (now 0.039). Its brightness there is its light over the image area of those
-// landings (the chief rays' stretched by how the two part, along the radius and around the axis).
-// So a uniform surface is as bright across the frame as through the real lens, whatever the
-// model's distortion (the paraxial model has none); a lone highlight carries the real lens's light
-// times the model's image area over the lens's (1 to 3 % apart where the Seidel model's distortion
-// is the lens's within its third order). The footprint's shape (cat's eye, aberrations) stays the
-// model's own.
+// on a 192 px frame): the model's light is placed where it lands, and takes the real lens's
+// brightness there. A lone highlight carries the real lens's light times the model's image area
+// over the lens's (1 to 3 % apart where the Seidel model's distortion is the lens's within its third
+// order). The footprint's shape (cat's eye, aberrations) stays the model's own.
+//
+// The real brightness was first taken from the object side, as R_model is: the real beams' light
+// over the image area of their chief rays, stretched to where their light lands. That stretch moved
+// with the light's centroid, which a 0.1 px error at the frame's edge turned into 1-2 %: the
+// first-order models came out 0.011-0.033 of the centre brighter than the truth at the frame's edge
+// on lentil 0001, 0009 and 0010 wide open, where the exact model is within 0.012.
 //
 // Tabulated along the field radius (the lens is round: MappedPupilTable::round_lens) at kFieldNodes
 // radii and kDepthNodes inverse depths across the picture's, read by linear interpolation.
@@ -103,15 +108,17 @@ class IlluminationTable {
     std::vector<double> model_relative;  // the model's B / B(axis), or -1 where its chief ray lands nowhere
     std::vector<double> model_rho_px;    // where the model's light lands on average (its chief ray where none
                                          // passes), output px from the axis's
-    std::vector<double> real_rho_px;     // where the exact tracer's light lands, increasing (nodes beyond a fold dropped)
-    std::vector<double> real_relative;   // its B / B(axis) at real_rho_px
     std::vector<double> factor;          // the light factor at each node
   };
-  static double node_factor(const Depth& d, std::size_t i);
+  double node_factor(const Depth& d, std::size_t i) const;
   // Interpolates `of` over the nodes at field radius `radius` and inverse depth w.
   template <typename Of>
   double at(const ScenePoint& point, Of&& of) const;
 
+  // The real lens's brightness at the film (the irradiance from a uniform surface relative to the
+  // frame centre's) at output radii (px) from the frame's centre, the same at every depth.
+  std::vector<double> real_rho_px_;
+  std::vector<double> real_relative_;
   double step_ = 1.0;  // tangent per node
   double w0_ = 0.0, dw_ = 1.0;
   std::vector<Depth> depths_;
