@@ -254,7 +254,8 @@ IlluminationTable::IlluminationTable(const RayModel& model, const PupilMesh& fin
   // first-order models 0.011-0.033 of the centre brighter than the truth at the frame's edge on
   // lentil 0001, 0009 and 0010 wide open, where the exact model is within 0.012: its stretch moved
   // with a light centroid that a 0.1 px error at the frame's edge turns into 1-2 %.
-  std::vector<double> sensor_rho_px(kSensorRadii), sensor_light(kSensorRadii, 0.0);
+  real_rho_px_.assign(kSensorRadii, 0.0);
+  real_relative_.assign(kSensorRadii, 0.0);  // the film's mean ray weight, then relative to the centre's
   std::optional<LensCamera> film;
   try {
     film.emplace(camera.real_lens() != nullptr ? *camera.real_lens() : camera, std::span<const double>(&wavelength_nm, 1));
@@ -276,12 +277,12 @@ IlluminationTable::IlluminationTable(const RayModel& model, const PupilMesh& fin
         if (ray.ok()) sum += ray.ray.weight;
       }
     }
-    sensor_rho_px[static_cast<std::size_t>(k)] = rho;
-    sensor_light[static_cast<std::size_t>(k)] = sum / (kPupilRings * kPupilSectors);
+    real_rho_px_[static_cast<std::size_t>(k)] = rho;
+    real_relative_[static_cast<std::size_t>(k)] = sum / (kPupilRings * kPupilSectors);
   }
-  if (!(sensor_light[0] > 0.0)) return;
-  real_rho_px_ = sensor_rho_px;
-  for (const double light : sensor_light) real_relative_.push_back(light / sensor_light[0]);
+  const double centre_light = real_relative_[0];
+  if (!(centre_light > 0.0)) return;
+  for (double& light : real_relative_) light /= centre_light;
   std::vector<Depth> depths(static_cast<std::size_t>(depth_nodes));
   for (int d = 0; d < depth_nodes; ++d) {
     const std::size_t first = static_cast<std::size_t>(d) * kFieldNodes;

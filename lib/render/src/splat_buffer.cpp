@@ -763,12 +763,17 @@ __attribute__((target("avx2,fma"))) void add_scaled_samples_avx2(const float* sa
   }
   if (k < count) add_scaled_samples_scalar(samples + k, count - k, value, out + 4 * k);
 }
+
+// Whether this processor runs the AVX2 paths above (asked once).
+bool avx2_fma() {
+  static const bool supported = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  return supported;
+}
 #endif
 
 void add_scaled_samples(const float* samples, std::size_t count, const float* value, float* out) {
 #if defined(__GNUC__) && defined(__x86_64__)
-  static const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  if (avx2) return add_scaled_samples_avx2(samples, count, value, out);
+  if (avx2_fma()) return add_scaled_samples_avx2(samples, count, value, out);
 #endif
   add_scaled_samples_scalar(samples, count, value, out);
 }
@@ -776,8 +781,7 @@ void add_scaled_samples(const float* samples, std::size_t count, const float* va
 // Returns the samples' sum.
 float sample_image_row(const float* data, int nx, int ny, float u0, float v0, float du, float dv, std::size_t count, float* out) {
 #if defined(__GNUC__) && defined(__x86_64__)
-  static const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  if (avx2) return sample_image_row_avx2(data, nx, ny, u0, v0, du, dv, count, out);
+  if (avx2_fma()) return sample_image_row_avx2(data, nx, ny, u0, v0, du, dv, count, out);
 #endif
   return sample_image_row_scalar(data, nx, ny, u0, v0, du, dv, count, out);
 }
@@ -894,10 +898,6 @@ void SplatBuffer::add_image(std::span<const float> samples, int nx, int ny, floa
   }
   const double k_px = 1.0 / scale_;
   const float* data = samples.data();
-  const double sum_slope = a00 + a10, difference_slope = a00 - a10;
-  auto inverse = [](double slope) { return slope != 0.0 ? 1.0 / slope : 0.0; };
-  const double inverse_a00 = inverse(a00), inverse_a10 = inverse(a10), inverse_sum = inverse(sum_slope),
-               inverse_difference = inverse(difference_slope);
   // Each row's cells first, for all rows in one short loop, then the rows' samples (interleaved row
   // by row, this bookkeeping took about as long as the samples' gathers). Along a row's centre line
   // u = u0 + a00 x, v = v0 + a10 x at x = cell centre - anchor.x; its cells are those whose centres
@@ -913,9 +913,15 @@ void SplatBuffer::add_image(std::span<const float> samples, int nx, int ny, floa
   const double x_lowest = normalise ? -kInfinity : 0.0, x_highest = normalise ? kInfinity : static_cast<double>(grid_width_ - 1);
   const double x_shift = x_offset_ - 0.5;
   const double scale = scale_, anchor_x = anchor.x, anchor_y = anchor.y;
-  const double inverses[4] = {inverse_a00, inverse_a10, inverse_sum, inverse_difference};
+  // The four bounds: u, v, u + v and u - v, each changing along a row at its slope.
+  const double slopes[4] = {a00, a10, a00 + a10, a00 - a10};
   const double bottoms[4] = {0.0, 0.0, diagonals[0], diagonals[2]}, tops[4] = {um, vm, diagonals[1], diagonals[3]};
-  const bool sloped[4] = {a00 != 0.0, a10 != 0.0, sum_slope != 0.0, difference_slope != 0.0};
+  double inverses[4];
+  bool sloped[4];
+  for (int c = 0; c < 4; ++c) {
+    sloped[c] = slopes[c] != 0.0;
+    inverses[c] = sloped[c] ? 1.0 / slopes[c] : 0.0;
+  }
   for (int i = 0; i < rows; ++i) {
     const double dy = (row_first + i + 0.5) * k_px - anchor_y;
     const double u0 = u_at_anchor + a01 * dy, v0 = v_at_anchor + a11 * dy;
