@@ -84,7 +84,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   // Where the model only approximates the lens's brightness across the frame, the real lens's.
   render_detail::ImageAreaTable areas;
   render_detail::IlluminationTable illumination;
-  const bool real_illumination = render_detail::IlluminationTable::applies(model, aperture, options.vignetting);
+  const bool real_illumination = render_detail::IlluminationTable::applies(model, aperture, options.vignetting, true);
   if ((render_detail::ImageAreaTable::needed(model) || real_illumination) && !sources.empty()) {
     double w_min = sources.front().inverse_depth_per_mm, w_max = w_min;
 #pragma omp parallel for num_threads(threads) reduction(min : w_min) reduction(max : w_max)

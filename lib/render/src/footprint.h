@@ -73,7 +73,7 @@ struct FootprintPlan {
   // distortion (thin, paraxial).
   float area = 1.0f;
   // The factor on its light that makes a uniform surface as bright across the frame as through the
-  // real lens (IlluminationTable; 1 for the thin lens, the exact model and without vignetting).
+  // real lens (IlluminationTable; 1 for an ideal thin lens, a lens that is not round and without vignetting).
   float light = 1.0f;
 };
 
