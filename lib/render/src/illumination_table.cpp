@@ -157,8 +157,8 @@ bool IlluminationTable::applies(const RayModel& model, const Aperture& aperture,
 }
 
 IlluminationTable IlluminationTable::where_applies(const RayModel& model, const Aperture& aperture, bool vignetting, int margin_px,
-                                                   double w_min, double w_max, int threads, bool thin_only) {
-  if ((thin_only && model.kind() != RayModelKind::Thin) || !applies(model, aperture, vignetting)) return {};
+                                                   double w_min, double w_max, int threads, bool thin_only, bool exact_too) {
+  if ((thin_only && model.kind() != RayModelKind::Thin) || !applies(model, aperture, vignetting, exact_too)) return {};
   const PupilMeshTable meshes(aperture);
   const ImageAreaTable areas(model, margin_px, w_min, w_max, threads);
   return IlluminationTable(model, meshes.mesh(PupilMeshTable::light_mesh()), areas, margin_px, w_min, w_max, threads);

@@ -77,8 +77,11 @@ PsfTable::PsfTable(const RayModel& model, const Aperture& aperture, double w_min
   for (double a : area) total_area += a;
   const double wavelength = camera_.reference_wavelength_nm();
   // The real lens's brightness and clipped share for the models that only approximate them
-  // (illumination_table.h): their throughput scaled to it, their discs widened where far too tight.
-  const IlluminationTable illumination = IlluminationTable::where_applies(model, aperture, options_.vignetting, margin, w_min, w_max, threads);
+  // (illumination_table.h): their throughput scaled to it, their discs widened where far too tight;
+  // and the exact model's, whose light lands about its vignetted beams' centroids while the
+  // throughput is spread over the chief rays' image area.
+  const IlluminationTable illumination =
+      IlluminationTable::where_applies(model, aperture, options_.vignetting, margin, w_min, w_max, threads, false, true);
   entries_.resize(static_cast<std::size_t>(kGridX) * kGridY * depths_);
 #pragma omp parallel num_threads(threads)
   {
