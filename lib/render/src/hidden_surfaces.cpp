@@ -129,6 +129,14 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
   cells.reserve(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
   scratch.push_pull.reserve(w, h);
   cells.assign(static_cast<std::size_t>(ww) * wh, PushPullCell<5>{});
+  // The targets' cells: the only ones read below, so the only ones the push-pulls finish.
+  std::vector<std::size_t>& target_cells = scratch.target_cells;
+  target_cells.resize(targets.size());
+  for (std::size_t k = 0; k < targets.size(); ++k) {
+    const std::size_t i = targets[k];
+    target_cells[k] = (i / static_cast<std::size_t>(w) - static_cast<std::size_t>(y0)) * static_cast<std::size_t>(ww) +
+                      (i % static_cast<std::size_t>(w) - static_cast<std::size_t>(x0));
+  }
   // The layer's own whole pixels (the parts of split edge pixels are uncertain estimates).
   for (int i : layers.members(layer)) {
     const ScatterSource& p = sources[static_cast<std::size_t>(i)];
@@ -141,7 +149,7 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
     cell[3] += static_cast<float>(c * p.inverse_depth_per_mm);
     cell[4] += static_cast<float>(c);
   }
-  push_pull(ww, wh, cells, threads, &scratch.push_pull);
+  push_pull(ww, wh, cells, threads, &scratch.push_pull, target_cells);
   // The layer's share of what lies behind the nearer pixels: among the visible parts of this layer
   // and of every farther one, the fraction on this layer, interpolated by the same push-pull. Each
   // farther layer claims only its share, so that composited "over" one another the layers behind an
@@ -174,17 +182,16 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
         }
       }
     }
-    push_pull(ww, wh, shares, threads, &scratch.push_pull_shares);
+    push_pull(ww, wh, shares, threads, &scratch.push_pull_shares, target_cells);
   }
   const std::size_t before = out.size();
-  for (std::size_t i : targets) {
-    const std::size_t wx = i % static_cast<std::size_t>(w) - static_cast<std::size_t>(x0);
-    const std::size_t wy = i / static_cast<std::size_t>(w) - static_cast<std::size_t>(y0);
-    const auto& v = cells[wy * static_cast<std::size_t>(ww) + wx];
+  for (std::size_t k = 0; k < targets.size(); ++k) {
+    const std::size_t i = targets[k];
+    const auto& v = cells[target_cells[k]];
     ScatterSource s;
     s.x = static_cast<int>(i % static_cast<std::size_t>(w));
     s.y = static_cast<int>(i / static_cast<std::size_t>(w));
-    const double share = farther ? shares[wy * static_cast<std::size_t>(ww) + wx][0] : 1.0;
+    const double share = farther ? shares[target_cells[k]][0] : 1.0;
     s.coverage = layers.unknown_behind(i, layer) * static_cast<float>(share);
     if (!(s.coverage > 0.0f)) continue;
     s.coverage_only = mode == HiddenSurfaces::Stretch;

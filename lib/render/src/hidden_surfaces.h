@@ -29,6 +29,7 @@ struct HiddenScratch {
   LargeVector<int> row_distance;
   LargeVector<std::uint8_t> within;
   std::vector<std::size_t> targets;
+  std::vector<std::size_t> target_cells;  // the targets' cells in the push-pull's window
   std::vector<std::vector<std::size_t>> block_targets;  // each thread's block of rows' targets, before they join `targets`
   LargeVector<PushPullCell<5>> cells;   // colour (tone-mapped), inverse depth, weight
   LargeVector<PushPullCell<2>> shares;  // the layer's visible share, weight

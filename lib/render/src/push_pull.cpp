@@ -26,7 +26,8 @@ PushPullCell<N> normalised(const PushPullCell<N>& v) {
 }  // namespace
 
 template <std::size_t N>
-void push_pull(int w, int h, LargeVector<PushPullCell<N>>& cells, int threads, PushPullScratch<N>* scratch) {
+void push_pull(int w, int h, LargeVector<PushPullCell<N>>& cells, int threads, PushPullScratch<N>* scratch,
+               std::span<const std::size_t> finish) {
   using Cell = PushPullCell<N>;
   constexpr std::size_t kWeight = N - 1;
   // Pull: each level sums 2 x 2 blocks of the one below, down to a single cell.
@@ -71,34 +72,41 @@ void push_pull(int w, int h, LargeVector<PushPullCell<N>>& cells, int threads, P
     const LargeVector<Cell>& c = levels[l];
     const int fw = sizes[l].first, fh = sizes[l].second;
     const int cw = sizes[l + 1].first, ch = sizes[l + 1].second;
-#pragma omp parallel for num_threads(threads) schedule(static) if (fw * fh > kParallelCells)
-    for (int y = 0; y < fh; ++y) {
+    // Cell (x, y) of level l from its own sums and the finished level above.
+    auto push = [&](int x, int y) {
       const double cy = std::clamp((y + 0.5) / 2.0 - 0.5, 0.0, static_cast<double>(ch - 1));
       const int y0 = static_cast<int>(cy), y1 = std::min(y0 + 1, ch - 1);
       const double ty = cy - y0;
-      for (int x = 0; x < fw; ++x) {
-        const double cx = std::clamp((x + 0.5) / 2.0 - 0.5, 0.0, static_cast<double>(cw - 1));
-        const int x0 = static_cast<int>(cx), x1 = std::min(x0 + 1, cw - 1);
-        const double tx = cx - x0;
-        const Cell& a = c[static_cast<std::size_t>(y0) * cw + x0];
-        const Cell& b = c[static_cast<std::size_t>(y0) * cw + x1];
-        const Cell& d = c[static_cast<std::size_t>(y1) * cw + x0];
-        const Cell& e = c[static_cast<std::size_t>(y1) * cw + x1];
-        Cell& v = f[static_cast<std::size_t>(y) * fw + x];
-        const Cell own = normalised(v);
-        const double keep = own[kWeight];
-        for (std::size_t k = 0; k < kWeight; ++k) {
-          const double up = (1.0 - ty) * ((1.0 - tx) * a[k] + tx * b[k]) + ty * ((1.0 - tx) * d[k] + tx * e[k]);
-          v[k] = static_cast<float>(keep * own[k] + (1.0 - keep) * up);
-        }
-        // Known wherever the level above is (the coarsest cell is known if any cell was).
-        v[kWeight] = std::max({a[kWeight], b[kWeight], d[kWeight], e[kWeight], own[kWeight]}) > 0.0f ? 1.0f : 0.0f;
+      const double cx = std::clamp((x + 0.5) / 2.0 - 0.5, 0.0, static_cast<double>(cw - 1));
+      const int x0 = static_cast<int>(cx), x1 = std::min(x0 + 1, cw - 1);
+      const double tx = cx - x0;
+      const Cell& a = c[static_cast<std::size_t>(y0) * cw + x0];
+      const Cell& b = c[static_cast<std::size_t>(y0) * cw + x1];
+      const Cell& d = c[static_cast<std::size_t>(y1) * cw + x0];
+      const Cell& e = c[static_cast<std::size_t>(y1) * cw + x1];
+      Cell& v = f[static_cast<std::size_t>(y) * fw + x];
+      const Cell own = normalised(v);
+      const double keep = own[kWeight];
+      for (std::size_t k = 0; k < kWeight; ++k) {
+        const double up = (1.0 - ty) * ((1.0 - tx) * a[k] + tx * b[k]) + ty * ((1.0 - tx) * d[k] + tx * e[k]);
+        v[k] = static_cast<float>(keep * own[k] + (1.0 - keep) * up);
       }
+      // Known wherever the level above is (the coarsest cell is known if any cell was).
+      v[kWeight] = std::max({a[kWeight], b[kWeight], d[kWeight], e[kWeight], own[kWeight]}) > 0.0f ? 1.0f : 0.0f;
+    };
+    if (l == 0 && !finish.empty()) {
+      // Only the cells the caller reads (their values are the same as when every cell is finished).
+      for (const std::size_t i : finish) push(static_cast<int>(i % static_cast<std::size_t>(fw)), static_cast<int>(i / static_cast<std::size_t>(fw)));
+      continue;
+    }
+#pragma omp parallel for num_threads(threads) schedule(static) if (fw * fh > kParallelCells)
+    for (int y = 0; y < fh; ++y) {
+      for (int x = 0; x < fw; ++x) push(x, y);
     }
   }
 }
 
-template void push_pull<2>(int, int, LargeVector<PushPullCell<2>>&, int, PushPullScratch<2>*);
-template void push_pull<5>(int, int, LargeVector<PushPullCell<5>>&, int, PushPullScratch<5>*);
+template void push_pull<2>(int, int, LargeVector<PushPullCell<2>>&, int, PushPullScratch<2>*, std::span<const std::size_t>);
+template void push_pull<5>(int, int, LargeVector<PushPullCell<5>>&, int, PushPullScratch<5>*, std::span<const std::size_t>);
 
 }  // namespace lensmith::render_detail

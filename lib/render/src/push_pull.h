@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstddef>
+#include <span>
 #include <vector>
 
 #include "lensmith/core/huge_page_allocator.h"
@@ -39,8 +40,12 @@ struct PushPullScratch {
 // unknown). Pull sums 2 x 2 blocks down to one cell; push gives every unknown cell its parent's
 // normalised value. On return every cell holds normalised values and weight 1 (all zero if no cell
 // was known). Rows are shared among `threads` threads; the result does not depend on their number.
-// Made for N = 2 (a share) and N = 5 (colour and inverse depth).
+// Made for N = 2 (a share) and N = 5 (colour and inverse depth). `finish`, when not empty: only
+// these cells (y * w + x) are finished on return, each with the value it gets when all are (the
+// others keep partial sums): a caller that reads a few cells of a large grid (the hidden-surface
+// fill's targets) skips the finest level's push, about half the work.
 template <std::size_t N>
-void push_pull(int w, int h, LargeVector<PushPullCell<N>>& cells, int threads = 1, PushPullScratch<N>* scratch = nullptr);
+void push_pull(int w, int h, LargeVector<PushPullCell<N>>& cells, int threads = 1, PushPullScratch<N>* scratch = nullptr,
+               std::span<const std::size_t> finish = {});
 
 }  // namespace lensmith::render_detail
