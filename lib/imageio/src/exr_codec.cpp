@@ -22,8 +22,10 @@
 #include <OpenEXR/ImfThreading.h>
 #include <OpenEXR/ImfVecAttribute.h>
 #include <OpenEXR/openexr.h>
+#include <zlib.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <array>
 #include <atomic>
 #include <cctype>
@@ -76,14 +78,22 @@ bool is_structural(std::string_view name) {
   return false;
 }
 
+// The primaries of a "chromaticities" attribute (rx, ry, gx, gy, bx, by, wx, wy), written as the
+// standard attribute only: a string of that name would hide them from readers.
+std::array<float, 8> chromaticities_of(const ImageAttribute& attribute) {
+  const auto* text = std::get_if<std::string>(&attribute.value);
+  const std::optional<std::array<double, 8>> c = text ? parse_chromaticities(*text) : std::nullopt;
+  if (!c) throw OptionsError("chromaticities attribute: expected eight numbers \"rx, ry, gx, gy, bx, by, wx, wy\"");
+  std::array<float, 8> f{};
+  for (std::size_t i = 0; i < f.size(); ++i) f[i] = static_cast<float>((*c)[i]);
+  return f;
+}
+
 void insert_attributes(Imf::Header& header, const std::vector<ImageAttribute>& attributes) {
   for (const ImageAttribute& attribute : attributes) {
     if (attribute.name == "chromaticities") {
-      // The standard attribute only: a string of that name would hide the primaries from readers.
-      const auto* text = std::get_if<std::string>(&attribute.value);
-      const std::optional<std::array<double, 8>> c = text ? parse_chromaticities(*text) : std::nullopt;
-      if (!c) throw OptionsError("chromaticities attribute: expected eight numbers \"rx, ry, gx, gy, bx, by, wx, wy\"");
-      const auto xy = [&](int i) { return Imath::V2f(static_cast<float>((*c)[i]), static_cast<float>((*c)[i + 1])); };
+      const std::array<float, 8> c = chromaticities_of(attribute);
+      const auto xy = [&](std::size_t i) { return Imath::V2f(c[i], c[i + 1]); };
       header.insert("chromaticities", Imf::ChromaticitiesAttribute(Imf::Chromaticities(xy(0), xy(2), xy(4), xy(6))));
     } else if (const auto* text = std::get_if<std::string>(&attribute.value)) {
       header.insert(exr_name(attribute.name), Imf::StringAttribute(*text));
@@ -598,6 +608,51 @@ Metadata read_exr_metadata(const fs::path& path) {
   return metadata;
 }
 
+namespace {
+
+// The last message of the OpenEXR C library's error handler on this thread (its default handler
+// prints to stderr; a lensmith error says what failed instead).
+thread_local std::string core_error;
+
+void note_core_error(exr_const_context_t, exr_result_t, const char* message) { core_error = message ? message : ""; }
+
+// A C-library write context, finished (its chunk table written, the file closed) when it goes.
+struct CoreWriteContext {
+  exr_context_t context = nullptr;
+  CoreWriteContext() = default;
+  CoreWriteContext(const CoreWriteContext&) = delete;
+  CoreWriteContext& operator=(const CoreWriteContext&) = delete;
+  ~CoreWriteContext() {
+    if (context != nullptr) exr_finish(&context);
+  }
+};
+
+// OpenEXR's ZIP block filter (ImfZip.cpp, internal_zip.c): the bytes split into the even and the odd
+// ones, then each byte replaced by its difference to the one before plus 128. Float samples' high
+// bytes then run in long similar stretches that deflate compresses.
+void zip_filter(const std::uint8_t* raw, std::size_t n, std::uint8_t* out) {
+  std::uint8_t* first = out;
+  std::uint8_t* second = out + (n + 1) / 2;
+  for (std::size_t i = 0; i + 1 < n; i += 2) {
+    *first++ = raw[i];
+    *second++ = raw[i + 1];
+  }
+  if (n % 2 == 1) *first = raw[n - 1];
+  int previous = n > 0 ? out[0] : 0;
+  for (std::size_t i = 1; i < n; ++i) {
+    const int d = int{out[i]} - previous + (128 + 256);
+    previous = out[i];
+    out[i] = static_cast<std::uint8_t>(d);
+  }
+}
+
+}  // namespace
+
+// Written with OpenEXR's C library (3.1's "core"): the blocks of 16 scanlines are packed, filtered and
+// deflated here, all at once on the codec threads (OpenMP: after a render, its threads), then written
+// in order. OpenEXR's C++ writer compresses a block at a time on its own pool behind its writer: a
+// 600 x 400 RGB float picture took 14-15 ms on 2 threads, of which zlib's (libdeflate's) work is
+// about 8 ms a thread (docs/performance.md). The file is the same ZIP-compressed OpenEXR.
 void write_exr_file(const fs::path& path, const std::string& file, const PixelsView<float>& pixels,
                     const std::vector<std::string>& channel_names, const std::vector<ImageAttribute>& attributes,
                     const std::optional<std::pair<PixelBox, PixelBox>>& windows) {
@@ -607,35 +662,130 @@ void write_exr_file(const fs::path& path, const std::string& file, const PixelsV
       throw OptionsError(path.string() + ": channel name '" + name + "' is empty or repeated: each channel needs its own name");
     }
   }
-  size_codec_pool();
-  try {
-    Imf::Header header(pixels.width, pixels.height);
-    if (windows) {
-      const auto box = [](const PixelBox& b) { return Imath::Box2i({b.min_x, b.min_y}, {b.max_x, b.max_y}); };
-      header.dataWindow() = box(windows->first);
-      header.displayWindow() = box(windows->second);
-    }
-    header.compression() = Imf::ZIP_COMPRESSION;
-    // zlib level 1 instead of OpenEXR's 4: a 600 x 400 float RGB render wrote in 0.040 s instead of
-    // 0.051 s on 2 threads, 0.4 % larger (float mantissas hardly compress at any level).
-    header.zipCompressionLevel() = kZipLevel;
-    insert_attributes(header, attributes);
-    Imf::FrameBuffer frame;
-    const auto stride = static_cast<std::size_t>(pixels.channels);
-    for (std::size_t c = 0; c < channel_names.size(); ++c) {
-      header.channels().insert(channel_names[c], Imf::Channel(Imf::FLOAT));
-      frame.insert(channel_names[c], Imf::Slice::Make(Imf::FLOAT, pixels.samples.data() + c, header.dataWindow(),
-                                                      stride * sizeof(float),
-                                                      static_cast<std::size_t>(pixels.width) * stride * sizeof(float)));
-    }
-    Imf::OutputFile out(file.c_str(), header);
-    out.setFrameBuffer(frame);
-    out.writePixels(pixels.height);
-  } catch (const Error&) {
-    throw;
-  } catch (const std::exception& e) {
-    throw IoError(path.string() + ": cannot write the OpenEXR image: " + e.what());
+  const auto fail = [&](exr_result_t code, const std::string& what) {
+    const std::string detail = core_error.empty() ? exr_get_default_error_message(code) : core_error;
+    throw IoError(path.string() + ": cannot write the OpenEXR image (" + what + "): " + detail);
+  };
+  core_error.clear();
+  exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+  init.error_handler_fn = note_core_error;
+  init.zip_level = kZipLevel;
+  CoreWriteContext out;
+  if (const exr_result_t rc = exr_start_write(&out.context, file.c_str(), EXR_WRITE_FILE_DIRECTLY, &init); rc != EXR_ERR_SUCCESS) {
+    out.context = nullptr;
+    fail(rc, "opening it");
   }
+  exr_context_t ctx = out.context;
+  // Names past 31 bytes need the file's long-names flag (OpenEXR 1.7 on), set only where they occur
+  // as OpenEXR's C++ writer does (lensmith:estimated_relative_error is 33).
+  constexpr std::size_t kShortName = 31;
+  const bool long_names = std::any_of(attributes.begin(), attributes.end(), [&](const ImageAttribute& a) { return exr_name(a.name).size() > kShortName; }) ||
+                          std::any_of(channel_names.begin(), channel_names.end(), [&](const std::string& n) { return n.size() > kShortName; });
+  if (long_names) {
+    if (const exr_result_t rc = exr_set_longname_support(ctx, 1); rc != EXR_ERR_SUCCESS) fail(rc, "long names");
+  }
+  int part = 0;
+  if (const exr_result_t rc = exr_add_part(ctx, "", EXR_STORAGE_SCANLINE, &part); rc != EXR_ERR_SUCCESS) fail(rc, "its part");
+  const auto box = [](const PixelBox& b) {
+    exr_attr_box2i_t e{};
+    e.min.x = b.min_x;
+    e.min.y = b.min_y;
+    e.max.x = b.max_x;
+    e.max.y = b.max_y;
+    return e;
+  };
+  const PixelBox whole{0, 0, pixels.width - 1, pixels.height - 1};
+  const exr_attr_box2i_t data = box(windows ? windows->first : whole), display = box(windows ? windows->second : whole);
+  const exr_attr_v2f_t centre{};
+  if (const exr_result_t rc =
+          exr_initialize_required_attr(ctx, part, &display, &data, 1.0f, &centre, 1.0f, EXR_LINEORDER_INCREASING_Y, EXR_COMPRESSION_ZIP);
+      rc != EXR_ERR_SUCCESS) {
+    fail(rc, "its windows");
+  }
+  for (const std::string& name : channel_names) {
+    if (const exr_result_t rc = exr_add_channel(ctx, part, name.c_str(), EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
+        rc != EXR_ERR_SUCCESS) {
+      fail(rc, "channel " + name);
+    }
+  }
+  for (const ImageAttribute& attribute : attributes) {
+    const std::string name = exr_name(attribute.name);
+    exr_result_t rc = EXR_ERR_SUCCESS;
+    if (attribute.name == "chromaticities") {
+      const std::array<float, 8> c = chromaticities_of(attribute);
+      const exr_attr_chromaticities_t k{c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]};
+      rc = exr_attr_set_chromaticities(ctx, part, name.c_str(), &k);
+    } else if (const auto* text = std::get_if<std::string>(&attribute.value)) {
+      rc = exr_attr_set_string(ctx, part, name.c_str(), text->c_str());
+    } else if (name == "pixelAspectRatio") {
+      rc = exr_set_pixel_aspect_ratio(ctx, part, static_cast<float>(std::get<double>(attribute.value)));
+    } else if (attribute.exr_float) {
+      rc = exr_attr_set_float(ctx, part, name.c_str(), static_cast<float>(std::get<double>(attribute.value)));
+    } else {
+      rc = exr_attr_set_double(ctx, part, name.c_str(), std::get<double>(attribute.value));
+    }
+    if (rc != EXR_ERR_SUCCESS) fail(rc, "attribute " + name);
+  }
+  if (const exr_result_t rc = exr_write_header(ctx); rc != EXR_ERR_SUCCESS) fail(rc, "its header");
+
+  // A block's lines, each line its channels in the file's (sorted) order, each channel the row's
+  // samples (little-endian floats, as x86 and ARM hold them).
+  const exr_attr_chlist_t* list = nullptr;
+  if (const exr_result_t rc = exr_get_channels(ctx, part, &list); rc != EXR_ERR_SUCCESS) fail(rc, "its channels");
+  std::vector<std::size_t> source(static_cast<std::size_t>(list->num_channels));
+  for (std::size_t c = 0; c < source.size(); ++c) {
+    const std::string_view name(list->entries[c].name.str, static_cast<std::size_t>(list->entries[c].name.length));
+    source[c] = static_cast<std::size_t>(std::find(channel_names.begin(), channel_names.end(), name) - channel_names.begin());
+  }
+  int32_t lines_per_block = 0;
+  if (const exr_result_t rc = exr_get_scanlines_per_chunk(ctx, part, &lines_per_block); rc != EXR_ERR_SUCCESS) fail(rc, "its blocks");
+  const auto width = static_cast<std::size_t>(pixels.width), stride = static_cast<std::size_t>(pixels.channels);
+  const int blocks = (pixels.height + lines_per_block - 1) / lines_per_block;
+  std::vector<std::vector<std::uint8_t>> packed(static_cast<std::size_t>(blocks));
+  bool deflated = true;
+#pragma omp parallel num_threads(std::max(1, codec_thread_count()))
+  {
+    std::vector<std::uint8_t> raw, filtered;
+#pragma omp for schedule(dynamic, 1)
+    for (int b = 0; b < blocks; ++b) {
+      const int y0 = b * lines_per_block, y1 = std::min(pixels.height, y0 + lines_per_block);
+      const std::size_t bytes = static_cast<std::size_t>(y1 - y0) * width * source.size() * sizeof(float);
+      raw.resize(bytes);
+      auto* line = reinterpret_cast<float*>(raw.data());
+      for (int y = y0; y < y1; ++y) {
+        const float* row = pixels.samples.data() + static_cast<std::size_t>(y) * width * stride;
+        for (const std::size_t c : source) {
+          for (std::size_t x = 0; x < width; ++x) line[x] = row[x * stride + c];
+          line += width;
+        }
+      }
+      filtered.resize(bytes);
+      zip_filter(raw.data(), bytes, filtered.data());
+      std::vector<std::uint8_t>& block = packed[static_cast<std::size_t>(b)];
+      uLongf size = compressBound(static_cast<uLong>(bytes));
+      block.resize(size);
+      const int rc = compress2(block.data(), &size, filtered.data(), static_cast<uLong>(bytes), kZipLevel);
+      if (rc != Z_OK) {
+#pragma omp atomic write
+        deflated = false;
+      } else if (size >= bytes) {
+        block = raw;  // OpenEXR keeps a block that does not shrink as it is (its readers know it by its size)
+      } else {
+        block.resize(size);
+      }
+    }
+  }
+  if (!deflated) throw IoError(path.string() + ": cannot write the OpenEXR image: zlib failed to compress a block");
+  for (int b = 0; b < blocks; ++b) {
+    const std::vector<std::uint8_t>& block = packed[static_cast<std::size_t>(b)];
+    if (const exr_result_t rc = exr_write_scanline_chunk(ctx, part, data.min.y + b * lines_per_block, block.data(), block.size());
+        rc != EXR_ERR_SUCCESS) {
+      fail(rc, "block " + std::to_string(b));
+    }
+  }
+  const exr_result_t rc = exr_finish(&out.context);
+  out.context = nullptr;
+  if (rc != EXR_ERR_SUCCESS) fail(rc, "closing it");
 }
 
 }  // namespace lensmith::codecs

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include <omp.h>
@@ -29,8 +31,11 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
   // bounding box of the layer's pixels in the frame widened by the reach (a layer of a few distant
   // lights costs that box, not the frame).
   int bx0 = w, bx1 = -1, by0 = h, by1 = -1;
-  for (int i : layers.members(layer)) {
-    const ScatterSource& p = sources[static_cast<std::size_t>(i)];
+  const std::span<const int> members = layers.members(layer);
+  const auto member_count = static_cast<std::ptrdiff_t>(members.size());
+#pragma omp parallel for num_threads(threads) schedule(static) reduction(min : bx0, by0) reduction(max : bx1, by1)
+  for (std::ptrdiff_t k = 0; k < member_count; ++k) {
+    const ScatterSource& p = sources[static_cast<std::size_t>(members[static_cast<std::size_t>(k)])];
     if (p.x < 0 || p.y < 0 || p.x >= w || p.y >= h) continue;  // the scatter's margin
     bx0 = std::min(bx0, p.x);
     bx1 = std::max(bx1, p.x);
@@ -137,17 +142,24 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
     target_cells[k] = (i / static_cast<std::size_t>(w) - static_cast<std::size_t>(y0)) * static_cast<std::size_t>(ww) +
                       (i % static_cast<std::size_t>(w) - static_cast<std::size_t>(x0));
   }
-  // The layer's own whole pixels (the parts of split edge pixels are uncertain estimates).
-  for (int i : layers.members(layer)) {
-    const ScatterSource& p = sources[static_cast<std::size_t>(i)];
-    if (p.x < x0 || p.x > x1 || p.y < y0 || p.y > y1 || p.coverage < 1.0f) continue;
-    PushPullCell<5>& cell = cells[static_cast<std::size_t>(p.y - y0) * ww + (p.x - x0)];
-    const double c = p.coverage;
-    cell[0] += static_cast<float>(c * tone(p.rgb[0] / p.coverage));
-    cell[1] += static_cast<float>(c * tone(p.rgb[1] / p.coverage));
-    cell[2] += static_cast<float>(c * tone(p.rgb[2] / p.coverage));
-    cell[3] += static_cast<float>(c * p.inverse_depth_per_mm);
-    cell[4] += static_cast<float>(c);
+  // The layer's own whole pixels (the parts of split edge pixels are uncertain estimates). Each thread
+  // adds those of its block of the window's rows, in the members' order (a deep pixel's opaque
+  // samples may share a cell), so the sums are the same whatever the threads.
+#pragma omp parallel num_threads(threads)
+  {
+    const int t = omp_get_thread_num(), n = omp_get_num_threads();
+    const int ya = y0 + static_cast<int>(static_cast<long long>(wh) * t / n), yb = y0 + static_cast<int>(static_cast<long long>(wh) * (t + 1) / n);
+    for (const int i : members) {
+      const ScatterSource& p = sources[static_cast<std::size_t>(i)];
+      if (p.y < ya || p.y >= yb || p.x < x0 || p.x > x1 || p.coverage < 1.0f) continue;
+      PushPullCell<5>& cell = cells[static_cast<std::size_t>(p.y - y0) * ww + (p.x - x0)];
+      const double c = p.coverage;
+      cell[0] += static_cast<float>(c * tone(p.rgb[0] / p.coverage));
+      cell[1] += static_cast<float>(c * tone(p.rgb[1] / p.coverage));
+      cell[2] += static_cast<float>(c * tone(p.rgb[2] / p.coverage));
+      cell[3] += static_cast<float>(c * p.inverse_depth_per_mm);
+      cell[4] += static_cast<float>(c);
+    }
   }
   push_pull(ww, wh, cells, threads, &scratch.push_pull, target_cells);
   // The layer's share of what lies behind the nearer pixels: among the visible parts of this layer
