@@ -59,13 +59,17 @@ double frame_edge_gap_px(const RayModel& model) {
   return gap;
 }
 
-double clamp_inverse_depth(const Camera& camera, double w, double max_blur_px, std::size_t& clamped) {
+double clamp_inverse_depth(const Camera& camera, double w, double max_blur_px, std::size_t& clamped, double* coc_px) {
   const double nearest_mm = std::max(camera.z_perspective_mm(), 0.0) + kNearestObjectMm;
   if (w > 1.0 / nearest_mm) {
     w = 1.0 / nearest_mm;
     ++clamped;
   }
-  if (std::abs(camera.signed_coc_px(w)) <= max_blur_px) return w;
+  const double coc = camera.signed_coc_px(w);
+  if (std::abs(coc) <= max_blur_px) {
+    if (coc_px) *coc_px = coc;
+    return w;
+  }
   // Bisect between the focus plane (no blur) and w for the depth whose blur is the limit.
   double in = inverse_per_mm(camera.focus_distance_mm()), out = w;
   for (int k = 0; k < kClampBisections; ++k) {
@@ -73,6 +77,7 @@ double clamp_inverse_depth(const Camera& camera, double w, double max_blur_px, s
     (std::abs(camera.signed_coc_px(mid)) <= max_blur_px ? in : out) = mid;
   }
   ++clamped;
+  if (coc_px) *coc_px = camera.signed_coc_px(in);
   return in;
 }
 
@@ -99,11 +104,12 @@ ClampedDepths clamped_inverse_depths(const Camera& camera, const DepthMap& depth
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-      const double inverse = clamp_inverse_depth(camera, inverse_depth_per_mm(depth.at(x, y)), max_blur_px, clamped);
+      double coc = 0.0;
+      const double inverse = clamp_inverse_depth(camera, inverse_depth_per_mm(depth.at(x, y)), max_blur_px, clamped, &coc);
       out.inverse[p] = inverse;
       w_min = std::min(w_min, inverse);
       w_max = std::max(w_max, inverse);
-      max_blur = std::max(max_blur, std::abs(camera.signed_coc_px(inverse)));
+      max_blur = std::max(max_blur, std::abs(coc));
     }
   }
   out.w_min = w_min;
@@ -132,8 +138,7 @@ ScatterSources make_scatter_sources(const Image& image, const DepthMap& depth, c
       s.x = x;
       s.y = y;
       s.rgb = {image.at(x, y, 0), image.at(x, y, 1), image.at(x, y, 2)};
-      s.inverse_depth_per_mm = clamp_inverse_depth(camera, inverse_depth_per_mm(depth.at(x, y)), options.max_blur_px, clamped);
-      s.coc_px = camera.signed_coc_px(s.inverse_depth_per_mm);
+      s.inverse_depth_per_mm = clamp_inverse_depth(camera, inverse_depth_per_mm(depth.at(x, y)), options.max_blur_px, clamped, &s.coc_px);
       coc_min = std::min(coc_min, s.coc_px);
       coc_max = std::max(coc_max, s.coc_px);
     }

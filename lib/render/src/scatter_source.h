@@ -60,7 +60,10 @@ double frame_edge_gap_px(const RayModel& model);
 
 // Inverse depth (1/mm) clamped to 1 mm in front of the lens and to `max_blur_px`; `clamped` counts
 // the changed ones.
-double clamp_inverse_depth(const Camera& camera, double inverse_depth_per_mm, double max_blur_px, std::size_t& clamped);
+// `coc_px`, when given, gets the signed blur (px) at the returned inverse depth (Camera::signed_coc_px),
+// which the clamp computes anyway.
+double clamp_inverse_depth(const Camera& camera, double inverse_depth_per_mm, double max_blur_px, std::size_t& clamped,
+                           double* coc_px = nullptr);
 
 // The one-surface-per-pixel methods' inputs checked: the picture (3 channels) and its depth both the
 // camera's size, and an aperture they can draw (no mask). OptionsError naming `function` and
