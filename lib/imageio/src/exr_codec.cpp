@@ -25,8 +25,8 @@
 #include <zlib.h>
 
 #include <algorithm>
-#include <cstdint>
 #include <array>
+#include <cstdint>
 #include <atomic>
 #include <cctype>
 #include <memory>
@@ -679,8 +679,9 @@ void write_exr_file(const fs::path& path, const std::string& file, const PixelsV
   // Names past 31 bytes need the file's long-names flag (OpenEXR 1.7 on), set only where they occur
   // as OpenEXR's C++ writer does (lensmith:estimated_relative_error is 33).
   constexpr std::size_t kShortName = 31;
-  const bool long_names = std::any_of(attributes.begin(), attributes.end(), [&](const ImageAttribute& a) { return exr_name(a.name).size() > kShortName; }) ||
-                          std::any_of(channel_names.begin(), channel_names.end(), [&](const std::string& n) { return n.size() > kShortName; });
+  const bool long_names =
+      std::any_of(attributes.begin(), attributes.end(), [&](const ImageAttribute& a) { return exr_name(a.name).size() > kShortName; }) ||
+      std::any_of(channel_names.begin(), channel_names.end(), [&](const std::string& n) { return n.size() > kShortName; });
   if (long_names) {
     if (const exr_result_t rc = exr_set_longname_support(ctx, 1); rc != EXR_ERR_SUCCESS) fail(rc, "long names");
   }

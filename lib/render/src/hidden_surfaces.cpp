@@ -148,7 +148,8 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
 #pragma omp parallel num_threads(threads)
   {
     const int t = omp_get_thread_num(), n = omp_get_num_threads();
-    const int ya = y0 + static_cast<int>(static_cast<long long>(wh) * t / n), yb = y0 + static_cast<int>(static_cast<long long>(wh) * (t + 1) / n);
+    const int ya = y0 + static_cast<int>(static_cast<long long>(wh) * t / n);
+    const int yb = y0 + static_cast<int>(static_cast<long long>(wh) * (t + 1) / n);
     for (const int i : members) {
       const ScatterSource& p = sources[static_cast<std::size_t>(i)];
       if (p.y < ya || p.y >= yb || p.x < x0 || p.x > x1 || p.coverage < 1.0f) continue;

@@ -152,7 +152,8 @@ bool IlluminationTable::applies(const RayModel& model, const Aperture& aperture,
   // A thin model stands for a real lens only where it was made for one (Camera::real_lens).
   const Camera& real = model.camera().real_lens() != nullptr ? *model.camera().real_lens() : model.camera();
   return vignetting &&
-         (kind == RayModelKind::Thin || kind == RayModelKind::Paraxial || kind == RayModelKind::Seidel || kind == RayModelKind::Poly || (exact_too && kind == RayModelKind::Exact)) &&
+         (kind == RayModelKind::Thin || kind == RayModelKind::Paraxial || kind == RayModelKind::Seidel || kind == RayModelKind::Poly ||
+          (exact_too && kind == RayModelKind::Exact)) &&
          aperture.kind() != Aperture::Kind::Mask && MappedPupilTable::round_lens(real);
 }
 

@@ -96,7 +96,8 @@ void push_pull(int w, int h, LargeVector<PushPullCell<N>>& cells, int threads, P
     };
     if (l == 0 && !finish.empty()) {
       // Only the cells the caller reads (their values are the same as when every cell is finished).
-      for (const std::size_t i : finish) push(static_cast<int>(i % static_cast<std::size_t>(fw)), static_cast<int>(i / static_cast<std::size_t>(fw)));
+      const auto row = static_cast<std::size_t>(fw);
+      for (const std::size_t i : finish) push(static_cast<int>(i % row), static_cast<int>(i / row));
       continue;
     }
 #pragma omp parallel for num_threads(threads) schedule(static) if (fw * fh > kParallelCells)
