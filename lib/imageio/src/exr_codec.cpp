@@ -35,6 +35,7 @@
 #include <set>
 #include <string_view>
 #include <thread>
+#include <variant>
 
 #include "codecs.h"
 #include "lensmith/core/ascii_text.h"
@@ -78,29 +79,41 @@ bool is_structural(std::string_view name) {
   return false;
 }
 
-// The primaries of a "chromaticities" attribute (rx, ry, gx, gy, bx, by, wx, wy), written as the
-// standard attribute only: a string of that name would hide them from readers.
-std::array<float, 8> chromaticities_of(const ImageAttribute& attribute) {
-  const auto* text = std::get_if<std::string>(&attribute.value);
-  const std::optional<std::array<double, 8>> c = text ? parse_chromaticities(*text) : std::nullopt;
-  if (!c) throw OptionsError("chromaticities attribute: expected eight numbers \"rx, ry, gx, gy, bx, by, wx, wy\"");
-  std::array<float, 8> f{};
-  for (std::size_t i = 0; i < f.size(); ++i) f[i] = static_cast<float>((*c)[i]);
-  return f;
+// An attribute as OpenEXR stores it: its OpenEXR name and typed value. "chromaticities" becomes the
+// standard attribute's primaries (rx, ry, gx, gy, bx, by, wx, wy) only: a string of that name would
+// hide them from readers. Numbers are floats where the attribute says (OpenEXR's standard ones).
+struct ExrAttribute {
+  std::string name;
+  std::variant<std::array<float, 8>, std::string, float, double> value;
+};
+
+ExrAttribute exr_attribute(const ImageAttribute& attribute) {
+  if (attribute.name == "chromaticities") {
+    const auto* text = std::get_if<std::string>(&attribute.value);
+    const std::optional<std::array<double, 8>> c = text ? parse_chromaticities(*text) : std::nullopt;
+    if (!c) throw OptionsError("chromaticities attribute: expected eight numbers \"rx, ry, gx, gy, bx, by, wx, wy\"");
+    std::array<float, 8> f{};
+    for (std::size_t i = 0; i < f.size(); ++i) f[i] = static_cast<float>((*c)[i]);
+    return {"chromaticities", f};
+  }
+  if (const auto* text = std::get_if<std::string>(&attribute.value)) return {exr_name(attribute.name), *text};
+  const double number = std::get<double>(attribute.value);
+  if (attribute.exr_float) return {exr_name(attribute.name), static_cast<float>(number)};
+  return {exr_name(attribute.name), number};
 }
 
 void insert_attributes(Imf::Header& header, const std::vector<ImageAttribute>& attributes) {
   for (const ImageAttribute& attribute : attributes) {
-    if (attribute.name == "chromaticities") {
-      const std::array<float, 8> c = chromaticities_of(attribute);
-      const auto xy = [&](std::size_t i) { return Imath::V2f(c[i], c[i + 1]); };
-      header.insert("chromaticities", Imf::ChromaticitiesAttribute(Imf::Chromaticities(xy(0), xy(2), xy(4), xy(6))));
-    } else if (const auto* text = std::get_if<std::string>(&attribute.value)) {
-      header.insert(exr_name(attribute.name), Imf::StringAttribute(*text));
-    } else if (attribute.exr_float) {
-      header.insert(exr_name(attribute.name), Imf::FloatAttribute(static_cast<float>(std::get<double>(attribute.value))));
+    const ExrAttribute a = exr_attribute(attribute);
+    if (const auto* c = std::get_if<std::array<float, 8>>(&a.value)) {
+      const auto xy = [&](std::size_t i) { return Imath::V2f((*c)[i], (*c)[i + 1]); };
+      header.insert(a.name, Imf::ChromaticitiesAttribute(Imf::Chromaticities(xy(0), xy(2), xy(4), xy(6))));
+    } else if (const auto* text = std::get_if<std::string>(&a.value)) {
+      header.insert(a.name, Imf::StringAttribute(*text));
+    } else if (const auto* f = std::get_if<float>(&a.value)) {
+      header.insert(a.name, Imf::FloatAttribute(*f));
     } else {
-      header.insert(exr_name(attribute.name), Imf::DoubleAttribute(std::get<double>(attribute.value)));
+      header.insert(a.name, Imf::DoubleAttribute(std::get<double>(a.value)));
     }
   }
 }
@@ -710,22 +723,24 @@ void write_exr_file(const fs::path& path, const std::string& file, const PixelsV
     }
   }
   for (const ImageAttribute& attribute : attributes) {
-    const std::string name = exr_name(attribute.name);
+    const ExrAttribute a = exr_attribute(attribute);
+    const char* name = a.name.c_str();
     exr_result_t rc = EXR_ERR_SUCCESS;
-    if (attribute.name == "chromaticities") {
-      const std::array<float, 8> c = chromaticities_of(attribute);
-      const exr_attr_chromaticities_t k{c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]};
-      rc = exr_attr_set_chromaticities(ctx, part, name.c_str(), &k);
-    } else if (const auto* text = std::get_if<std::string>(&attribute.value)) {
-      rc = exr_attr_set_string(ctx, part, name.c_str(), text->c_str());
-    } else if (name == "pixelAspectRatio") {
-      rc = exr_set_pixel_aspect_ratio(ctx, part, static_cast<float>(std::get<double>(attribute.value)));
-    } else if (attribute.exr_float) {
-      rc = exr_attr_set_float(ctx, part, name.c_str(), static_cast<float>(std::get<double>(attribute.value)));
+    if (const auto* c = std::get_if<std::array<float, 8>>(&a.value)) {
+      const exr_attr_chromaticities_t k{(*c)[0], (*c)[1], (*c)[2], (*c)[3], (*c)[4], (*c)[5], (*c)[6], (*c)[7]};
+      rc = exr_attr_set_chromaticities(ctx, part, name, &k);
+    } else if (const auto* text = std::get_if<std::string>(&a.value)) {
+      rc = exr_attr_set_string(ctx, part, name, text->c_str());
     } else {
-      rc = exr_attr_set_double(ctx, part, name.c_str(), std::get<double>(attribute.value));
+      const auto* f = std::get_if<float>(&a.value);
+      const double number = f ? *f : std::get<double>(a.value);
+      if (a.name == "pixelAspectRatio") {
+        rc = exr_set_pixel_aspect_ratio(ctx, part, static_cast<float>(number));  // a required attribute: its own setter
+      } else {
+        rc = f ? exr_attr_set_float(ctx, part, name, *f) : exr_attr_set_double(ctx, part, name, number);
+      }
     }
-    if (rc != EXR_ERR_SUCCESS) fail(rc, "attribute " + name);
+    if (rc != EXR_ERR_SUCCESS) fail(rc, "attribute " + a.name);
   }
   if (const exr_result_t rc = exr_write_header(ctx); rc != EXR_ERR_SUCCESS) fail(rc, "its header");
 

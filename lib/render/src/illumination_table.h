@@ -13,7 +13,7 @@
 // ground truth there within 0.004 (a film point's projected solid angle of passing directions, and a
 // point's passing flux over its light centroids' image area). So the exact model takes the table too:
 // its factor is 1 where the centroid is the chief ray's, and makes the wall agree with the truth
-// within 0.008 on that lens. The first-order models (paraxial, Seidel) take the
+// within 0.004 on that lens (radial profile; 0.006 on the test's strip). The first-order models (paraxial, Seidel) take the
 // solid angle of the paraxial pupil and first-order images of the clear apertures (discs), the poly
 // model a fit's weights, and the thin model of a lens (its EFL and f-number) nothing at all: it was
 // flat to the corners where the double Gauss of issue 12 at f/2 falls to 0.65. On a retrofocus

@@ -72,11 +72,20 @@ void push_pull(int w, int h, LargeVector<PushPullCell<N>>& cells, int threads, P
     const LargeVector<Cell>& c = levels[l];
     const int fw = sizes[l].first, fh = sizes[l].second;
     const int cw = sizes[l + 1].first, ch = sizes[l + 1].second;
-    // Cell (x, y) of level l from its own sums and the finished level above.
-    auto push = [&](int x, int y) {
+    // Row y's rows of the level above and the weight between them.
+    struct Above {
+      int y0, y1;
+      double ty;
+    };
+    auto above = [&](int y) {
       const double cy = std::clamp((y + 0.5) / 2.0 - 0.5, 0.0, static_cast<double>(ch - 1));
-      const int y0 = static_cast<int>(cy), y1 = std::min(y0 + 1, ch - 1);
-      const double ty = cy - y0;
+      const int y0 = static_cast<int>(cy);
+      return Above{y0, std::min(y0 + 1, ch - 1), cy - y0};
+    };
+    // Cell (x, y) of level l from its own sums and the finished level above.
+    auto push = [&](int x, int y, const Above& r) {
+      const int y0 = r.y0, y1 = r.y1;
+      const double ty = r.ty;
       const double cx = std::clamp((x + 0.5) / 2.0 - 0.5, 0.0, static_cast<double>(cw - 1));
       const int x0 = static_cast<int>(cx), x1 = std::min(x0 + 1, cw - 1);
       const double tx = cx - x0;
@@ -97,12 +106,16 @@ void push_pull(int w, int h, LargeVector<PushPullCell<N>>& cells, int threads, P
     if (l == 0 && !finish.empty()) {
       // Only the cells the caller reads (their values are the same as when every cell is finished).
       const auto row = static_cast<std::size_t>(fw);
-      for (const std::size_t i : finish) push(static_cast<int>(i % row), static_cast<int>(i / row));
+      for (const std::size_t i : finish) {
+        const auto y = static_cast<int>(i / row);
+        push(static_cast<int>(i % row), y, above(y));
+      }
       continue;
     }
 #pragma omp parallel for num_threads(threads) schedule(static) if (fw * fh > kParallelCells)
     for (int y = 0; y < fh; ++y) {
-      for (int x = 0; x < fw; ++x) push(x, y);
+      const Above r = above(y);
+      for (int x = 0; x < fw; ++x) push(x, y, r);
     }
   }
 }
