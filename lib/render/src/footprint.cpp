@@ -1257,7 +1257,11 @@ bool starts_run(std::span<const ScatterSource> sources, std::size_t i) {
 void plan_range_starts(std::span<const ScatterSource> sources, std::size_t target, std::vector<std::size_t>& starts) {
   starts.clear();
   for (std::size_t i = 0; i < sources.size(); i += target) {
-    while (!starts_run(sources, i)) ++i;
+    // Where no run continues across (a row's first pixel, a gap): a range that ended at a run's
+    // kShapeStride column cut the run short of the column it would have shared with the next
+    // (plan_range), so a split edge pixel far away, appended before and shifting every range,
+    // changed how the pixels before a range's end were planned.
+    while (i < sources.size() && i > 0 && joins_run(sources, i)) ++i;
     if (i < sources.size()) starts.push_back(i);
   }
   starts.push_back(sources.size());

@@ -224,9 +224,9 @@ FootprintPlan moved_plan(const FootprintPlan& p, const ScatterSource& from, cons
 int footprint_subrows(const FootprintPlan& p, int buffer_subrows);
 
 // Where the ranges of a layer's sources planned together (FootprintScatter::plan_range) begin, about
-// `target` sources apart, each where a run of neighbours that may share a mapped shape begins, so
-// that the plans depend neither on the threads nor on where the ranges are cut; the last entry is
-// sources.size().
+// `target` sources apart, each where no run of neighbours that may share a mapped shape continues
+// across (a row's first pixel, a gap), so that the plans depend neither on the threads nor on where
+// the ranges are cut; the last entry is sources.size().
 void plan_range_starts(std::span<const ScatterSource> sources, std::size_t target, std::vector<std::size_t>& starts);
 
 // Everything a footprint depends on besides its source; one per render, shared by the threads.
