@@ -37,6 +37,11 @@ OCCLUDER_Y = 1.2
 # The portrait scene (--scene portrait).
 SUBJECT_Y = 1.0
 PORTRAIT_WALL_Y = 5.0
+# The table scene (--scene table): a table top receding from the camera's feet to a far wall.
+TABLE_Z = -0.25
+TABLE_NEAR_Y = 0.35
+TABLE_FAR_Y = 4.0
+TABLE_WALL_Y = 8.0
 
 
 def parse_args():
@@ -50,10 +55,13 @@ def parse_args():
     p.add_argument("--spp", type=int, required=True, help="samples per pixel for both renders (>= 1)")
     p.add_argument("--threads", type=int, default=0, help="render threads, 0 = all (also pass blender -t)")
     p.add_argument("--seed", type=int, default=0, help="Cycles seed, the same for both renders")
-    p.add_argument("--scene", choices=["street", "portrait"], default="street",
+    p.add_argument("--scene", choices=["street", "portrait", "table"], default="street",
                    help="street: posts and a sign at 1.2 m, walls at 3 and 20 m, string lights (default); "
                         "portrait: a sharp striped bar, a checkered disc and a thin rod at 1 m over a "
-                        "textured wall at 5 m with highlights (the sharp-subject case)")
+                        "textured wall at 5 m with highlights (the sharp-subject case); "
+                        "table: a checkered table top receding from 0.35 to 4 m (continuous depth) with "
+                        "blocks and a post on it at 0.7, 1.5 and 2.5 m, a wall at 8 m, highlights at "
+                        "every depth (focus on the 1.5 m block)")
     p.add_argument("--skip-pinhole", action="store_true",
                    help="render only reference.exr (reuse an existing DIR/pinhole.exr)")
     a = p.parse_args(argv)
@@ -247,7 +255,7 @@ def build_scene(args):
     scene = bpy.context.scene
     for ob in list(bpy.data.objects):
         bpy.data.objects.remove(ob, do_unlink=True)
-    lights, depths = (build_portrait if args.scene == "portrait" else build_street)(args)
+    lights, depths = {"portrait": build_portrait, "table": build_table, "street": build_street}[args.scene](args)
     for name, centre, radius, rgb, strength in lights:
         sphere(name, centre, radius, emission("em_" + name, rgb, strength))
 
@@ -300,6 +308,41 @@ def build_portrait(args):
               ("wall_e", (-1.3, PORTRAIT_WALL_Y - 0.02, -0.7), 0.012, (0.4, 1.0, 0.5), 120.0),
               ("subject_glint", (0.09, SUBJECT_Y - 0.002, 0.08), 0.0014, (1.0, 1.0, 1.0), 60.0)]
     depths = {"subject_faces": SUBJECT_Y, "wall": PORTRAIT_WALL_Y}
+    return lights, depths
+
+
+def build_table(args):
+    """Continuous depth: a table top from the camera's feet into the distance, things on it at three
+    depths (one in focus at 1.5 m), a far wall, and highlights near, in focus and far.
+
+    The table top is one plane, so its depth runs through every layer the scatter makes; its checker
+    has hard edges whose blur grows steadily with distance from the focus. The blocks' front faces
+    face the camera at one planar depth each, with hard-edged patterns.
+    """
+    sky_and_sun("evening", (0.2, 0.22, 0.3), 3.0, 3.0, (1.0, 0.85, 0.7), 55.0, 25.0)
+
+    top = diffuse("table_top", checker_colour(12.0, (0.55, 0.45, 0.3), (0.15, 0.1, 0.07)))
+    quad_xy("table_top", TABLE_Z, -2.5, 2.5, TABLE_NEAR_Y, TABLE_FAR_Y, top)
+    wall = diffuse("far_wall", noise_colour(3.0, (0.05, 0.06, 0.09), (0.35, 0.3, 0.25)))
+    quad_xz("wall_8m", TABLE_WALL_Y, -6.0, 6.0, -3.0, 3.0, wall)
+    # A striped block near the camera (blurred foreground), a checkered one in focus, a post behind.
+    near = diffuse("near_block", stripe_colour(60.0, (0.9, 0.85, 0.7), (0.1, 0.25, 0.5)))
+    box("near_block", 0.12, 0.26, 0.7, 0.78, TABLE_Z, TABLE_Z + 0.12, near)
+    mid = diffuse("mid_block", checker_colour(50.0, (0.85, 0.2, 0.15), (0.9, 0.9, 0.85)))
+    box("mid_block", -0.28, -0.08, 1.5, 1.6, TABLE_Z, TABLE_Z + 0.2, mid)
+    post = diffuse("far_post", flat_colour((0.15, 0.45, 0.2)))
+    box("far_post", 0.35, 0.45, 2.5, 2.6, TABLE_Z, 0.6, post)
+    # Highlights: a row of small lights along the table's left side at every depth, one on the
+    # in-focus block's face, two on the far wall.
+    lights = []
+    for i, y in enumerate([0.6, 0.9, 1.3, 1.8, 2.4, 3.2]):
+        lights.append(("table_%d" % i, (-0.45 - 0.05 * y, y, TABLE_Z + 0.01), 0.0025 * y, (1.0, 0.75, 0.4), 100.0))
+    lights += [("block_glint", (-0.18, 1.5 - 0.002, TABLE_Z + 0.1), 0.0015, (1.0, 1.0, 1.0), 80.0),
+               ("wall_a", (1.1, TABLE_WALL_Y - 0.02, 0.4), 0.012, (0.3, 0.5, 1.0), 150.0),
+               ("wall_b", (-0.9, TABLE_WALL_Y - 0.02, 0.7), 0.012, (1.0, 0.3, 0.2), 150.0)]
+    depths = {"table_top": "z = %.2f m, from %.2f to %.1f m" % (TABLE_Z, TABLE_NEAR_Y, TABLE_FAR_Y),
+              "near_block_front_face": 0.7, "mid_block_front_face": 1.5, "far_post_front_face": 2.5,
+              "wall": TABLE_WALL_Y}
     return lights, depths
 
 

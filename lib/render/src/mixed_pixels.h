@@ -7,7 +7,8 @@
 // far part of coverage 1 - alpha, each at its surface's depth.
 //
 // alpha comes from colour where the two surfaces' colours differ clearly: the projection of the
-// pixel's colour on the segment between the mean colours of its near and far neighbours (3 x 3);
+// pixel's colour on the segment between the colours of a near and a far neighbour (3 x 3), the pair
+// whose segment passes nearest the pixel's colour (a textured or highlighted side has no one colour);
 // where they do not, from depth (a filtered depth between the surfaces gives its position between
 // them; a depth equal to one surface's gives 0 or 1). A pixel whose colour is wholly one surface's
 // takes that surface's depth. Pixels with no neighbour of the other kind (1-px features) are kept.
