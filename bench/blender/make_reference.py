@@ -42,6 +42,9 @@ TABLE_Z = -0.25
 TABLE_NEAR_Y = 0.35
 TABLE_FAR_Y = 4.0
 TABLE_WALL_Y = 8.0
+# The fence scene (--scene fence): thin bars in front of a lit wall.
+FENCE_Y = 1.5
+FENCE_WALL_Y = 6.0
 
 
 def parse_args():
@@ -55,13 +58,15 @@ def parse_args():
     p.add_argument("--spp", type=int, required=True, help="samples per pixel for both renders (>= 1)")
     p.add_argument("--threads", type=int, default=0, help="render threads, 0 = all (also pass blender -t)")
     p.add_argument("--seed", type=int, default=0, help="Cycles seed, the same for both renders")
-    p.add_argument("--scene", choices=["street", "portrait", "table"], default="street",
+    p.add_argument("--scene", choices=["street", "portrait", "table", "fence"], default="street",
                    help="street: posts and a sign at 1.2 m, walls at 3 and 20 m, string lights (default); "
                         "portrait: a sharp striped bar, a checkered disc and a thin rod at 1 m over a "
                         "textured wall at 5 m with highlights (the sharp-subject case); "
                         "table: a checkered table top receding from 0.35 to 4 m (continuous depth) with "
                         "blocks and a post on it at 0.7, 1.5 and 2.5 m, a wall at 8 m, highlights at "
-                        "every depth (focus on the 1.5 m block)")
+                        "every depth (focus on the 1.5 m block); "
+                        "fence: bars 1-3 px wide and a wire mesh at 1.5 m over a brick wall at 6 m with "
+                        "highlights, some just behind a bar")
     p.add_argument("--skip-pinhole", action="store_true",
                    help="render only reference.exr (reuse an existing DIR/pinhole.exr)")
     a = p.parse_args(argv)
@@ -255,7 +260,8 @@ def build_scene(args):
     scene = bpy.context.scene
     for ob in list(bpy.data.objects):
         bpy.data.objects.remove(ob, do_unlink=True)
-    lights, depths = {"portrait": build_portrait, "table": build_table, "street": build_street}[args.scene](args)
+    lights, depths = {"portrait": build_portrait, "table": build_table, "fence": build_fence,
+                      "street": build_street}[args.scene](args)
     for name, centre, radius, rgb, strength in lights:
         sphere(name, centre, radius, emission("em_" + name, rgb, strength))
 
@@ -343,6 +349,42 @@ def build_table(args):
     depths = {"table_top": "z = %.2f m, from %.2f to %.1f m" % (TABLE_Z, TABLE_NEAR_Y, TABLE_FAR_Y),
               "near_block_front_face": 0.7, "mid_block_front_face": 1.5, "far_post_front_face": 2.5,
               "wall": TABLE_WALL_Y}
+    return lights, depths
+
+
+def build_fence(args):
+    """Thin foreground structure: vertical bars of 1 to 3 px and a diagonal wire mesh at 1.5 m over a
+    brick wall at 6 m, with highlights on the wall, some half behind a bar.
+
+    Sub-pixel and few-pixel features are where edge pixels are all edge (no pure pixel of the near
+    surface beside them) and where a blurred foreground lets most of the background through.
+    """
+    sky_and_sun("day", (0.45, 0.5, 0.6), 3.0, 3.0, (1.0, 0.95, 0.85), 50.0, -35.0)
+    wall = diffuse("bricks", brick_colour)
+    quad_xz("wall_6m", FENCE_WALL_Y, -5.0, 5.0, -3.5, 3.5, wall)
+    metal = diffuse("metal", flat_colour((0.08, 0.08, 0.09)))
+    paint = diffuse("paint", flat_colour((0.75, 0.7, 0.2)))
+    # Vertical bars, 2.5 mm to 7.5 mm wide (about 1.4 to 4.2 px at 600 px), 8 cm apart.
+    px_m = FENCE_Y * SENSOR_WIDTH_MM / FOCAL_LENGTH_MM / args.width  # metres per pixel at the fence
+    for i in range(-7, 8):
+        x = 0.08 * i + 0.013
+        width_m = px_m * (1.0 + 0.75 * (i % 4)) + 0.0002
+        box("bar_%d" % i, x, x + width_m, FENCE_Y, FENCE_Y + 0.01, -1.2, 1.2, paint if i % 3 == 0 else metal)
+    # A wire mesh along the bottom of the frame: thin diagonal wires (about 1 px) both ways.
+    for i in range(-12, 13):
+        x = 0.06 * i
+        for sgn in (1.0, -1.0):
+            quad("wire_%d_%d" % (i, int(sgn)), [(x, FENCE_Y - 0.002, -0.36), (x + px_m, FENCE_Y - 0.002, -0.36),
+                                                 (x + px_m + sgn * 0.24, FENCE_Y - 0.002, -0.12), (x + sgn * 0.24, FENCE_Y - 0.002, -0.12)], metal)
+    lights = []
+    colours = [(1.0, 0.8, 0.5), (0.4, 0.6, 1.0), (1.0, 0.3, 0.2), (0.5, 1.0, 0.4)]
+    for i in range(10):
+        # Every other one lies right behind a bar's edge (as the camera sees it).
+        bar_x = 0.08 * (i - 5) + 0.013
+        x = bar_x * FENCE_WALL_Y / FENCE_Y + (0.0 if i % 2 == 0 else 0.09)
+        z = 0.35 + 0.12 * (i % 3)
+        lights.append(("wall_%d" % i, (x, FENCE_WALL_Y - 0.03, z), 0.014, colours[i % 4], 120.0))
+    depths = {"bars_and_wires": FENCE_Y, "wall": FENCE_WALL_Y}
     return lights, depths
 
 

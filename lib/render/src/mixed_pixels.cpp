@@ -32,6 +32,16 @@ constexpr double kFitResidualHigh = 0.6;
 // lies beyond the near colour's end of the segment and is neither (tests/render/bokeh_edges_test.cpp).
 constexpr double kModelContrastLow = 0.15;
 constexpr double kModelContrastHigh = 0.3;
+// A pixel at the near surface's depth that no mix explains and that is more than this many times
+// as bright as either surface's colour holds light from behind the near surface's edge: a highlight
+// mostly hidden behind a thin bar, a sliver of it in the bar's edge pixel. Kept whole, the sliver
+// stayed a sharp bright dot on the bar; its light beyond the near colour goes to the far surface,
+// where it blurs with the highlight's disc.
+constexpr double kExcessBrightness = 2.0;
+// The near part's coverage there, which no colour tells: a renderer's first sample, uniform over the
+// pixel, names the near surface with probability equal to its coverage c, so a pixel that carries
+// the near depth is covered E[c^2] / E[c] = 2/3 on average (c uniform).
+constexpr double kExcessNearCoverage = 2.0 / 3.0;
 // Near and far groups whose colours differ by less than this (relative contrast) look like one
 // surface (decide() then looks one ring further out for the far one).
 constexpr double kSameSurfaceContrast = 0.01;
@@ -149,6 +159,9 @@ void choose_colours(const std::array<float, 3>& p, Group& near, Group& far) {
 struct Decision {
   enum class Kind { Keep, Move, Split } kind = Kind::Keep;
   double alpha = 1.0;  // coverage of the near part (Split)
+  // Split: the near part takes the near surface's colour, the far part the rest of the light
+  // (light from behind the near surface's edge; see kExcessBrightness).
+  bool excess = false;
   Group near, far;
 };
 
@@ -212,6 +225,23 @@ Decision decide(const ScatterSources& sources, const LargeVector<std::uint8_t>& 
       }
     }
   }
+  // A thin near structure (a bar, a wire: 1-3 px) has no pure pixel in the 3 x 3, and where a
+  // highlight lies behind it, its edge pixels there hold the highlight's light: as the near colour
+  // they made the highlight's own edge pixels look like the bar, which moved them onto it (sharp
+  // bright dots on the bar). Where the 3 x 3's near pixels are more than kExcessBrightness times as
+  // bright as the pure ones on the 5 x 5 border, the border's stand for the near surface.
+  if (near_pure.count == 0 && d.near.count > 0) {
+    Group ring;
+    for (int qy = std::max(0, y - 2); qy <= std::min(height - 1, y + 2); ++qy) {
+      for (int qx = std::max(0, x - 2); qx <= std::min(width - 1, x + 2); ++qx) {
+        if (std::max(std::abs(qx - x), std::abs(qy - y)) < 2) continue;
+        const std::size_t q = static_cast<std::size_t>(qy) * width + qx;
+        if (!next_to_step[q] && sources[q].coc_px >= hi - tolerance) ring.add(sources[q]);
+      }
+    }
+    const auto brightness = [](const Group& g) { return (g.rgb[0] + g.rgb[1] + g.rgb[2]) / std::max(1, g.count); };
+    if (ring.count > 0 && brightness(d.near) > kExcessBrightness * brightness(ring)) near_pure = ring;
+  }
   if (near_pure.count > 0) d.near = near_pure;
   if (far_pure.count > 0) d.far = far_pure;
   if (d.near.count == 0 || d.far.count == 0) return d;  // a 1-px feature: nothing to unmix it with
@@ -253,6 +283,7 @@ Decision decide(const ScatterSources& sources, const LargeVector<std::uint8_t>& 
   }
   const double span2 = span[0] * span[0] + span[1] * span[1] + span[2] * span[2];
   double alpha = alpha_depth;
+  bool excess = false;
   if (span2 > 0.0) {
     const double alpha_colour =
         std::clamp((offset[0] * span[0] + offset[1] * span[1] + offset[2] * span[2]) / span2, 0.0, 1.0);
@@ -270,6 +301,15 @@ Decision decide(const ScatterSources& sources, const LargeVector<std::uint8_t>& 
         std::clamp((kFitResidualHigh - residual) / (kFitResidualHigh - kFitResidualLow), 0.0, 1.0) *
         std::clamp((kModelContrastHigh - model_contrast) / (kModelContrastHigh - kModelContrastLow), 0.0, 1.0);
     alpha = trust * alpha_colour + (1.0 - trust) * alpha_depth;
+    const auto brightness = [](const auto& c) { return static_cast<double>(c[0]) + c[1] + c[2]; };
+    excess = alpha_depth >= 1.0 - kPureAlpha && model_contrast > kModelContrastHigh &&
+             brightness(p.rgb) > kExcessBrightness * std::max(brightness(d.near.rgb), brightness(d.far.rgb));
+  }
+  if (excess) {
+    d.kind = Decision::Kind::Split;
+    d.alpha = kExcessNearCoverage;
+    d.excess = true;
+    return d;
   }
   if (alpha < kPureAlpha) alpha = 0.0;
   if (alpha > 1.0 - kPureAlpha) alpha = 1.0;
@@ -302,7 +342,8 @@ void apply(ScatterSources& sources, std::size_t i, const Decision& d, const Came
   // up to the pixel exactly.
   ScatterSource near = p, far = p;
   for (std::size_t c = 0; c < 3; ++c) {
-    near.rgb[c] = static_cast<float>(std::max(0.0, p.rgb[c] - (1.0 - d.alpha) * d.far.rgb[c]));
+    near.rgb[c] = d.excess ? static_cast<float>(std::min<double>(p.rgb[c], d.alpha * d.near.rgb[c]))
+                           : static_cast<float>(std::max(0.0, p.rgb[c] - (1.0 - d.alpha) * d.far.rgb[c]));
     far.rgb[c] = p.rgb[c] - near.rgb[c];
   }
   near.coverage = static_cast<float>(d.alpha);
