@@ -84,8 +84,13 @@ double contrast(const std::array<double, 3>& a, const std::array<double, 3>& b) 
 }
 double contrast(const Group& a, const Group& b) { return contrast(a.rgb, b.rgb); }
 
-// Distance of colour p from the segment between colours `from` and `to`.
-double distance_from_segment(const std::array<float, 3>& p, const std::array<double, 3>& from, const std::array<double, 3>& to) {
+// Where colour p projects on the segment from colour `from` to colour `to` (0 at `from`, clamped to
+// the segment), and its distance from that point.
+struct Projection {
+  double t = 0.0;
+  double miss = 0.0;
+};
+Projection project(const std::array<float, 3>& p, const std::array<double, 3>& from, const std::array<double, 3>& to) {
   std::array<double, 3> span{}, offset{};
   for (std::size_t c = 0; c < 3; ++c) {
     span[c] = to[c] - from[c];
@@ -93,8 +98,17 @@ double distance_from_segment(const std::array<float, 3>& p, const std::array<dou
   }
   const double span2 = span[0] * span[0] + span[1] * span[1] + span[2] * span[2];
   const double t = span2 > 0.0 ? std::clamp((offset[0] * span[0] + offset[1] * span[1] + offset[2] * span[2]) / span2, 0.0, 1.0) : 0.0;
-  return norm({offset[0] - t * span[0], offset[1] - t * span[1], offset[2] - t * span[2]});
+  return {t, norm({offset[0] - t * span[0], offset[1] - t * span[1], offset[2] - t * span[2]})};
 }
+
+// 1 up to `full`, 0 from `none`, linear between (either way round): how far a measure is trusted.
+double ramp(double v, double full, double none) { return std::clamp((none - v) / (none - full), 0.0, 1.0); }
+
+// How far two surfaces' colours of relative contrast c tell a pixel's coverage (kColourContrastLow..High).
+double contrast_trust(double c) { return ramp(c, kColourContrastHigh, kColourContrastLow); }
+
+double brightness(const std::array<float, 3>& c) { return static_cast<double>(c[0]) + c[1] + c[2]; }
+double brightness(const std::array<double, 3>& c) { return c[0] + c[1] + c[2]; }
 
 // Pairs explain the pixel about as well up to this share of its colour's size apart (the
 // weights' spread in choose_colours).
@@ -126,9 +140,9 @@ void choose_colours(const std::array<float, 3>& p, Group& near, Group& far) {
     for (int k = 0; k < far.stored(); ++k) {
       const auto& fk = far.members[static_cast<std::size_t>(k)];
       const std::array<double, 3> f{fk[0], fk[1], fk[2]};
-      const double trust = std::clamp((contrast(n, f) - kColourContrastLow) / (kColourContrastHigh - kColourContrastLow), 0.0, 1.0);
+      const double trust = contrast_trust(contrast(n, f));
       if (!(trust > 0.0)) continue;
-      const double miss = distance_from_segment(p, f, n);
+      const double miss = project(p, f, n).miss;
       pairs[count++] = {n, f, miss, trust};
       best = std::min(best, miss);
     }
@@ -153,6 +167,22 @@ void choose_colours(const std::array<float, 3>& p, Group& near, Group& far) {
     near.rgb[c] = n_sum[c] / w_sum;
     far.rgb[c] = f_sum[c] / w_sum;
   }
+}
+
+// The pure pixels (not next to a depth step) on the 5 x 5 border around (x, y) whose blur `on_surface`
+// accepts: a surface sampled one ring further out where the 3 x 3 cannot tell it.
+template <class OnSurface>
+Group border_group(const ScatterSources& sources, const LargeVector<std::uint8_t>& next_to_step, int width, int height, int x, int y,
+                   OnSurface on_surface) {
+  Group g;
+  for (int qy = std::max(0, y - 2); qy <= std::min(height - 1, y + 2); ++qy) {
+    for (int qx = std::max(0, x - 2); qx <= std::min(width - 1, x + 2); ++qx) {
+      if (std::max(std::abs(qx - x), std::abs(qy - y)) < 2) continue;
+      const std::size_t q = static_cast<std::size_t>(qy) * width + qx;
+      if (!next_to_step[q] && on_surface(sources[q].coc_px)) g.add(sources[q]);
+    }
+  }
+  return g;
 }
 
 // What to do with one pixel: nothing, move it wholly to one surface's depth, or split it.
@@ -231,16 +261,9 @@ Decision decide(const ScatterSources& sources, const LargeVector<std::uint8_t>& 
   // bright dots on the bar). Where the 3 x 3's near pixels are more than kExcessBrightness times as
   // bright as the pure ones on the 5 x 5 border, the border's stand for the near surface.
   if (near_pure.count == 0 && d.near.count > 0) {
-    Group ring;
-    for (int qy = std::max(0, y - 2); qy <= std::min(height - 1, y + 2); ++qy) {
-      for (int qx = std::max(0, x - 2); qx <= std::min(width - 1, x + 2); ++qx) {
-        if (std::max(std::abs(qx - x), std::abs(qy - y)) < 2) continue;
-        const std::size_t q = static_cast<std::size_t>(qy) * width + qx;
-        if (!next_to_step[q] && sources[q].coc_px >= hi - tolerance) ring.add(sources[q]);
-      }
-    }
-    const auto brightness = [](const Group& g) { return (g.rgb[0] + g.rgb[1] + g.rgb[2]) / std::max(1, g.count); };
-    if (ring.count > 0 && brightness(d.near) > kExcessBrightness * brightness(ring)) near_pure = ring;
+    const Group ring = border_group(sources, next_to_step, width, height, x, y, [&](double c) { return c >= hi - tolerance; });
+    // (Sums of colours: their means compared.)
+    if (ring.count > 0 && brightness(d.near.rgb) / d.near.count > kExcessBrightness * brightness(ring.rgb) / ring.count) near_pure = ring;
   }
   if (near_pure.count > 0) d.near = near_pure;
   if (far_pure.count > 0) d.far = far_pure;
@@ -256,16 +279,7 @@ Decision decide(const ScatterSources& sources, const LargeVector<std::uint8_t>& 
   // moved 0.06 dB closer to its path-traced reference in the depth-edge band (a 2 % threshold here
   // cost it 0.04 dB).
   if (const double own = contrast(d.near, d.far); own < kSameSurfaceContrast && p.coc_px <= lo + tolerance) {
-    Group far_ring;
-    for (int qy = std::max(0, y - 2); qy <= std::min(height - 1, y + 2); ++qy) {
-      for (int qx = std::max(0, x - 2); qx <= std::min(width - 1, x + 2); ++qx) {
-        if (std::max(std::abs(qx - x), std::abs(qy - y)) < 2) continue;
-        const std::size_t q = static_cast<std::size_t>(qy) * width + qx;
-        if (next_to_step[q]) continue;
-        const ScatterSource& s = sources[q];
-        if (s.coc_px <= lo + tolerance) far_ring.add(s);
-      }
-    }
+    Group far_ring = border_group(sources, next_to_step, width, height, x, y, [&](double c) { return c <= lo + tolerance; });
     if (far_ring.count > 0) {
       far_ring.finish();
       if (contrast(d.near, far_ring) >= kColourContrastHigh) d.far = far_ring;
@@ -276,32 +290,21 @@ Decision decide(const ScatterSources& sources, const LargeVector<std::uint8_t>& 
   choose_colours(p.rgb, d.near, d.far);
   // alpha from colour: the projection on the segment from the far colour to the near one, trusted
   // where the colours differ clearly and the pixel lies near the line through them.
-  std::array<double, 3> span{}, offset{};
-  for (std::size_t c = 0; c < 3; ++c) {
-    span[c] = d.near.rgb[c] - d.far.rgb[c];
-    offset[c] = p.rgb[c] - d.far.rgb[c];
-  }
-  const double span2 = span[0] * span[0] + span[1] * span[1] + span[2] * span[2];
+  const std::array<double, 3> span{d.near.rgb[0] - d.far.rgb[0], d.near.rgb[1] - d.far.rgb[1], d.near.rgb[2] - d.far.rgb[2]};
   double alpha = alpha_depth;
   bool excess = false;
-  if (span2 > 0.0) {
-    const double alpha_colour =
-        std::clamp((offset[0] * span[0] + offset[1] * span[1] + offset[2] * span[2]) / span2, 0.0, 1.0);
-    std::array<double, 3> miss{};
-    for (std::size_t c = 0; c < 3; ++c) miss[c] = offset[c] - alpha_colour * span[c];
-    const double residual = norm(miss) / std::sqrt(span2);
+  if (const double span_length = norm(span); span_length > 0.0) {
+    const Projection fit = project(p.rgb, d.far.rgb, d.near.rgb);
+    const double alpha_colour = fit.t, residual = fit.miss / span_length;
     // The mix that explains the pixel best, against the pixel itself: the residual above is relative
     // to the surfaces' difference, which a highlight on one of them makes so large that a pixel far
     // off both colours still fits.
     std::array<double, 3> model{};
     for (std::size_t c = 0; c < 3; ++c) model[c] = d.far.rgb[c] + alpha_colour * span[c];
     const double model_contrast = contrast({p.rgb[0], p.rgb[1], p.rgb[2]}, model);
-    const double trust =
-        std::clamp((contrast(d.near, d.far) - kColourContrastLow) / (kColourContrastHigh - kColourContrastLow), 0.0, 1.0) *
-        std::clamp((kFitResidualHigh - residual) / (kFitResidualHigh - kFitResidualLow), 0.0, 1.0) *
-        std::clamp((kModelContrastHigh - model_contrast) / (kModelContrastHigh - kModelContrastLow), 0.0, 1.0);
+    const double trust = contrast_trust(contrast(d.near, d.far)) * ramp(residual, kFitResidualLow, kFitResidualHigh) *
+                         ramp(model_contrast, kModelContrastLow, kModelContrastHigh);
     alpha = trust * alpha_colour + (1.0 - trust) * alpha_depth;
-    const auto brightness = [](const auto& c) { return static_cast<double>(c[0]) + c[1] + c[2]; };
     excess = alpha_depth >= 1.0 - kPureAlpha && model_contrast > kModelContrastHigh &&
              brightness(p.rgb) > kExcessBrightness * std::max(brightness(d.near.rgb), brightness(d.far.rgb));
   }
