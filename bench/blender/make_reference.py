@@ -374,8 +374,9 @@ def build_fence(args):
     for i in range(-12, 13):
         x = 0.06 * i
         for sgn in (1.0, -1.0):
-            quad("wire_%d_%d" % (i, int(sgn)), [(x, FENCE_Y - 0.002, -0.36), (x + px_m, FENCE_Y - 0.002, -0.36),
-                                                 (x + px_m + sgn * 0.24, FENCE_Y - 0.002, -0.12), (x + sgn * 0.24, FENCE_Y - 0.002, -0.12)], metal)
+            y = FENCE_Y - 0.002
+            quad("wire_%d_%d" % (i, int(sgn)),
+                 [(x, y, -0.36), (x + px_m, y, -0.36), (x + px_m + sgn * 0.24, y, -0.12), (x + sgn * 0.24, y, -0.12)], metal)
     lights = []
     colours = [(1.0, 0.8, 0.5), (0.4, 0.6, 1.0), (1.0, 0.3, 0.2), (0.5, 1.0, 0.4)]
     for i in range(10):

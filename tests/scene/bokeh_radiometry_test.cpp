@@ -550,7 +550,8 @@ TEST_CASE("Through the Biotar wide open the thin and paraxial models darken a wa
                  kMargin);
 }
 
-TEST_CASE("Through the Primoplan wide open the exact model darkens a wall towards the corner as the film receives it where vignetting moves the light off the chief ray",
+TEST_CASE("Through the Primoplan wide open the exact model darkens a wall towards the corner as the film receives it "
+          "where vignetting moves the light off the chief ray",
           "[scene][radiometry]") {
   // lentil's entry 0002 (Meyer-Optik Primoplan, 100 mm) at f/1.5, a wall at 4 m in focus, a strip
   // along the middle row reaching a 48 x 32 mm frame's corner (as the Biotar's above). Its front and
@@ -559,9 +560,10 @@ TEST_CASE("Through the Primoplan wide open the exact model darkens a wall toward
   // rays' there, 2.3 % less in the corner). The scatter weighs a footprint's coverage by the chief
   // rays' image area, so the exact model's own rays drew the wall up to 0.015 of the centre too bright
   // at the cut's onset and 0.040 too dark in the corner (at f/8, where only the corner is cut, 0.041
-  // too bright there). It now takes the illumination table's factor as the other models do. Two brute-force estimates outside the renderer (a film point's projected solid angle
-  // of passing directions; a point's passing flux over its light centroids' image area) agree with the
-  // ground truth within 0.004 on this lens.
+  // too bright there). It now takes the illumination table's factor as the other models do. Two
+  // brute-force estimates outside the renderer (a film point's projected solid angle of passing
+  // directions; a point's passing flux over its light centroids' image area) agree with the ground
+  // truth within 0.004 on this lens.
   constexpr int w = kCornerStripWidth;
   // The truth's noise (about 0.5 % of the centre on these patches at this sample count, the ratio's
   // twice) and the table's nodes across the cut's onset. Measured within 0.006; 0.025 at x = 54
