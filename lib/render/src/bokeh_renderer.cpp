@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "depth_layers.h"
+#include "first_touch.h"
 #include "footprint.h"
 #include "hidden_surfaces.h"
 #include "image_circle.h"
@@ -39,6 +40,7 @@ namespace lensmith {
 namespace {
 
 using render_detail::DepthLayers;
+using render_detail::fault_in;
 using render_detail::FootprintPlan;
 using render_detail::FootprintScatter;
 using render_detail::FootprintScratch;
@@ -103,9 +105,14 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   const std::size_t unaimed_before = model.unaimed_rays();
 
   const bool stretch = options.hidden == HiddenSurfaces::Stretch;
-  LargeVector<float> layer_rgba(static_cast<std::size_t>(w) * h * 4);
-  LargeVector<float> hole_rgba(stretch ? layer_rgba.size() : 0);  // Stretch: coverage of the hidden sources
-  LargeVector<float> result(static_cast<std::size_t>(w) * h * 4, 0.0f);  // premultiplied RGB + coverage
+  const std::size_t frame_floats = static_cast<std::size_t>(w) * h * 4;
+  LargeVector<float> layer_rgba, hole_rgba, result;  // hole_rgba (Stretch): coverage of the hidden sources
+  fault_in(layer_rgba, frame_floats, threads);
+  fault_in(hole_rgba, stretch ? frame_floats : 0, threads);
+  fault_in(result, frame_floats, threads);
+  layer_rgba.resize(frame_floats);
+  hole_rgba.resize(stretch ? frame_floats : 0);
+  result.resize(frame_floats, 0.0f);  // premultiplied RGB + coverage
   const int bands = std::max(1, std::min(h, threads * (model.affine_in_pupil() ? kBandsPerThreadAffine : kBandsPerThreadMapped)));
   std::size_t done = 0;
   std::atomic<std::size_t> footprints{0}, triangles{0}, reused{0};
@@ -132,6 +139,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   for (int l = 0; l < layers.count; ++l) {
     const auto u = static_cast<std::size_t>(l);
     layer.clear();
+    fault_in(layer, layers.members(l).size(), threads);
     for (int i : layers.members(l)) layer.push_back(sources[static_cast<std::size_t>(i)]);
     const double hidden_blur = layers.max_blur_px[u] + layers.nearer_blur_px[u];
     if (!layer.empty() && l + 1 < layers.count && hidden_blur >= kMinHiddenBlurPx) {
@@ -144,6 +152,8 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
     // Level of detail: sources whose footprints go to a coarse grid, merged by its cells.
     render_detail::merge_coarse_sources(layer, w, h, merge_scratch, margin);
 
+    fault_in(plans, layer.size(), threads);
+    fault_in(plan_rows, layer.size(), threads);
     plans.resize(layer.size());
     plan_rows.resize(layer.size());
     render_detail::plan_range_starts(layer, kPlanRange, range_begin);

@@ -11,6 +11,7 @@
 
 #include <omp.h>
 
+#include "first_touch.h"
 #include "push_pull.h"
 
 namespace lensmith::render_detail {
@@ -133,7 +134,9 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
   // larger window moves the cells to fresh memory.
   cells.reserve(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
   scratch.push_pull.reserve(w, h);
-  cells.assign(static_cast<std::size_t>(ww) * wh, PushPullCell<5>{});
+  cells.clear();
+  fault_in(cells, static_cast<std::size_t>(ww) * wh, threads);
+  cells.resize(static_cast<std::size_t>(ww) * wh);
   // The targets' cells: the only ones read below, so the only ones the push-pulls finish.
   std::vector<std::size_t>& target_cells = scratch.target_cells;
   target_cells.resize(targets.size());

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <span>
 
+#include "first_touch.h"
 #include "lensmith/core/units.h"
 
 namespace lensmith::render_detail {
@@ -128,6 +129,7 @@ ScatterSources make_scatter_sources(const Image& image, const DepthMap& depth, c
   const std::size_t pixels = static_cast<std::size_t>(w) * h;
   ScatterSources sources;
   sources.reserve(pixels + pixels / 4);
+  fault_in(sources, pixels, threads);
   sources.resize(pixels);
   std::size_t clamped = 0;
   double coc_min = kInfinity, coc_max = -kInfinity;
