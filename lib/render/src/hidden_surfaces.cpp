@@ -200,22 +200,32 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
     }
     push_pull(ww, wh, shares, threads, &scratch.push_pull_shares, target_cells);
   }
+  // One source per target, made in parallel in the targets' order; those with nothing hidden to
+  // stand for (no coverage) are dropped after.
   const std::size_t before = out.size();
-  for (std::size_t k = 0; k < targets.size(); ++k) {
-    const std::size_t i = targets[k];
-    const auto& v = cells[target_cells[k]];
-    ScatterSource s;
+  fault_in(out, before + targets.size(), threads);
+  out.resize(before + targets.size());
+  const auto target_count = static_cast<std::ptrdiff_t>(targets.size());
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (std::ptrdiff_t k = 0; k < target_count; ++k) {
+    const auto u = static_cast<std::size_t>(k);
+    const std::size_t i = targets[u];
+    const auto& v = cells[target_cells[u]];
+    ScatterSource& s = out[before + u];
+    s = ScatterSource{};
     s.x = static_cast<int>(i % static_cast<std::size_t>(w));
     s.y = static_cast<int>(i / static_cast<std::size_t>(w));
-    const double share = farther ? shares[target_cells[k]][0] : 1.0;
+    const double share = farther ? shares[target_cells[u]][0] : 1.0;
     s.coverage = layers.unknown_behind(i, layer) * static_cast<float>(share);
     if (!(s.coverage > 0.0f)) continue;
     s.coverage_only = mode == HiddenSurfaces::Stretch;
     if (!s.coverage_only) s.rgb = {s.coverage * untone(v[0]), s.coverage * untone(v[1]), s.coverage * untone(v[2])};
     s.inverse_depth_per_mm = v[3];
     s.coc_px = camera.signed_coc_px(v[3]);
-    out.push_back(s);
   }
+  out.erase(std::remove_if(out.begin() + static_cast<std::ptrdiff_t>(before), out.end(),
+                           [](const ScatterSource& s) { return !(s.coverage > 0.0f); }),
+            out.end());
   return out.size() - before;
 }
 

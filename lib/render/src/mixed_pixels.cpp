@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "first_touch.h"
 #include "lensmith/core/units.h"
 
 namespace lensmith::render_detail {
@@ -352,28 +353,26 @@ void place_on(ScatterSource& part, const ScatterSource& p, const Surface& g, con
   part.coc_px = camera.signed_coc_px(g.inverse_depth_per_mm);
 }
 
-void apply(ScatterSources& sources, std::size_t i, const Decision& d, const Camera& camera, BokehStatistics& stats) {
-  const ScatterSource p = sources[i];
-  if (d.kind == Decision::Kind::Move) {
-    place_on(sources[i], p, d.alpha == 1.0 ? d.near : d.far, camera);
-    ++stats.redepthed_edge_pixels;
-    return;
-  }
+// Pixel p moved wholly to the surface its decision names.
+void move(ScatterSource& p, const Decision& d, const Camera& camera) { place_on(p, p, d.alpha == 1.0 ? d.near : d.far, camera); }
+
+// Pixel p split: the near part replaces it, the far part goes to `far`.
+void split(ScatterSource& p, const Decision& d, const Camera& camera, ScatterSource& far) {
   // Near part: the pixel less the far surface's share; the far part what remains, so the two add
   // up to the pixel exactly.
-  ScatterSource near = p, far = p;
+  const ScatterSource whole = p;
+  ScatterSource near = whole;
+  far = whole;
   for (std::size_t c = 0; c < 3; ++c) {
-    near.rgb[c] = d.excess ? static_cast<float>(std::min<double>(p.rgb[c], d.alpha * d.near.rgb[c]))
-                           : static_cast<float>(std::max(0.0, p.rgb[c] - (1.0 - d.alpha) * d.far.rgb[c]));
-    far.rgb[c] = p.rgb[c] - near.rgb[c];
+    near.rgb[c] = d.excess ? static_cast<float>(std::min<double>(whole.rgb[c], d.alpha * d.near.rgb[c]))
+                           : static_cast<float>(std::max(0.0, whole.rgb[c] - (1.0 - d.alpha) * d.far.rgb[c]));
+    far.rgb[c] = whole.rgb[c] - near.rgb[c];
   }
   near.coverage = static_cast<float>(d.alpha);
   far.coverage = static_cast<float>(1.0 - d.alpha);
-  place_on(near, p, d.near, camera);
-  place_on(far, p, d.far, camera);
-  sources[i] = near;
-  sources.push_back(far);
-  ++stats.split_edge_pixels;
+  place_on(near, whole, d.near, camera);
+  place_on(far, whole, d.far, camera);
+  p = near;
 }
 
 }  // namespace
@@ -432,18 +431,48 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
         if (d.kind != Decision::Kind::Keep && (last || d.kind == Decision::Kind::Move)) ++changes;
       }
     }
-    // One growth for all the split pixels' second parts (none while the reserve lasts).
-    if (sources.capacity() < sources.size() + changes) sources.reserve(sources.size() + changes);
+    if (last) {
+      // The splits, row by row in parallel (each reads and writes only its own pixel): the far parts
+      // appended in row order, each row's after the rows before it.
+      std::vector<std::size_t> row_splits(static_cast<std::size_t>(height) + 1, 0);
+      for (int y = 0; y < height; ++y) {
+        std::size_t n = 0;
+        for (const auto& entry : decided[static_cast<std::size_t>(y)]) n += entry.second.kind == Decision::Kind::Split ? 1 : 0;
+        row_splits[static_cast<std::size_t>(y) + 1] = row_splits[static_cast<std::size_t>(y)] + n;
+      }
+      const std::size_t first_far = sources.size();
+      fault_in(sources, first_far + row_splits.back(), threads);
+      sources.resize(first_far + row_splits.back());
+      std::size_t splits = 0, moves = 0;
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 16) reduction(+ : splits, moves)
+      for (int y = 0; y < height; ++y) {
+        std::size_t far = first_far + row_splits[static_cast<std::size_t>(y)];
+        for (const auto& [x, d] : decided[static_cast<std::size_t>(y)]) {
+          ScatterSource& p = sources[static_cast<std::size_t>(y) * width + x];
+          if (d.kind == Decision::Kind::Move) {
+            move(p, d, camera);
+            ++moves;
+          } else if (d.kind == Decision::Kind::Split) {
+            split(p, d, camera, sources[far++]);
+            ++splits;
+          }
+        }
+      }
+      stats.split_edge_pixels += splits;
+      stats.redepthed_edge_pixels += moves;
+      break;
+    }
+    // The moves of this pass (a few), in row order.
     moved.clear();
     for (int y = 0; y < height; ++y) {
       for (const auto& [x, d] : decided[static_cast<std::size_t>(y)]) {
-        if (d.kind == Decision::Kind::Keep || (!last && d.kind != Decision::Kind::Move)) continue;
+        if (d.kind != Decision::Kind::Move) continue;
         const std::size_t i = static_cast<std::size_t>(y) * width + x;
-        apply(sources, i, d, camera, stats);
-        if (!last) moved.push_back(i);
+        move(sources[i], d, camera);
+        ++stats.redepthed_edge_pixels;
+        moved.push_back(i);
       }
     }
-    if (last) break;
     for (const std::size_t i : moved) coc[i] = sources[i].coc_px;
     std::fill(unchanged.begin(), unchanged.end(), std::uint8_t{1});
     // A moved pixel's blur enters its 4-neighbours' step flags and its 3 x 3 neighbours' spans, and
