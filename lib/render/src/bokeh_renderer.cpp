@@ -205,18 +205,21 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
           // A footprint cross-faded between two group counts deposits both splits.
           local_footprints += static_cast<std::size_t>(plans[i].groups + (plans[i].blend < 1.0f ? plans[i].groups - 1 : 0));
         }
+        // A band this layer reaches is resolved and composited over the result; one it does not
+        // reach is left as it is (its rows of the layer's image are not even cleared).
         bool any = false;
-        for (int set = 0; set < (stretch ? 2 : 1); ++set) {
-          LargeVector<float>& target = set == 0 ? layer_rgba : hole_rgba;
-          float* rows = target.data() + static_cast<std::size_t>(row_begin) * w * 4;
-          std::fill(rows, rows + static_cast<std::size_t>(row_end - row_begin) * w * 4, 0.0f);
-          for (std::size_t lv = 0; lv < static_cast<std::size_t>(kLevels); ++lv) {
-            if (!buffers.used[static_cast<std::size_t>(set)][lv]) continue;
-            buffers.buffers[static_cast<std::size_t>(set)][lv]->resolve_into(target.data());
-            any = true;
+        for (const auto& set : buffers.used) any = any || std::find(set.begin(), set.end(), true) != set.end();
+        if (any) {
+          for (int set = 0; set < (stretch ? 2 : 1); ++set) {
+            LargeVector<float>& target = set == 0 ? layer_rgba : hole_rgba;
+            float* rows = target.data() + static_cast<std::size_t>(row_begin) * w * 4;
+            std::fill(rows, rows + static_cast<std::size_t>(row_end - row_begin) * w * 4, 0.0f);
+            for (std::size_t lv = 0; lv < static_cast<std::size_t>(kLevels); ++lv) {
+              if (buffers.used[static_cast<std::size_t>(set)][lv]) buffers.buffers[static_cast<std::size_t>(set)][lv]->resolve_into(target.data());
+            }
           }
+          render_detail::composite_layer_over(layer_rgba, stretch ? &hole_rgba : nullptr, result, w, row_begin, row_end);
         }
-        if (any) render_detail::composite_layer_over(layer_rgba, stretch ? &hole_rgba : nullptr, result, w, row_begin, row_end);
         // Progress in even steps: this layer's share of the sources times the bands it has done.
         if (options.progress) {
           const double fraction = (static_cast<double>(done) + static_cast<double>(layers.members(l).size()) *
