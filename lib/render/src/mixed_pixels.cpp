@@ -405,8 +405,9 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
   // (one more ring): one whose 7 x 7 neighbourhood no pass has moved a pixel of since the previous
   // pass keeps that pass's decision instead of deciding again (bench/blender's fence scene focused
   // on its wall at 6 m decides 40 186 pixels, then 2 207, 601 and 188 again: this stage took 34 ms
-  // and now 19, medians of 9). Per row, every spanning pixel's decision by column; those that change
-  // something are applied in row order.
+  // and now 19, medians of 9). Per row, every spanning pixel's decision by column. Those that change
+  // something are applied after the pass: its moves in row order, the last pass's splits and moves
+  // row by row in parallel.
   std::vector<std::vector<std::pair<int, Decision>>> decided(static_cast<std::size_t>(height)), previous(decided.size());
   LargeVector<std::uint8_t> unchanged(pixels, 0);  // since the previous pass
   std::vector<std::size_t> moved;
