@@ -411,16 +411,19 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
   std::vector<std::vector<std::pair<int, Decision>>> decided(static_cast<std::size_t>(height)), previous(decided.size());
   LargeVector<std::uint8_t> unchanged(pixels, 0);  // since the previous pass
   std::vector<std::size_t> moved;
+  // Per row, its splits (entry y + 1), made prefix sums in the last pass: where its far parts go.
+  std::vector<std::size_t> row_splits(static_cast<std::size_t>(height) + 1, 0);
   for (int pass = 0; pass <= kMovePasses; ++pass) {
     const bool last = pass == kMovePasses;
-    std::size_t changes = 0;
+    std::size_t moves_decided = 0;
     decided.swap(previous);
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 16) reduction(+ : changes)
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 16) reduction(+ : moves_decided)
     for (int y = 0; y < height; ++y) {
       auto& row = decided[static_cast<std::size_t>(y)];
       const auto& before = previous[static_cast<std::size_t>(y)];
       row.clear();
       std::size_t k = 0;  // the previous pass's decision at or after column x
+      std::size_t splits = 0;
       const std::size_t row_start = static_cast<std::size_t>(y) * width;
       for (int x = 0; x < width; ++x) {
         if (!spans[row_start + x]) continue;  // decide() would keep it
@@ -428,19 +431,16 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
         // (A pixel whose neighbourhood is unchanged spanned a step then too: its spans flag did not change.)
         const bool known = unchanged[row_start + x] && k < before.size() && before[k].first == x;
         row.emplace_back(x, known ? before[k].second : decide(sources, next_to_step, width, height, x, y));
-        const Decision& d = row.back().second;
-        if (d.kind != Decision::Kind::Keep && (last || d.kind == Decision::Kind::Move)) ++changes;
+        const Decision::Kind kind = row.back().second.kind;
+        moves_decided += kind == Decision::Kind::Move ? 1 : 0;
+        splits += kind == Decision::Kind::Split ? 1 : 0;
       }
+      row_splits[static_cast<std::size_t>(y) + 1] = splits;
     }
     if (last) {
       // The splits, row by row in parallel (each reads and writes only its own pixel): the far parts
       // appended in row order, each row's after the rows before it.
-      std::vector<std::size_t> row_splits(static_cast<std::size_t>(height) + 1, 0);
-      for (int y = 0; y < height; ++y) {
-        std::size_t n = 0;
-        for (const auto& entry : decided[static_cast<std::size_t>(y)]) n += entry.second.kind == Decision::Kind::Split ? 1 : 0;
-        row_splits[static_cast<std::size_t>(y) + 1] = row_splits[static_cast<std::size_t>(y)] + n;
-      }
+      for (std::size_t y = 0; y < static_cast<std::size_t>(height); ++y) row_splits[y + 1] += row_splits[y];
       const std::size_t first_far = sources.size();
       fault_in(sources, first_far + row_splits.back(), threads);
       sources.resize(first_far + row_splits.back());
@@ -492,7 +492,7 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
         std::fill(r + std::max(0, x - 3), r + std::min(width, x + 4), std::uint8_t{0});
       }
     }
-    if (changes == 0) pass = kMovePasses - 1;  // nothing moved: go to the split
+    if (moves_decided == 0) pass = kMovePasses - 1;  // nothing moved: go to the split
   }
 }
 
