@@ -201,7 +201,9 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
             slot->reset(row_begin, row_end);
           }
           used = true;
-          scatter.deposit(layer[i], plans[i], i, *slot, scratch, local_triangles, local_reused);
+          if (!scatter.deposit_planned_point(layer[i], plans[i], *slot)) {
+            scatter.deposit(layer[i], plans[i], i, *slot, scratch, local_triangles, local_reused);
+          }
           // A footprint cross-faded between two group counts deposits both splits.
           local_footprints += static_cast<std::size_t>(plans[i].groups + (plans[i].blend < 1.0f ? plans[i].groups - 1 : 0));
         }

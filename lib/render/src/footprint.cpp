@@ -1726,6 +1726,18 @@ void FootprintScatter::draw_shape(const ScatterSource& s, const FootprintPlan& p
   }
 }
 
+bool FootprintScatter::deposit_planned_point(const ScatterSource& s, const FootprintPlan& p, SplatBuffer& buffer) const {
+  if (p.outline != FootprintPlan::kPoint || !p.mapped || p.groups != 1 || p.blend != 1.0f || p.images || p.mesh >= 0 ||
+      !(p.passing > 0.0f)) {
+    return false;
+  }
+  std::array<float, 4> v = lit(group_value(s, groups_.split(1).front(), p.blend, p, options_.vignetting), p.centre_weight);
+  const float light = options_.vignetting ? p.passing : 1.0f;
+  for (std::size_t k = 0; k < 3; ++k) v[k] *= light;
+  buffer.add_point({p.affine_px[0], p.affine_px[1]}, v);
+  return true;
+}
+
 void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, std::size_t index, SplatBuffer& buffer,
                                FootprintScratch& scratch, std::size_t& triangles, std::size_t& reused) const {
   // First-order vignetting (the model's pupil discs, the same at every wavelength): the share of the
@@ -1771,7 +1783,10 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, s
   const int own_subrows = footprint_subrows(p, buffer.options().subrows);
   std::vector<SensorHit>& hits = scratch.hits;
   std::vector<Point2f>& points = scratch.points;
-  const ScenePoint point = scene_point(s);
+  // A single group's rays are the plan's, at the reference wavelength: the scene point is needed only
+  // to map others and to clip by discs.
+  const bool planned = p.mapped && p.groups == 1 && p.blend == 1.0f;
+  const ScenePoint point = planned && !p.discs ? ScenePoint{} : scene_point(s);
   if (p.discs && p.outline != FootprintPlan::kPoint) {
     clip_discs(point, scratch.discs);
   } else {
@@ -1797,8 +1812,6 @@ void FootprintScatter::deposit(const ScatterSource& s, const FootprintPlan& p, s
   // One wavelength group's share of the light.
   auto deposit_group = [&](const SpectralGroup& g, float share) {
     const std::array<float, 4> value = group_value(s, g, share, p, options_.vignetting);
-    // A single group's rays are the plan's, at the reference wavelength.
-    const bool planned = p.mapped && p.groups == 1 && p.blend == 1.0f;
     if (p.outline == FootprintPlan::kPoint) {
       PixelPoint c{p.affine_px[0], p.affine_px[1]};
       double centre_weight = p.centre_weight;
