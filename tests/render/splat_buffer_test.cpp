@@ -349,6 +349,13 @@ TEST_CASE("splat buffer: bands of rows 0-36, 37-79 and 80-99 filled separately e
   for (const SplatBuffer& b : bands) b.resolve_into(banded);
   CHECK(max_abs_difference(one, banded) < kBandRoundoff);
   CHECK(channel_sum(one, 0) > 10.0);  // the scene did land in the image
+  // Each band resolved into rows of its own (a renderer's band-sized layer image) holds exactly its
+  // rows of the whole.
+  for (const SplatBuffer& b : bands) {
+    std::vector<float> rows(static_cast<std::size_t>(b.row_end() - b.row_begin()) * kWidth * 4, 0.0f);
+    b.resolve_rows_into(rows.data());
+    CHECK(std::equal(rows.begin(), rows.end(), banded.data.begin() + static_cast<std::ptrdiff_t>(b.row_begin()) * kWidth * 4));
+  }
 }
 
 TEST_CASE("splat buffer: a disc over the image edge keeps only the part inside", "[render][splat]") {
@@ -530,6 +537,10 @@ TEST_CASE("splat buffer at 1/2 and 1/4 resolution: a large disc keeps its value 
       band.add_polygon(disc(101.3, 84.8, kDiameterPx), kValue);
       band.add_point({3.2f, 168.9f}, kValue);
       band.resolve_into(banded);
+      // Resolved into its own rows: the same values as its rows of the whole.
+      std::vector<float> rows(static_cast<std::size_t>(end - begin) * kWidth * 4, 0.0f);
+      band.resolve_rows_into(rows.data());
+      CHECK(std::equal(rows.begin(), rows.end(), banded.data.begin() + static_cast<std::ptrdiff_t>(begin) * kWidth * 4));
     }
     coarse.add_point({3.2f, 168.9f}, kValue);
     CHECK(max_abs_difference(resolved(coarse, kHeight), banded) < 1e-6);

@@ -54,6 +54,10 @@ constexpr int kLevels = 3;
 struct BandBuffers {
   std::array<std::array<std::optional<SplatBuffer>, kLevels>, 2> buffers;
   std::array<std::array<bool, kLevels>, 2> used{};
+  // The band's rows of the layer's image, resolved from the buffers: light, and the hidden coverage.
+  // Band-sized: a frame-sized layer image was 16 bytes a pixel of first-touched memory (33 MB at
+  // 1080p, docs/performance.md), of which each band used only its own rows.
+  std::array<LargeVector<float>, 2> rows;
 };
 // Bands of rows per thread: each band scatters the footprints that reach it, so a footprint that
 // straddles a band's edge is deposited once per band it reaches. Where the model maps a footprint's
@@ -106,12 +110,8 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
 
   const bool stretch = options.hidden == HiddenSurfaces::Stretch;
   const std::size_t frame_floats = static_cast<std::size_t>(w) * h * 4;
-  LargeVector<float> layer_rgba, hole_rgba, result;  // hole_rgba (Stretch): coverage of the hidden sources
-  fault_in(layer_rgba, frame_floats, threads);
-  fault_in(hole_rgba, stretch ? frame_floats : 0, threads);
+  LargeVector<float> result;
   fault_in(result, frame_floats, threads);
-  layer_rgba.resize(frame_floats);
-  hole_rgba.resize(stretch ? frame_floats : 0);
   result.resize(frame_floats, 0.0f);  // premultiplied RGB + coverage
   const int bands = std::max(1, std::min(h, threads * (model.affine_in_pupil() ? kBandsPerThreadAffine : kBandsPerThreadMapped)));
   std::size_t done = 0;
@@ -212,15 +212,16 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
         bool any = false;
         for (const auto& set : buffers.used) any = any || std::find(set.begin(), set.end(), true) != set.end();
         if (any) {
-          for (int set = 0; set < (stretch ? 2 : 1); ++set) {
-            LargeVector<float>& target = set == 0 ? layer_rgba : hole_rgba;
-            float* rows = target.data() + static_cast<std::size_t>(row_begin) * w * 4;
-            std::fill(rows, rows + static_cast<std::size_t>(row_end - row_begin) * w * 4, 0.0f);
+          for (std::size_t set = 0; set < (stretch ? 2u : 1u); ++set) {
+            LargeVector<float>& rows = buffers.rows[set];
+            rows.resize(static_cast<std::size_t>(row_end - row_begin) * static_cast<std::size_t>(w) * 4);
+            std::fill(rows.begin(), rows.end(), 0.0f);
             for (std::size_t lv = 0; lv < static_cast<std::size_t>(kLevels); ++lv) {
-              if (buffers.used[static_cast<std::size_t>(set)][lv]) buffers.buffers[static_cast<std::size_t>(set)][lv]->resolve_into(target.data());
+              if (buffers.used[set][lv]) buffers.buffers[set][lv]->resolve_rows_into(rows.data());
             }
           }
-          render_detail::composite_layer_over(layer_rgba, stretch ? &hole_rgba : nullptr, result, w, row_begin, row_end);
+          render_detail::composite_layer_over(buffers.rows[0].data(), stretch ? buffers.rows[1].data() : nullptr, result, w, row_begin,
+                                              row_end);
         }
         // Progress in even steps: this layer's share of the sources times the bands it has done.
         if (options.progress) {

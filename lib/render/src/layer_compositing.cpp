@@ -23,13 +23,17 @@ constexpr double kHalfCovered = 0.5;
 constexpr double kGapTolerance = 1e-9;
 }  // namespace
 
-void composite_layer_over(const LargeVector<float>& layer_rgba, const LargeVector<float>* holes, LargeVector<float>& result,
-                          int width, int row_begin, int row_end) {
-  for (std::size_t k = static_cast<std::size_t>(row_begin) * width; k < static_cast<std::size_t>(row_end) * width; ++k) {
-    double c[4] = {layer_rgba[4 * k], layer_rgba[4 * k + 1], layer_rgba[4 * k + 2], layer_rgba[4 * k + 3]};
-    if (holes && c[3] > kGapTolerance) {
+void composite_layer_over(const float* layer_rows, const float* hole_rows, LargeVector<float>& result, int width, int row_begin,
+                          int row_end) {
+  const std::size_t first = static_cast<std::size_t>(row_begin) * static_cast<std::size_t>(width);
+  const std::size_t count = static_cast<std::size_t>(row_end - row_begin) * static_cast<std::size_t>(width);
+  for (std::size_t j = 0; j < count; ++j) {
+    const std::size_t k = first + j;
+    const float* layer = layer_rows + 4 * j;
+    double c[4] = {layer[0], layer[1], layer[2], layer[3]};
+    if (hole_rows && c[3] > kGapTolerance) {
       // The layer's colour spread over its own coverage and that of its hidden sources.
-      const double total = std::min(1.0, c[3] + std::max(0.0, static_cast<double>((*holes)[4 * k + 3])));
+      const double total = std::min(1.0, c[3] + std::max(0.0, static_cast<double>(hole_rows[4 * j + 3])));
       if (total > c[3]) {
         const double scale = total / c[3];
         for (double& v : c) v *= scale;

@@ -20,11 +20,12 @@
 namespace lensmith::render_detail {
 
 // result (premultiplied RGB + coverage, float, w x h x 4; each layer composited in double: the picture
-// is float, and a frame's doubles were 8 MB of first-touched memory at 600 x 400) = layer rows [row_begin, row_end) over
-// result. `holes` (HiddenSurfaces::Stretch, else null): the coverage of the layer's hidden sources in
-// channel 3; the layer's colour is renormalised over it.
-void composite_layer_over(const LargeVector<float>& layer_rgba, const LargeVector<float>* holes, LargeVector<float>& result,
-                          int width, int row_begin, int row_end);
+// is float, and a frame's doubles were 8 MB of first-touched memory at 600 x 400) = a layer's rows
+// [row_begin, row_end) over result. `layer_rows`: those rows of the layer alone (w x (row_end - row_begin)
+// x 4 floats, premultiplied RGB + coverage). `hole_rows` (HiddenSurfaces::Stretch, else null): the
+// same rows' coverage of the layer's hidden sources in channel 3; the layer's colour is renormalised over it.
+void composite_layer_over(const float* layer_rows, const float* hole_rows, LargeVector<float>& result, int width, int row_begin,
+                          int row_end);
 
 // Whether some pixel of the result is covered less than half (then the image circle is measured).
 bool has_gaps(const LargeVector<float>& result);

@@ -978,11 +978,15 @@ void SplatBuffer::add_image(std::span<const float> samples, int nx, int ny, floa
 }
 
 void SplatBuffer::resolve_into(float* rgba_full_image) const {
+  resolve_rows_into(rgba_full_image + static_cast<std::size_t>(row_begin_) * static_cast<std::size_t>(width_) * kChannels);
+}
+
+void SplatBuffer::resolve_rows_into(float* rgba_rows) const {
   const std::size_t grid_row_size = static_cast<std::size_t>(grid_width_) * kChannels;
   if (options_.downsample == 1) {
     for (int row = row_begin_; row < row_end_; ++row) {
       const double* d = diff_.data() + static_cast<std::size_t>(row - row_begin_) * grid_row_size;
-      float* out = rgba_full_image + static_cast<std::size_t>(row) * grid_row_size;
+      float* out = rgba_rows + static_cast<std::size_t>(row - row_begin_) * grid_row_size;
       double sum[kChannels] = {0.0, 0.0, 0.0, 0.0};
       for (std::size_t i = 0; i < grid_row_size; i += kChannels) {
         for (int c = 0; c < kChannels; ++c) {
@@ -1023,7 +1027,7 @@ void SplatBuffer::resolve_into(float* rgba_full_image) const {
     const std::size_t r0 = static_cast<std::size_t>(static_cast<int>(g0) - grid_row_begin_);
     const double* top = cells.data() + r0 * grid_row_size;
     const double* bottom = top + grid_row_size;
-    float* out = rgba_full_image + static_cast<std::size_t>(row) * out_row_size;
+    float* out = rgba_rows + static_cast<std::size_t>(row - row_begin_) * out_row_size;
     for (int x = 0; x < width_; ++x) {
       const double gx = (x + 0.5) * scale_ - 0.5 + x_offset_;
       const double c0 = fast_floor(gx);

@@ -168,6 +168,9 @@ class SplatBuffer {
   // Prefix-sums each row and adds the band into rgba_full_image: the full image, width() x (at
   // least row_end()) pixels x 4 floats, row-major, top row first; rows outside the band untouched.
   void resolve_into(float* rgba_full_image) const;
+  // The same into the band's rows alone: `rgba_rows` holds width() x (row_end() - row_begin())
+  // pixels x 4 floats, row row_begin() first (a renderer's band-sized image of a layer).
+  void resolve_rows_into(float* rgba_rows) const;
   // The same into an Image; throws OptionsError unless it is width() wide, 4 channels and at least
   // row_end() rows high.
   void resolve_into(Image& rgba) const;
