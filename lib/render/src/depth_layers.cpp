@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <string>
 
+#include "lensmith/core/errors.h"
 #include "lensmith/core/units.h"
 
 namespace lensmith::render_detail {
@@ -51,11 +55,17 @@ DepthLayers make_depth_layers(const ScatterSources& sources, int width, int heig
   static_cast<LayerSpacing&>(l) = spacing;
   l.max_blur_px.assign(static_cast<std::size_t>(l.count), 0.0);
   const std::size_t pixel_count = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-  // Each source's layer, once (threads); the passes below are serial, as each appends in source order.
+  // Each source's layer, once (threads; 2 bytes: BokehOptions::max_layers is at most 1024, and the
+  // focus split adds 2); the passes below are serial, as each places in source order.
+  if (l.count < 1 || l.count > std::numeric_limits<std::uint16_t>::max()) {
+    throw OptionsError("depth layers: " + std::to_string(l.count) + " layers; 1 to 65535 are possible");
+  }
   const auto n = static_cast<std::ptrdiff_t>(sources.size());
-  LargeVector<std::int32_t> layer_of(sources.size());
+  LargeVector<std::uint16_t> layer_of(sources.size());
 #pragma omp parallel for num_threads(threads) schedule(static)
-  for (std::ptrdiff_t i = 0; i < n; ++i) layer_of[static_cast<std::size_t>(i)] = spacing.layer_at(sources[static_cast<std::size_t>(i)].coc_px);
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    layer_of[static_cast<std::size_t>(i)] = static_cast<std::uint16_t>(spacing.layer_at(sources[static_cast<std::size_t>(i)].coc_px));
+  }
   // Parts grouped by pixel: counted, then placed (a split pixel's second part comes at the end of
   // the sources). Sources beyond the frame (the scatter's margin) are no pixel's parts: they only
   // scatter. The layers' members are placed at their final positions: grown by doubling, the lists
@@ -66,27 +76,33 @@ DepthLayers make_depth_layers(const ScatterSources& sources, int width, int heig
   for (std::size_t i = 0; i < sources.size(); ++i) {
     const ScatterSource& s = sources[i];
     if (inside(s)) ++l.part_begin[static_cast<std::size_t>(s.y) * width + s.x + 1];
-    ++member_count[static_cast<std::size_t>(layer_of[i])];
+    ++member_count[layer_of[i]];
   }
+  // part_begin[p + 1]: where pixel p's parts end.
   for (std::size_t p = 0; p < pixel_count; ++p) l.part_begin[p + 1] += l.part_begin[p];
   l.parts.resize(l.part_begin[pixel_count]);
   l.member_begin.assign(member_count.size() + 1, 0);
   for (std::size_t k = 0; k < member_count.size(); ++k) l.member_begin[k + 1] = l.member_begin[k] + member_count[k];
   l.member_store.resize(sources.size());
-  std::vector<std::size_t> next_member(l.member_begin.begin(), l.member_begin.end() - 1);
-  LargeVector<std::uint32_t> next(l.part_begin.begin(), l.part_begin.end() - 1);
-  for (std::size_t i = 0; i < sources.size(); ++i) {
+  // Placed from each list's end, sources in reverse (so each list is in source order), without a
+  // copy of the pixels' or the layers' positions (4 bytes a pixel of first-touched memory): each
+  // pixel's end moves down to its start, part_begin[p + 1] to where p's parts begin.
+  std::vector<std::size_t> member_end(l.member_begin.begin() + 1, l.member_begin.end());
+  for (std::size_t i = sources.size(); i-- > 0;) {
     const ScatterSource& s = sources[i];
-    const int k = layer_of[i];
+    const std::size_t k = layer_of[i];
     if (inside(s)) {
-      PixelPart& part = l.parts[next[static_cast<std::size_t>(s.y) * width + s.x]++];
-      part.layer = k;
+      PixelPart& part = l.parts[--l.part_begin[static_cast<std::size_t>(s.y) * width + s.x + 1]];
+      part.layer = static_cast<int>(k);
       part.visible = s.coverage - s.hidden;
       part.hidden = s.hidden;
     }
-    l.member_store[next_member[static_cast<std::size_t>(k)]++] = static_cast<int>(i);
-    l.max_blur_px[static_cast<std::size_t>(k)] = std::max(l.max_blur_px[static_cast<std::size_t>(k)], std::abs(s.coc_px));
+    l.member_store[--member_end[k]] = static_cast<int>(i);
+    l.max_blur_px[k] = std::max(l.max_blur_px[k], std::abs(s.coc_px));
   }
+  // Now part_begin[p + 1] is where p's parts begin: each moves down one place, and the end is the total.
+  std::copy(l.part_begin.begin() + 1, l.part_begin.end(), l.part_begin.begin());
+  l.part_begin[pixel_count] = static_cast<std::uint32_t>(l.parts.size());
   l.nearer_blur_px.assign(static_cast<std::size_t>(l.count), 0.0);
   for (int k = l.count - 2; k >= 0; --k) {
     const auto u = static_cast<std::size_t>(k);
