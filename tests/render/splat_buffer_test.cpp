@@ -5,6 +5,7 @@
 
 #include <catch2/catch.hpp>
 #include <algorithm>
+#include <functional>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -355,6 +356,60 @@ TEST_CASE("splat buffer: bands of rows 0-36, 37-79 and 80-99 filled separately e
     std::vector<float> rows(static_cast<std::size_t>(b.row_end() - b.row_begin()) * kWidth * 4, 0.0f);
     b.resolve_rows_into(rows.data());
     CHECK(std::equal(rows.begin(), rows.end(), banded.data.begin() + static_cast<std::ptrdiff_t>(b.row_begin()) * kWidth * 4));
+  }
+}
+
+TEST_CASE("splat buffer: reset from band to band it resolves what a fresh buffer does, and rows it was not drawn in stay 0", "[render][splat]") {
+  // A buffer zeroes and resolves only the rows drawn in since its last reset (touched_rows): a
+  // renderer's layer reaches a few rows of a band. Drawn in a stripe of each band, by a polygon, a
+  // point, points and (at full resolution) a stamp; the previous band's deposits must not survive.
+  constexpr int kWidth = 90, kHeight = 120;
+  for (const int k : {1, 2}) {
+    SplatOptions options;
+    options.downsample = k;
+    SplatBuffer reused(kWidth, 0, 40, options);
+    for (const auto& [begin, end] : std::vector<std::pair<int, int>>{{0, 40}, {40, 100}, {10, 30}, {100, kHeight}, {0, kHeight}}) {
+      INFO("1/" << k << " resolution, rows " << begin << " to " << end);
+      reused.reset(begin, end);
+      SplatBuffer fresh(kWidth, begin, end, options);
+      const double y = begin + 0.3 * (end - begin);
+      const std::array<std::array<float, 3>, 2> points{{{0.0f, 0.0f, 0.5f}, {1.5f, 0.7f, 0.5f}}};
+      const DifferenceStamp stamp = SplatBuffer::record(disc(0.3, 0.2, 3.0), 4);
+      const std::vector<std::function<void(SplatBuffer&)>> kinds{
+          [&](SplatBuffer& b) { b.add_polygon(disc(20.4, y, 5.0), kValue); },
+          [&](SplatBuffer& b) { b.add_point({60.2f, static_cast<float>(y + 2.6)}, kValue); },
+          [&](SplatBuffer& b) { b.add_points(points, {1.0f, 0.0f, 0.0f, 1.0f}, {40.3f, static_cast<float>(y)}, kValue); },
+          [&](SplatBuffer& b) {
+            if (k == 1) b.add_stamp(stamp, 70, static_cast<int>(y), kValue);
+          }};
+      // Each kind alone, inside the band, keeps its whole value (a deposit whose rows were not marked
+      // would resolve to nothing).
+      for (std::size_t kind = 0; kind < kinds.size(); ++kind) {
+        if (k > 1 && kind == 3) continue;  // stamps are for full-resolution buffers
+        SplatBuffer alone(kWidth, begin, end, options);
+        kinds[kind](alone);
+        INFO("deposit kind " << kind);
+        CHECK_THAT(channel_sum(resolved(alone, kHeight), 0), WithinRel(double{kValue[0]}, kEnergyRoundoff));
+      }
+      auto draw = [&](SplatBuffer& b) {
+        for (const auto& add : kinds) add(b);
+      };
+      draw(reused);
+      draw(fresh);
+      const Image got = resolved(reused, kHeight), want = resolved(fresh, kHeight);
+      CHECK(got.data == want.data);
+      CHECK(channel_sum(got, 0) > 1.0);
+      // The stripe's rows, and nothing resolved outside them: about 9 px drawn (the 5-px disc, the
+      // point 2.6 px below), 2 cells of margin either side (touch_cells) and the cell a coarse grid
+      // interpolates from: at most 9 + 4 k + 2 k px, well short of the 60- and 120-row bands.
+      const auto [first, last] = reused.touched_rows();
+      CHECK(first < last);
+      CHECK(last - first <= 9 + 6 * k);
+      for (int row = 0; row < kHeight; ++row) {
+        if (row >= first && row < last) continue;
+        for (int x = 0; x < kWidth; ++x) CHECK(got.at(x, row, 0) == 0.0f);
+      }
+    }
   }
 }
 

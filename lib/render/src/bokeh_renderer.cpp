@@ -207,21 +207,32 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
           // A footprint cross-faded between two group counts deposits both splits.
           local_footprints += static_cast<std::size_t>(plans[i].groups + (plans[i].blend < 1.0f ? plans[i].groups - 1 : 0));
         }
-        // A band this layer reaches is resolved and composited over the result; one it does not
-        // reach is left as it is (its rows of the layer's image are not even cleared).
-        bool any = false;
-        for (const auto& set : buffers.used) any = any || std::find(set.begin(), set.end(), true) != set.end();
-        if (any) {
+        // The rows of the band this layer reaches are resolved and composited over the result; the
+        // others are left as they are (the layer is empty there; its image is not even cleared).
+        int first = row_end, end = row_begin;
+        for (std::size_t set = 0; set < 2; ++set) {
+          for (std::size_t lv = 0; lv < static_cast<std::size_t>(kLevels); ++lv) {
+            if (!buffers.used[set][lv]) continue;
+            const auto [touched_first, touched_end] = buffers.buffers[set][lv]->touched_rows();
+            if (touched_first >= touched_end) continue;
+            first = std::min(first, touched_first);
+            end = std::max(end, touched_end);
+          }
+        }
+        if (first < end) {
+          const std::size_t row_floats = static_cast<std::size_t>(w) * 4;
+          const std::size_t skip = static_cast<std::size_t>(first - row_begin) * row_floats;
           for (std::size_t set = 0; set < (stretch ? 2u : 1u); ++set) {
             LargeVector<float>& rows = buffers.rows[set];
-            rows.resize(static_cast<std::size_t>(row_end - row_begin) * static_cast<std::size_t>(w) * 4);
-            std::fill(rows.begin(), rows.end(), 0.0f);
+            rows.resize(static_cast<std::size_t>(row_end - row_begin) * row_floats);
+            std::fill(rows.begin() + static_cast<std::ptrdiff_t>(skip),
+                      rows.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(end - row_begin) * row_floats), 0.0f);
             for (std::size_t lv = 0; lv < static_cast<std::size_t>(kLevels); ++lv) {
               if (buffers.used[set][lv]) buffers.buffers[set][lv]->resolve_rows_into(rows.data());
             }
           }
-          render_detail::composite_layer_over(buffers.rows[0].data(), stretch ? buffers.rows[1].data() : nullptr, result, w, row_begin,
-                                              row_end);
+          render_detail::composite_layer_over(buffers.rows[0].data() + skip, stretch ? buffers.rows[1].data() + skip : nullptr, result, w,
+                                              first, end);
         }
         // Progress in even steps: this layer's share of the sources times the bands it has done.
         if (options.progress) {

@@ -6,6 +6,7 @@
 // generalised to polygons with a tent filter.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <limits>
 #include <cstddef>
@@ -13,6 +14,7 @@
 #include <ostream>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "lensmith/core/huge_page_allocator.h"
@@ -171,6 +173,10 @@ class SplatBuffer {
   // The same into the band's rows alone: `rgba_rows` holds width() x (row_end() - row_begin())
   // pixels x 4 floats, row row_begin() first (a renderer's band-sized image of a layer).
   void resolve_rows_into(float* rgba_rows) const;
+  // The output rows [first, second) that resolving may change: those the deposits since the last
+  // reset or clear reached (with the rows a coarse grid interpolates from them); empty (first >=
+  // second) when nothing was deposited. The band's other rows resolve to 0.
+  std::pair<int, int> touched_rows() const;
   // The same into an Image; throws OptionsError unless it is width() wide, 4 channels and at least
   // row_end() rows high.
   void resolve_into(Image& rgba) const;
@@ -270,11 +276,26 @@ class SplatBuffer {
     std::uint32_t offset = 0, count = 0;  // its samples in image_row_
   };
   std::vector<ImageSpan> image_spans_;
-  // add_image's deposits as values (not differences), added to the picture by resolve_into; sized
-  // and zeroed on a band's first add_image.
+  // add_image's deposits as values (not differences), added to the picture by resolve_into; the
+  // same rows as diff_, sized on a band's first add_image.
   LargeVector<float> dense_;
   bool dense_used_ = false;
   void use_dense();
+  // The grid rows written since the last reset or clear, [dirty_first_, dirty_last_] (empty when
+  // first > last). Every entry of diff_ and dense_ outside them is 0: a reset or clear zeroes them
+  // alone, and resolving touches them alone (and the rows interpolated from them). A layer's band
+  // of a renderer is written in a few of its rows (a stripe of a receding street), and zeroing and
+  // resolving the whole band, 48 bytes a pixel, was most of what a sharp layer's band cost.
+  int dirty_first_ = std::numeric_limits<int>::max();
+  int dirty_last_ = std::numeric_limits<int>::min();
+  void touch(int first_grid_row, int last_grid_row) {
+    dirty_first_ = std::min(dirty_first_, first_grid_row);
+    dirty_last_ = std::max(dirty_last_, last_grid_row);
+  }
+  // Zeroes the dirty rows of diff_ and dense_ and marks none dirty.
+  void zero_dirty_rows();
+  // Marks the rows a polygon or mesh spanning grid y in [top, bottom] may reach (none if not finite).
+  void touch_cells(double top, double bottom);
 };
 
 }  // namespace lensmith
