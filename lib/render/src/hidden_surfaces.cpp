@@ -174,8 +174,10 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
   // whole of the nearer branch's blur, 17 % too bright there (examples/scenes/branches.json).
   // (None to compute where no farther layer shows in the window: the layer claims all of it.)
   LargeVector<PushPullCell<2>>& shares = scratch.shares;
+  // (None where no source at all lies on a farther layer, as behind the fence's wall: no scan.)
   bool farther = false;
-  for (int y = y0; y <= y1 && !farther; ++y) {
+  const bool any_farther = layers.member_begin[static_cast<std::size_t>(layer)] > layers.member_begin[0];
+  for (int y = y0; y <= y1 && any_farther && !farther; ++y) {
     for (int x = x0; x <= x1 && !farther; ++x) {
       const std::size_t p = static_cast<std::size_t>(y) * w + x;
       for (std::uint32_t k = layers.part_begin[p]; k < layers.part_begin[p + 1]; ++k) farther = farther || layers.parts[k].layer < layer;

@@ -104,9 +104,13 @@ void push_pull(int w, int h, LargeVector<PushPullCell<N>>& cells, int threads, P
       v[kWeight] = std::max({a[kWeight], b[kWeight], d[kWeight], e[kWeight], own[kWeight]}) > 0.0f ? 1.0f : 0.0f;
     };
     if (l == 0 && !finish.empty()) {
-      // Only the cells the caller reads (their values are the same as when every cell is finished).
+      // Only the cells the caller reads (their values are the same as when every cell is finished),
+      // each on its own (threads).
       const auto row = static_cast<std::size_t>(fw);
-      for (const std::size_t i : finish) {
+      const auto count = static_cast<std::ptrdiff_t>(finish.size());
+#pragma omp parallel for num_threads(threads) schedule(static) if (count > kParallelCells / 4)
+      for (std::ptrdiff_t k = 0; k < count; ++k) {
+        const std::size_t i = finish[static_cast<std::size_t>(k)];
         const auto y = static_cast<int>(i / row);
         push(static_cast<int>(i % row), y, above(y));
       }
