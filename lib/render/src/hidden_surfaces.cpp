@@ -129,15 +129,7 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
   x1 = std::min(w - 1, x1 + reach);
   y1 = std::min(h - 1, y1 + reach);
   const int ww = x1 - x0 + 1, wh = y1 - y0 + 1;
-  LargeVector<PushPullCell<5>>& cells = scratch.cells;
-  // The whole frame's address space once (reserve is free until touched), so that no layer's
-  // larger window moves the cells to fresh memory.
-  cells.reserve(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
-  scratch.push_pull.reserve(w, h);
-  cells.clear();
-  fault_in(cells, static_cast<std::size_t>(ww) * wh, threads);
-  cells.resize(static_cast<std::size_t>(ww) * wh);
-  // The targets' cells: the only ones read below, so the only ones the push-pulls finish.
+  // The targets' cells in the window: the only ones of its finest level the push-pulls finish.
   std::vector<std::size_t>& target_cells = scratch.target_cells;
   target_cells.resize(targets.size());
   for (std::size_t k = 0; k < targets.size(); ++k) {
@@ -145,36 +137,62 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
     target_cells[k] = (i / static_cast<std::size_t>(w) - static_cast<std::size_t>(y0)) * static_cast<std::size_t>(ww) +
                       (i % static_cast<std::size_t>(w) - static_cast<std::size_t>(x0));
   }
+  // The push-pulls' finest level is never made: the window's pixels are summed into level 1
+  // directly, rows first within each 2 x 2 block as the pull sums them (so the same floats), and the
+  // targets' own pixels apart (push_pull_targets). A window-sized finest level (20 + 8 bytes a
+  // pixel) was zeroed, filled and read again for every layer.
+  const int cw = (ww + 1) / 2, ch = (wh + 1) / 2;
+  // The whole frame's address space once (reserve is free until touched), so that no layer's
+  // larger window moves the levels to fresh memory.
+  scratch.push_pull.reserve(w, h);
+  LargeVector<PushPullCell<5>>& first = push_pull_first_level(ww, wh, scratch.push_pull);
+  std::vector<PushPullCell<5>>& own = scratch.own;
+  own.assign(targets.size(), PushPullCell<5>{});
   // The layer's own whole pixels (the parts of split edge pixels are uncertain estimates). Each thread
-  // adds those of its block of the window's rows, in the members' order (a deep pixel's opaque
-  // samples may share a cell), so the sums are the same whatever the threads.
+  // adds those of its block of level 1's rows, in the members' order (raster order; a deep pixel's
+  // opaque samples may share a cell), so the sums are the same whatever the threads; a member on a
+  // target's pixel goes to that target's own sums too (the targets are in raster order).
 #pragma omp parallel num_threads(threads)
   {
     const int t = omp_get_thread_num(), n = omp_get_num_threads();
-    const int ya = y0 + static_cast<int>(static_cast<long long>(wh) * t / n);
-    const int yb = y0 + static_cast<int>(static_cast<long long>(wh) * (t + 1) / n);
+    const int cya = static_cast<int>(static_cast<long long>(ch) * t / n), cyb = static_cast<int>(static_cast<long long>(ch) * (t + 1) / n);
+    std::fill(first.begin() + static_cast<std::ptrdiff_t>(cya) * cw, first.begin() + static_cast<std::ptrdiff_t>(cyb) * cw,
+              PushPullCell<5>{});
+    const int ya = y0 + 2 * cya, yb = std::min(y1 + 1, y0 + 2 * cyb);
+    const auto row_start = [&](int y) {
+      return std::lower_bound(targets.begin(), targets.end(), static_cast<std::size_t>(y) * static_cast<std::size_t>(w)) - targets.begin();
+    };
+    const std::ptrdiff_t target_first = row_start(ya);
+    std::ptrdiff_t k = target_first;
+    std::size_t last_pixel = 0;
     for (const int i : members) {
       const ScatterSource& p = sources[static_cast<std::size_t>(i)];
       if (p.y < ya || p.y >= yb || p.x < x0 || p.x > x1 || p.coverage < 1.0f) continue;
-      PushPullCell<5>& cell = cells[static_cast<std::size_t>(p.y - y0) * ww + (p.x - x0)];
       const double c = p.coverage;
-      cell[0] += static_cast<float>(c * tone(p.rgb[0] / p.coverage));
-      cell[1] += static_cast<float>(c * tone(p.rgb[1] / p.coverage));
-      cell[2] += static_cast<float>(c * tone(p.rgb[2] / p.coverage));
-      cell[3] += static_cast<float>(c * p.inverse_depth_per_mm);
-      cell[4] += static_cast<float>(c);
+      const PushPullCell<5> v{static_cast<float>(c * tone(p.rgb[0] / p.coverage)), static_cast<float>(c * tone(p.rgb[1] / p.coverage)),
+                              static_cast<float>(c * tone(p.rgb[2] / p.coverage)), static_cast<float>(c * p.inverse_depth_per_mm),
+                              static_cast<float>(c)};
+      PushPullCell<5>& cell = first[static_cast<std::size_t>((p.y - y0) / 2) * cw + static_cast<std::size_t>((p.x - x0) / 2)];
+      for (std::size_t q = 0; q < 5; ++q) cell[q] += v[q];
+      // The next target at or after this pixel (searched again where a member comes out of order).
+      const std::size_t pixel = static_cast<std::size_t>(p.y) * w + static_cast<std::size_t>(p.x);
+      if (pixel < last_pixel) k = std::lower_bound(targets.begin() + target_first, targets.end(), pixel) - targets.begin();
+      last_pixel = pixel;
+      while (k < static_cast<std::ptrdiff_t>(targets.size()) && targets[static_cast<std::size_t>(k)] < pixel) ++k;
+      if (k < static_cast<std::ptrdiff_t>(targets.size()) && targets[static_cast<std::size_t>(k)] == pixel) {
+        for (std::size_t q = 0; q < 5; ++q) own[static_cast<std::size_t>(k)][q] += v[q];
+      }
     }
   }
-  push_pull(ww, wh, cells, threads, &scratch.push_pull, target_cells);
+  push_pull_targets<5>(ww, wh, scratch.push_pull, target_cells, own, threads);
   // The layer's share of what lies behind the nearer pixels: among the visible parts of this layer
   // and of every farther one, the fraction on this layer, interpolated by the same push-pull. Each
   // farther layer claims only its share, so that composited "over" one another the layers behind an
   // occluder mix as their pixels around it do. Without it every layer claimed all of it, and the
   // nearest of them hid the others: a branch crossing behind a nearer one was extended under the
   // whole of the nearer branch's blur, 17 % too bright there (examples/scenes/branches.json).
-  // (None to compute where no farther layer shows in the window: the layer claims all of it.)
-  LargeVector<PushPullCell<2>>& shares = scratch.shares;
-  // (None where no source at all lies on a farther layer, as behind the fence's wall: no scan.)
+  // (None to compute where no farther layer shows in the window: the layer claims all of it; none
+  // where no source at all lies on a farther layer, as behind the fence's wall: no scan.)
   bool farther = false;
   const bool any_farther = layers.member_begin[static_cast<std::size_t>(layer)] > layers.member_begin[0];
   for (int y = y0; y <= y1 && any_farther && !farther; ++y) {
@@ -183,24 +201,44 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
       for (std::uint32_t k = layers.part_begin[p]; k < layers.part_begin[p + 1]; ++k) farther = farther || layers.parts[k].layer < layer;
     }
   }
+  std::vector<PushPullCell<2>>& own_shares = scratch.own_shares;
   if (farther) {
-    shares.reserve(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+    // A pixel's cell: its parts on this layer and on this or farther ones.
+    auto share_cell = [&](int x, int y) {
+      const std::size_t p = static_cast<std::size_t>(y) * w + x;
+      PushPullCell<2> cell{};
+      for (std::uint32_t k = layers.part_begin[p]; k < layers.part_begin[p + 1]; ++k) {
+        const PixelPart& part = layers.parts[k];
+        if (part.layer > layer) continue;
+        if (part.layer == layer) cell[0] += part.visible;
+        cell[1] += part.visible;
+      }
+      return cell;
+    };
     scratch.push_pull_shares.reserve(w, h);
-    shares.assign(cells.size(), PushPullCell<2>{});
+    LargeVector<PushPullCell<2>>& first_shares = push_pull_first_level(ww, wh, scratch.push_pull_shares);
 #pragma omp parallel for num_threads(threads) schedule(static)
-    for (int y = y0; y <= y1; ++y) {
-      for (int x = x0; x <= x1; ++x) {
-        const std::size_t p = static_cast<std::size_t>(y) * w + x;
-        PushPullCell<2>& cell = shares[static_cast<std::size_t>(y - y0) * ww + (x - x0)];
-        for (std::uint32_t k = layers.part_begin[p]; k < layers.part_begin[p + 1]; ++k) {
-          const PixelPart& part = layers.parts[k];
-          if (part.layer > layer) continue;
-          if (part.layer == layer) cell[0] += part.visible;
-          cell[1] += part.visible;
+    for (int cy = 0; cy < ch; ++cy) {
+      for (int cx = 0; cx < cw; ++cx) {
+        PushPullCell<2> sum{};
+        for (int y = y0 + 2 * cy; y < std::min(y1 + 1, y0 + 2 * cy + 2); ++y) {
+          for (int x = x0 + 2 * cx; x < std::min(x1 + 1, x0 + 2 * cx + 2); ++x) {
+            const PushPullCell<2> cell = share_cell(x, y);
+            sum[0] += cell[0];
+            sum[1] += cell[1];
+          }
         }
+        first_shares[static_cast<std::size_t>(cy) * cw + static_cast<std::size_t>(cx)] = sum;
       }
     }
-    push_pull(ww, wh, shares, threads, &scratch.push_pull_shares, target_cells);
+    own_shares.resize(targets.size());
+    const auto count = static_cast<std::ptrdiff_t>(targets.size());
+#pragma omp parallel for num_threads(threads) schedule(static)
+    for (std::ptrdiff_t k = 0; k < count; ++k) {
+      const std::size_t i = targets[static_cast<std::size_t>(k)];
+      own_shares[static_cast<std::size_t>(k)] = share_cell(static_cast<int>(i % static_cast<std::size_t>(w)), static_cast<int>(i / static_cast<std::size_t>(w)));
+    }
+    push_pull_targets<2>(ww, wh, scratch.push_pull_shares, target_cells, own_shares, threads);
   }
   // One source per target, made in parallel in the targets' order; those with nothing hidden to
   // stand for (no coverage) are dropped after.
@@ -212,12 +250,12 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
   for (std::ptrdiff_t k = 0; k < target_count; ++k) {
     const auto u = static_cast<std::size_t>(k);
     const std::size_t i = targets[u];
-    const auto& v = cells[target_cells[u]];
+    const auto& v = own[u];
     ScatterSource& s = out[before + u];
     s = ScatterSource{};
     s.x = static_cast<int>(i % static_cast<std::size_t>(w));
     s.y = static_cast<int>(i / static_cast<std::size_t>(w));
-    const double share = farther ? shares[target_cells[u]][0] : 1.0;
+    const double share = farther ? own_shares[u][0] : 1.0;
     s.coverage = layers.unknown_behind(i, layer) * static_cast<float>(share);
     if (!(s.coverage > 0.0f)) continue;
     s.coverage_only = mode == HiddenSurfaces::Stretch;

@@ -25,20 +25,23 @@ PushPullCell<N> normalised(const PushPullCell<N>& v) {
 
 }  // namespace
 
+namespace {
+
+// The pull and the push of push_pull. `cells`: the finest level, or null where the caller gave level
+// 1 in levels[0] and the finest level only at `finish` (`own`).
 template <std::size_t N>
-void push_pull(int w, int h, LargeVector<PushPullCell<N>>& cells, int threads, PushPullScratch<N>* scratch,
-               std::span<const std::size_t> finish) {
+void run_push_pull(int w, int h, LargeVector<PushPullCell<N>>* cells, int threads, std::vector<LargeVector<PushPullCell<N>>>& levels,
+                   std::span<const std::size_t> finish, std::span<PushPullCell<N>> own) {
   using Cell = PushPullCell<N>;
   constexpr std::size_t kWeight = N - 1;
   // Pull: each level sums 2 x 2 blocks of the one below, down to a single cell.
-  PushPullScratch<N> local;
-  std::vector<LargeVector<Cell>>& levels = (scratch ? *scratch : local).levels;
   std::vector<std::pair<int, int>> sizes{{w, h}};
+  if (!cells && (w > 1 || h > 1)) sizes.push_back({(w + 1) / 2, (h + 1) / 2});  // given
   while (sizes.back().first > 1 || sizes.back().second > 1) {
     const int fw = sizes.back().first, fh = sizes.back().second;
     const int cw = (fw + 1) / 2, ch = (fh + 1) / 2;
     if (levels.size() < sizes.size()) levels.emplace_back();
-    const LargeVector<Cell>& f = sizes.size() == 1 ? cells : levels[sizes.size() - 2];
+    const LargeVector<Cell>& f = sizes.size() == 1 ? *cells : levels[sizes.size() - 2];
     LargeVector<Cell>& c = levels[sizes.size() - 1];
     c.resize(static_cast<std::size_t>(cw) * ch);  // every cell is written below
     // Each coarse row from its two fine rows: rows are independent.
@@ -57,8 +60,10 @@ void push_pull(int w, int h, LargeVector<PushPullCell<N>>& cells, int threads, P
   }
   const std::size_t level_count = sizes.size() - 1;
   if (level_count == 0) {  // a single cell
-    cells[0] = normalised(cells[0]);
-    if (cells[0][kWeight] > 0.0f) cells[0][kWeight] = 1.0f;
+    for (Cell& one : cells ? std::span<Cell>(cells->data(), 1) : own) {
+      one = normalised(one);
+      if (one[kWeight] > 0.0f) one[kWeight] = 1.0f;
+    }
     return;
   }
   // Push: from the coarsest level down, every cell becomes its own normalised value blended by its
@@ -68,7 +73,8 @@ void push_pull(int w, int h, LargeVector<PushPullCell<N>>& cells, int threads, P
   top = normalised(top);
   if (top[kWeight] > 0.0f) top[kWeight] = 1.0f;
   for (std::size_t l = level_count; l-- > 0;) {
-    LargeVector<Cell>& f = l == 0 ? cells : levels[l - 1];
+    // (Level 0 without its cells: only `own`'s, below.)
+    Cell* const f = l == 0 ? (cells ? cells->data() : nullptr) : levels[l - 1].data();
     const LargeVector<Cell>& c = levels[l];
     const int fw = sizes[l].first, fh = sizes[l].second;
     const int cw = sizes[l + 1].first, ch = sizes[l + 1].second;
@@ -82,8 +88,8 @@ void push_pull(int w, int h, LargeVector<PushPullCell<N>>& cells, int threads, P
       const int y0 = static_cast<int>(cy);
       return Above{y0, std::min(y0 + 1, ch - 1), cy - y0};
     };
-    // Cell (x, y) of level l from its own sums and the finished level above.
-    auto push = [&](int x, int y, const Above& r) {
+    // Cell `v` (column x, its row's levels above `r`) of level l from its own sums and the finished level above.
+    auto push = [&](int x, const Above& r, Cell& v) {
       const int y0 = r.y0, y1 = r.y1;
       const double ty = r.ty;
       const double cx = std::clamp((x + 0.5) / 2.0 - 0.5, 0.0, static_cast<double>(cw - 1));
@@ -93,38 +99,63 @@ void push_pull(int w, int h, LargeVector<PushPullCell<N>>& cells, int threads, P
       const Cell& b = c[static_cast<std::size_t>(y0) * cw + x1];
       const Cell& d = c[static_cast<std::size_t>(y1) * cw + x0];
       const Cell& e = c[static_cast<std::size_t>(y1) * cw + x1];
-      Cell& v = f[static_cast<std::size_t>(y) * fw + x];
-      const Cell own = normalised(v);
-      const double keep = own[kWeight];
+      const Cell self = normalised(v);
+      const double keep = self[kWeight];
       for (std::size_t k = 0; k < kWeight; ++k) {
         const double up = (1.0 - ty) * ((1.0 - tx) * a[k] + tx * b[k]) + ty * ((1.0 - tx) * d[k] + tx * e[k]);
-        v[k] = static_cast<float>(keep * own[k] + (1.0 - keep) * up);
+        v[k] = static_cast<float>(keep * self[k] + (1.0 - keep) * up);
       }
       // Known wherever the level above is (the coarsest cell is known if any cell was).
-      v[kWeight] = std::max({a[kWeight], b[kWeight], d[kWeight], e[kWeight], own[kWeight]}) > 0.0f ? 1.0f : 0.0f;
+      v[kWeight] = std::max({a[kWeight], b[kWeight], d[kWeight], e[kWeight], self[kWeight]}) > 0.0f ? 1.0f : 0.0f;
     };
-    if (l == 0 && !finish.empty()) {
+    if (l == 0 && (!finish.empty() || !cells)) {
       // Only the cells the caller reads (their values are the same as when every cell is finished),
-      // each on its own (threads).
+      // each on its own (threads): in place, or in `own`.
       const auto row = static_cast<std::size_t>(fw);
       const auto count = static_cast<std::ptrdiff_t>(finish.size());
 #pragma omp parallel for num_threads(threads) schedule(static) if (count > kParallelCells / 4)
       for (std::ptrdiff_t k = 0; k < count; ++k) {
         const std::size_t i = finish[static_cast<std::size_t>(k)];
         const auto y = static_cast<int>(i / row);
-        push(static_cast<int>(i % row), y, above(y));
+        push(static_cast<int>(i % row), above(y), f ? f[i] : own[static_cast<std::size_t>(k)]);
       }
       continue;
     }
 #pragma omp parallel for num_threads(threads) schedule(static) if (fw * fh > kParallelCells)
     for (int y = 0; y < fh; ++y) {
       const Above r = above(y);
-      for (int x = 0; x < fw; ++x) push(x, y, r);
+      for (int x = 0; x < fw; ++x) push(x, r, f[static_cast<std::size_t>(y) * fw + x]);
     }
   }
 }
 
+}  // namespace
+
+template <std::size_t N>
+void push_pull(int w, int h, LargeVector<PushPullCell<N>>& cells, int threads, PushPullScratch<N>* scratch,
+               std::span<const std::size_t> finish) {
+  PushPullScratch<N> local;
+  run_push_pull<N>(w, h, &cells, threads, (scratch ? *scratch : local).levels, finish, {});
+}
+
+template <std::size_t N>
+LargeVector<PushPullCell<N>>& push_pull_first_level(int w, int h, PushPullScratch<N>& scratch) {
+  if (scratch.levels.empty()) scratch.levels.emplace_back();
+  scratch.levels[0].resize(static_cast<std::size_t>((w + 1) / 2) * static_cast<std::size_t>((h + 1) / 2));
+  return scratch.levels[0];
+}
+
+template <std::size_t N>
+void push_pull_targets(int w, int h, PushPullScratch<N>& scratch, std::span<const std::size_t> finish, std::span<PushPullCell<N>> own,
+                       int threads) {
+  run_push_pull<N>(w, h, nullptr, threads, scratch.levels, finish, own);
+}
+
 template void push_pull<2>(int, int, LargeVector<PushPullCell<2>>&, int, PushPullScratch<2>*, std::span<const std::size_t>);
 template void push_pull<5>(int, int, LargeVector<PushPullCell<5>>&, int, PushPullScratch<5>*, std::span<const std::size_t>);
+template LargeVector<PushPullCell<2>>& push_pull_first_level<2>(int, int, PushPullScratch<2>&);
+template LargeVector<PushPullCell<5>>& push_pull_first_level<5>(int, int, PushPullScratch<5>&);
+template void push_pull_targets<2>(int, int, PushPullScratch<2>&, std::span<const std::size_t>, std::span<PushPullCell<2>>, int);
+template void push_pull_targets<5>(int, int, PushPullScratch<5>&, std::span<const std::size_t>, std::span<PushPullCell<5>>, int);
 
 }  // namespace lensmith::render_detail

@@ -48,4 +48,18 @@ template <std::size_t N>
 void push_pull(int w, int h, LargeVector<PushPullCell<N>>& cells, int threads = 1, PushPullScratch<N>* scratch = nullptr,
                std::span<const std::size_t> finish = {});
 
+// The same for a caller that wants only the cells `finish` (y * w + x, w x h grid) and has no
+// finest level to give: `first` holds the grid's level 1, ceil(w / 2) x ceil(h / 2) cells, each the
+// sum of its 2 x 2 finest cells (rows first: (2x, 2y), (2x + 1, 2y), (2x, 2y + 1), (2x + 1, 2y + 1)),
+// as push_pull's pull makes it; `own[k]`, finish[k]'s own sums. On return own[k] holds what
+// push_pull leaves in cells[finish[k]]. A frame-sized finest level costs its memory twice (written,
+// then read by the pull); the hidden-surface fill sums its pixels into level 1 directly. `first` is
+// the scratch's to keep (push_pull_first_level sizes it).
+template <std::size_t N>
+void push_pull_targets(int w, int h, PushPullScratch<N>& scratch, std::span<const std::size_t> finish, std::span<PushPullCell<N>> own,
+                       int threads = 1);
+// The level-1 grid of a w x h grid in `scratch`, sized ceil(w / 2) x ceil(h / 2) (not cleared).
+template <std::size_t N>
+LargeVector<PushPullCell<N>>& push_pull_first_level(int w, int h, PushPullScratch<N>& scratch);
+
 }  // namespace lensmith::render_detail
