@@ -31,7 +31,6 @@ struct HiddenScratch {
   std::vector<std::size_t> targets;
   std::vector<std::size_t> target_cells;  // the targets' cells in the push-pull's window
   std::vector<std::vector<std::size_t>> block_targets;  // each thread's block of rows' targets, before they join `targets`
-  LargeVector<PushPullCell<5>> cells;   // frame-sized, for finish_composite's fill (reused memory)
   std::vector<PushPullCell<5>> own;         // the targets' colour (tone-mapped), inverse depth, weight
   std::vector<PushPullCell<2>> own_shares;  // the targets' visible share of the layer, weight
   PushPullScratch<5> push_pull;
