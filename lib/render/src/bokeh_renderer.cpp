@@ -123,12 +123,11 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   // once: only what a layer touches is faulted in, and no layer copies it to grow.
   ScatterSources layer;
   layer.reserve(sources.size() + static_cast<std::size_t>(w) * h);
-  LargeVector<FootprintPlan> plans;
-  plans.reserve(layer.capacity());
-  // The rows each plan may touch, apart: every band scans them all, and 8 bytes a footprint stream
-  // faster than its whole plan.
-  LargeVector<std::array<float, 2>> plan_rows;
-  plan_rows.reserve(layer.capacity());
+  // The plans and the rows each plan may touch, apart (every band scans them all, and 8 bytes a
+  // footprint stream faster than its whole plan): written in full by each layer's planning, so not
+  // constructed first (WriteFirstArray).
+  render_detail::WriteFirstArray<FootprintPlan> plan_store(layer.capacity());
+  render_detail::WriteFirstArray<std::array<float, 2>> plan_row_store(layer.capacity());
   std::vector<std::size_t> range_begin;  // of the plan ranges of a layer
   render_detail::MergeScratch merge_scratch;
   render_detail::HiddenScratch hidden_scratch;
@@ -152,10 +151,8 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
     // Level of detail: sources whose footprints go to a coarse grid, merged by its cells.
     render_detail::merge_coarse_sources(layer, w, h, merge_scratch, margin);
 
-    fault_in(plans, layer.size(), threads);
-    fault_in(plan_rows, layer.size(), threads);
-    plans.resize(layer.size());
-    plan_rows.resize(layer.size());
+    const std::span<FootprintPlan> plans = plan_store.first(layer.size(), threads);
+    const std::span<std::array<float, 2>> plan_rows = plan_row_store.first(layer.size(), threads);
     render_detail::plan_range_starts(layer, kPlanRange, range_begin);
     const std::size_t ranges = range_begin.size() - 1;
 #pragma omp parallel num_threads(threads)
