@@ -7,7 +7,6 @@
 
 #include <omp.h>
 
-#include <algorithm>
 #include <cstddef>
 #include <span>
 #include <stdexcept>
@@ -18,18 +17,26 @@
 
 namespace lensmith::render_detail {
 
+inline constexpr std::size_t kTouchPageBytes = 4096;
+
+// Faults in the pages of storage[from, to) (bytes; `from` a page boundary) from `threads` threads, a
+// contiguous share each. Returns the page boundary at or after `to` (what is faulted in now).
+inline std::size_t touch_pages(void* storage, std::size_t from, std::size_t to, int threads) {
+  if (to <= from) return from;
+  volatile unsigned char* const bytes = static_cast<unsigned char*>(storage);
+  const auto pages = static_cast<std::ptrdiff_t>((to - from + kTouchPageBytes - 1) / kTouchPageBytes);
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (std::ptrdiff_t k = 0; k < pages; ++k) bytes[from + static_cast<std::size_t>(k) * kTouchPageBytes] = 0;
+  return from + static_cast<std::size_t>(pages) * kTouchPageBytes;
+}
+
 // Makes room in `v` for `count` elements and faults in the pages of that room beyond its elements
 // (the storage no element lives in yet) from `threads` threads, a contiguous share each.
 template <class T>
 void fault_in(LargeVector<T>& v, std::size_t count, int threads) {
   if (count > v.capacity()) v.reserve(count);
-  constexpr std::size_t kPageBytes = 4096;
-  volatile unsigned char* const storage = reinterpret_cast<unsigned char*>(v.data());
-  const std::size_t from = (v.size() * sizeof(T) + kPageBytes - 1) / kPageBytes * kPageBytes, to = count * sizeof(T);
-  if (to <= from) return;
-  const auto pages = static_cast<std::ptrdiff_t>((to - from + kPageBytes - 1) / kPageBytes);
-#pragma omp parallel for num_threads(threads) schedule(static)
-  for (std::ptrdiff_t k = 0; k < pages; ++k) storage[from + static_cast<std::size_t>(k) * kPageBytes] = 0;
+  const std::size_t from = (v.size() * sizeof(T) + kTouchPageBytes - 1) / kTouchPageBytes * kTouchPageBytes;
+  touch_pages(v.data(), from, count * sizeof(T), threads);
 }
 
 // Storage for up to `capacity` elements that a caller writes in full before it reads them (a layer's
@@ -52,16 +59,7 @@ class WriteFirstArray {
   // The first `count` elements (at most the capacity), for the caller to write before it reads them.
   std::span<T> first(std::size_t count, int threads) {
     if (count > capacity_) throw std::length_error("WriteFirstArray: " + std::to_string(count) + " elements of " + std::to_string(capacity_));
-    constexpr std::size_t kPageBytes = 4096;
-    const std::size_t to = count * sizeof(T);
-    if (to > faulted_bytes_) {
-      volatile unsigned char* const storage = reinterpret_cast<unsigned char*>(data_);
-      const std::size_t from = faulted_bytes_;
-      const auto pages = static_cast<std::ptrdiff_t>((to - from + kPageBytes - 1) / kPageBytes);
-#pragma omp parallel for num_threads(threads) schedule(static)
-      for (std::ptrdiff_t k = 0; k < pages; ++k) storage[from + static_cast<std::size_t>(k) * kPageBytes] = 0;
-      faulted_bytes_ = from + static_cast<std::size_t>(pages) * kPageBytes;
-    }
+    faulted_bytes_ = touch_pages(data_, faulted_bytes_, count * sizeof(T), threads);
     return {data_, count};
   }
 

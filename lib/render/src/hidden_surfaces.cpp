@@ -159,10 +159,8 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
     std::fill(first.begin() + static_cast<std::ptrdiff_t>(cya) * cw, first.begin() + static_cast<std::ptrdiff_t>(cyb) * cw,
               PushPullCell<5>{});
     const int ya = y0 + 2 * cya, yb = std::min(y1 + 1, y0 + 2 * cyb);
-    const auto row_start = [&](int y) {
-      return std::lower_bound(targets.begin(), targets.end(), static_cast<std::size_t>(y) * static_cast<std::size_t>(w)) - targets.begin();
-    };
-    const std::ptrdiff_t target_first = row_start(ya);
+    const std::ptrdiff_t target_first =
+        std::lower_bound(targets.begin(), targets.end(), static_cast<std::size_t>(ya) * static_cast<std::size_t>(w)) - targets.begin();
     std::ptrdiff_t k = target_first;
     std::size_t last_pixel = 0;
     for (const int i : members) {

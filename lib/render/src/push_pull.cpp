@@ -23,10 +23,6 @@ PushPullCell<N> normalised(const PushPullCell<N>& v) {
   return n;
 }
 
-}  // namespace
-
-namespace {
-
 // The pull and the push of push_pull. `cells`: the finest level, or null where the caller gave level
 // 1 in levels[0] and the finest level only at `finish` (`own`).
 template <std::size_t N>
