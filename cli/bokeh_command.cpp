@@ -815,6 +815,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
        << format_rounded(cam->f_number(), 3) << ", focus " << format_rounded(camera.focus_distance_m, 4) << " m, " << aperture.to_string()
        << " aperture\n  " << stats.layers << " depth layers " << format_rounded(stats.layer_spacing_px, 3) << " px apart, largest blur "
        << format_rounded(stats.max_abs_coc_px, 3) << " px; " << stats.footprints << " footprints";
+  if (stats.copied_pixels > 0) what << ", " << stats.copied_pixels << " sharp pixels copied";
   if (stats.triangles > 0) what << " (" << stats.triangles << " triangles)";
   if (stats.light_images > 0) what << ", drawn from " << stats.light_images << " light images";
   if (stats.reused_shapes > 0) what << ", " << stats.reused_shapes << " drawn from a neighbour's mapped shape";

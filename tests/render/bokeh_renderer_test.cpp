@@ -308,6 +308,67 @@ TEST_CASE("Through a thin lens, pixels at one depth drawn from a neighbour's pla
   CHECK(worst < kSamePicture);
 }
 
+TEST_CASE("Through a thin lens the sharp pixels that no blur reaches are copied and give the picture of every pixel scattered", "[render]") {
+  // A sharp wall at the focus distance with a blurred post in front of it, a blurred far band above,
+  // a strip receding through the focus (blurs from 0 to a few px) and an anti-aliased edge (split
+  // pixels). The wall's pixels beyond every blur's reach are copied (sharp_pixels.h); wherever the
+  // copy took a pixel that some footprint reaches, or gave one a value its scatter does not, the
+  // pictures differ by that footprint's light (up to 1). What is left is the double sums' rounding.
+  constexpr double kSamePicture = 1e-6;  // of values up to 1
+  const int w = 160, h = 96;
+  Image img = test_pattern(w, h);
+  DepthMap depth(w, h, 2.5f);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      if (x >= 30 && x < 42) depth.at(x, y) = 1.0f;                                          // the post
+      if (y < 12) depth.at(x, y) = 20.0f;                                                    // the far band
+      if (x >= 120 && x < 136) depth.at(x, y) = 2.5f * (1.0f + 0.01f * static_cast<float>(y - h / 2));  // the strip
+    }
+  }
+  // The post's right edge anti-aliased: its edge pixels mix the post's colour with the wall's.
+  for (int y = 0; y < h; ++y) {
+    for (int c = 0; c < 3; ++c) img.at(42, y, c) = 0.5f * img.at(41, y, c) + 0.5f * img.at(43, y, c);
+  }
+  const Camera cam = Camera::thin_lens(50.0, camera_options(2.5, 2.0), w, h);
+  const auto model = make_ray_model(RayModelKind::Thin, cam);
+  for (const HiddenSurfaces hidden : {HiddenSurfaces::Extend, HiddenSurfaces::Stretch}) {
+    for (const bool vignetting : {true, false}) {
+      for (const Aperture& aperture : {Aperture::circular(), Aperture::blades(5, 18.0)}) {
+        BokehOptions o;
+        o.hidden = hidden;
+        o.vignetting = vignetting;
+        BokehStatistics copied_stats, scattered_stats;
+        const Image copied = render_bokeh(img, depth, *model, aperture, o, &copied_stats);
+        o.copy_sharp_pixels = false;
+        const Image scattered = render_bokeh(img, depth, *model, aperture, o, &scattered_stats);
+        INFO(to_string(hidden) << (vignetting ? ", vignetting" : ", no vignetting") << ", " << aperture.to_string());
+        CHECK(copied_stats.copied_pixels > img.pixel_count() / 5);
+        CHECK(copied_stats.copied_pixels < img.pixel_count() * 3 / 4);
+        CHECK(copied_stats.split_edge_pixels > 0);
+        CHECK(scattered_stats.copied_pixels == 0);
+        CHECK(max_abs_difference(copied, scattered) < kSamePicture);
+      }
+    }
+  }
+  // Where a sharp point's light is not the pixel's own, nothing is copied: the thin model of a real
+  // lens with its vignetting (the lens's brightness across the frame), and an aperture picture (whose
+  // transmission scales the light).
+  const Camera thin_of_lens = Camera::thin_lens_for(LensLibrary::load("pbrt-dgauss-50mm").prescription, camera_options(2.5, 2.0), w, h);
+  const auto thin_lens_model = make_ray_model(RayModelKind::Thin, thin_of_lens);
+  const Aperture round = Aperture::circular(), half_open = Aperture::mask(2, 2, {1.0f, 1.0f, 1.0f, 0.0f});
+  for (const auto& [m, aperture] : {std::pair<const RayModel*, const Aperture*>{thin_lens_model.get(), &round},
+                                    std::pair<const RayModel*, const Aperture*>{model.get(), &half_open}}) {
+    BokehOptions o;
+    BokehStatistics copied_stats;
+    const Image copied = render_bokeh(img, depth, *m, *aperture, o, &copied_stats);
+    o.copy_sharp_pixels = false;
+    const Image scattered = render_bokeh(img, depth, *m, *aperture, o);
+    INFO(aperture->to_string());
+    CHECK(copied_stats.copied_pixels == 0);
+    CHECK(max_abs_difference(copied, scattered) < kSamePicture);
+  }
+}
+
 TEST_CASE("Through the Biotar at f/5.6, a highlight's bokeh by the Seidel model matches the exact tracer's in place and size",
           "[render]") {
   // Tolerances: centroid within 0.1 px and RMS radius within 4 %, from the centre to 3/4 of the way

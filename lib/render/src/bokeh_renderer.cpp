@@ -1,6 +1,7 @@
 // The bokeh renderer's stages in order (docs/bokeh.md; each stage's file says where its method
 // comes from): sources from the image and its depth (scatter_source), anti-aliased edge pixels split
-// into their two surfaces (mixed_pixels), depth layers (depth_layers),
+// into their two surfaces (mixed_pixels), sharp pixels that nothing blurred reaches set apart to be
+// copied (sharp_pixels), depth layers (depth_layers),
 // per layer the hidden surfaces behind nearer pixels (hidden_surfaces), footprint planning and the
 // deposit into per-thread bands of rows (footprint, with spectral_groups and pupil_mesh_table),
 // then front-to-back compositing and the fill of what nothing covers (layer_compositing).
@@ -32,6 +33,7 @@
 #include "lensmith/render/deep_image.h"
 #include "pupil_mesh_table.h"
 #include "scatter_source.h"
+#include "sharp_pixels.h"
 #include "source_merging.h"
 #include "spectral_groups.h"
 
@@ -139,7 +141,10 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
     const auto u = static_cast<std::size_t>(l);
     layer.clear();
     fault_in(layer, layers.members(l).size(), threads);
-    for (int i : layers.members(l)) layer.push_back(sources[static_cast<std::size_t>(i)]);
+    // (Copied sharp pixels stay members: the hidden surfaces read them. They are written at the end.)
+    for (int i : layers.members(l)) {
+      if (!sources[static_cast<std::size_t>(i)].copied) layer.push_back(sources[static_cast<std::size_t>(i)]);
+    }
     const double hidden_blur = layers.max_blur_px[u] + layers.nearer_blur_px[u];
     if (!layer.empty() && l + 1 < layers.count && hidden_blur >= kMinHiddenBlurPx) {
       const double reach = std::min(0.5 * hidden_blur + kHiddenMarginPx, 0.5 * (w + h));
@@ -255,6 +260,21 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   stats.light_images = scatter.light_images();
   stats.reused_shapes = reused;
   stats.unaimed_rays = model.unaimed_rays() - unaimed_before;
+  // The copied sharp pixels, as the scatter draws them: all their own light at their own centre,
+  // covering the pixel fully; nothing nearer reaches them (sharp_pixels.h).
+  if (stats.copied_pixels > 0) {
+    const auto pixels = static_cast<std::ptrdiff_t>(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+#pragma omp parallel for num_threads(threads) schedule(static)
+    for (std::ptrdiff_t k = 0; k < pixels; ++k) {
+      const ScatterSource& s = sources[static_cast<std::size_t>(k)];
+      if (!s.copied) continue;
+      float* r = result.data() + 4 * static_cast<std::size_t>(k);
+      r[0] = s.rgb[0];
+      r[1] = s.rgb[1];
+      r[2] = s.rgb[2];
+      r[3] = s.coverage;
+    }
+  }
   LargeVector<render_detail::PushPullCell<5>> fill_cells;  // where some gap needs the push-pull fill
   // The lens's image circle, where some pixel is left uncovered (a fisheye's frame corners).
   const render_detail::ImageCircle circle =
@@ -361,7 +381,8 @@ std::string BokehOptions::to_string() const {
   os << "BokehOptions(threads " << threads << ", " << splat.to_string() << ", layer spacing " << layer_spacing_px
      << " px, max layers " << max_layers << ", hidden " << lensmith::to_string(hidden) << ", spectral "
      << (spectral ? std::to_string(spectral_samples) + " nodes" : std::string("off")) << ", chromatic tolerance "
-     << chromatic_tolerance_px << " px, max blur " << max_blur_px << " px" << (reuse_shapes ? "" : ", shapes not reused") << (interpolated_rays ? "" : ", rays per pixel") << ")";
+     << chromatic_tolerance_px << " px, max blur " << max_blur_px << " px" << (reuse_shapes ? "" : ", shapes not reused") << (interpolated_rays ? "" : ", rays per pixel")
+     << (copy_sharp_pixels ? "" : ", sharp pixels scattered") << ")";
   return os.str();
 }
 
@@ -369,7 +390,7 @@ std::string BokehStatistics::to_string() const {
   std::ostringstream os;
   os << "BokehStatistics(" << layers << " layers at " << layer_spacing_px << " px, " << source_pixels << " pixels, "
      << hidden_sources << " hidden sources, " << split_edge_pixels << " edge pixels split, " << redepthed_edge_pixels
-     << " moved, " << footprints << " footprints, " << triangles << " triangles, " << reused_shapes << " shapes reused, "
+     << " moved, " << copied_pixels << " sharp pixels copied, " << footprints << " footprints, " << triangles << " triangles, " << reused_shapes << " shapes reused, "
      << clamped_depths << " clamped depths, max |CoC| " << max_abs_coc_px << " px";
   if (deep_samples > 0) os << ", " << deep_samples << " deep samples, " << volume_slabs << " volume slabs";
   if (unaimed_rays > 0) os << ", " << unaimed_rays << " rays not aimed";
@@ -402,8 +423,12 @@ Image render_bokeh(const Image& image, const DepthMap& depth, const RayModel& mo
   if (options.split_edge_pixels) render_detail::split_mixed_pixels(sources, w, h, camera, threads, stats);
   const int margin = render_detail::frame_margin_px(model, 0.5 * stats.max_abs_coc_px);
   stats.edge_gap_px = render_detail::frame_edge_gap_px(model);
+  const render_detail::LayerSpacing spacing = render_detail::layer_spacing_of(sources, options.layer_spacing_px, options.max_layers, threads);
+  if (render_detail::copies_sharp_pixels(model, aperture, options)) {
+    stats.copied_pixels = render_detail::mark_sharp_pixels(sources, w, h, spacing.spacing_px, threads);
+  }
   add_margin_sources(sources, w, h, margin);
-  const DepthLayers layers = render_detail::make_depth_layers(sources, w, h, options.layer_spacing_px, options.max_layers, threads);
+  const DepthLayers layers = render_detail::make_depth_layers(sources, w, h, spacing, threads);
   return render_sources(sources, layers, w, h, margin, model, aperture, options, stats);
 }
 

@@ -111,7 +111,7 @@ DepthLayers make_depth_layers(const ScatterSources& sources, int width, int heig
   return l;
 }
 
-DepthLayers make_depth_layers(const ScatterSources& sources, int width, int height, double spacing_px, int max_layers, int threads) {
+LayerSpacing layer_spacing_of(const ScatterSources& sources, double spacing_px, int max_layers, int threads) {
   double coc_min = kInfinity, coc_max = -kInfinity;
   const auto n = static_cast<std::ptrdiff_t>(sources.size());
 #pragma omp parallel for num_threads(threads) schedule(static) reduction(min : coc_min) reduction(max : coc_max)
@@ -120,7 +120,7 @@ DepthLayers make_depth_layers(const ScatterSources& sources, int width, int heig
     coc_max = std::max(coc_max, sources[static_cast<std::size_t>(i)].coc_px);
   }
   if (sources.empty()) coc_min = coc_max = 0.0;
-  return make_depth_layers(sources, width, height, LayerSpacing::over(coc_min, coc_max, spacing_px, max_layers), threads);
+  return LayerSpacing::over(coc_min, coc_max, spacing_px, max_layers);
 }
 
 }  // namespace lensmith::render_detail

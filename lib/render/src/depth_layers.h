@@ -65,8 +65,8 @@ struct DepthLayers : LayerSpacing {
 // The layers of `sources` (the parts of the pixels of an image `width` x `height`), farthest first,
 // at `spacing`; `threads` find each source's layer.
 DepthLayers make_depth_layers(const ScatterSources& sources, int width, int height, const LayerSpacing& spacing, int threads);
-// The same, `spacing_px` apart over the sources' own range of blur (widened so there are at most
+// Layers `spacing_px` apart over the sources' own range of blur (widened so there are at most
 // `max_layers`).
-DepthLayers make_depth_layers(const ScatterSources& sources, int width, int height, double spacing_px, int max_layers, int threads);
+LayerSpacing layer_spacing_of(const ScatterSources& sources, double spacing_px, int max_layers, int threads);
 
 }  // namespace lensmith::render_detail

@@ -11,14 +11,11 @@ namespace lensmith::render_detail {
 
 namespace {
 
-// Footprints narrower than this (px) are deposited as points: the 2 px tent hides their shape.
-constexpr double kPointFootprintPx = 0.2;
 // A model is treated as affine over a footprint when no probe ray departs from the affine map
 // through three of them by more than this (px).
 constexpr double kAffineTolerancePx = 0.25;
-// Margin (px) added around the probed footprint: the 2 px tent; meshes add a quarter of their size
+// Meshes add this share of their size to the tent's margin around the probed footprint (footprint.h)
 // for the parts between probe rays.
-constexpr double kTentMarginPx = 2.0;
 constexpr double kMeshMarginFraction = 0.25;
 // Rings of a polar mesh per pixel of footprint size: models that clip at real clear apertures
 // (exact, poly) need rings fine enough for a vignetted beam's edge (at least 4, one per 6 px);
@@ -29,11 +26,6 @@ constexpr double kPxPerRing = 16.0;
 // Adjacent rings of a mapped pupil mesh whose light densities differ by less than this share of the
 // largest are deposited as one (a 2 % step in a large disc is below what a picture shows).
 constexpr double kRingMergeTolerance = 0.02;
-// Footprint sizes (px) from which the deposit goes to a grid of 2 x 2 and of 4 x 4 px cells: the
-// cost of a polygon falls with the cells per side, and its edge, softened to about two cells, stays
-// under 5 % of its size, invisible in a disc that large (bench/blender's scenes: within 0.1 dB).
-constexpr double kHalfResolutionPx = 40.0;
-constexpr double kQuarterResolutionPx = 96.0;
 // Share of the chromatic tolerance over which a footprint's light is cross-faded from n - 1 to n
 // wavelength groups (FootprintScatter::plan): the points there deposit both splits.
 constexpr double kGroupBlend = 0.25;
@@ -148,10 +140,6 @@ void reach_clip(const std::vector<PupilPoint>& outline, double scale, const std:
 }
 
 }  // namespace
-
-int grid_level(double footprint_px) {
-  return footprint_px >= kQuarterResolutionPx ? 2 : footprint_px >= kHalfResolutionPx ? 1 : 0;
-}
 
 double FootprintScatter::disc_passing_share(const std::vector<PupilDisc>& discs, int own_step, FootprintScratch& scratch) const {
   // Measured on an outline of at least kShareSectorStep's vertices: a coarse one would misjudge how

@@ -30,6 +30,7 @@ struct ScatterSource {
   std::array<float, 3> rgb{};       // linear radiance it sends (premultiplied by coverage)
   float coverage = 1.0f;            // fraction of the pixel's area this part stands for (0..1]
   bool coverage_only = false;       // a hidden source of HiddenSurfaces::Stretch: coverage, no light
+  bool copied = false;              // a sharp pixel no footprint reaches: copied, not scattered (sharp_pixels.h)
   float hidden = 0.0f;              // the part of `coverage` that nearer parts of its pixel hide (layered input)
   double inverse_depth_per_mm = 0.0;
   double coc_px = 0.0;              // signed blur diameter at the reference wavelength (Camera::signed_coc_px)

@@ -72,6 +72,10 @@ struct BokehOptions {
   // node's mesh deposited once, filtered, and sampled turned to each pixel's azimuth; docs/bokeh.md,
   // "Light images"). false: every footprint's mesh triangles deposited, slower, for checking.
   bool light_images = true;
+  // true: with the thin lens, a sharp pixel that no other pixel's blur reaches is copied to the
+  // output as the scatter would draw it (exactly, in its own place and brightness), not scattered
+  // (docs/bokeh.md, "Sharp pixels"). false: every pixel scattered, slower, for checking.
+  bool copy_sharp_pixels = true;
   // Called with the fraction done (0..1) after each band of rows of each layer, from the rendering
   // threads one at a time (never concurrently): it must not assume the calling thread.
   std::function<void(double)> progress;
@@ -86,6 +90,7 @@ struct BokehStatistics {
   std::size_t hidden_sources = 0;   // hidden-surface sources added behind nearer pixels (hidden_surfaces.h)
   std::size_t split_edge_pixels = 0;     // anti-aliased edge pixels split into a near and a far part
   std::size_t redepthed_edge_pixels = 0; // edge pixels whose colour is one surface's, moved to its depth
+  std::size_t copied_pixels = 0;    // sharp pixels copied, not scattered (BokehOptions::copy_sharp_pixels)
   std::size_t footprints = 0;       // (pixel, wavelength group) footprints deposited
   std::size_t triangles = 0;        // mesh triangles deposited (seidel, exact, masks)
   std::size_t light_images = 0;     // light images made (exact, poly: BokehOptions::light_images)

@@ -1,0 +1,37 @@
+// Sharp pixels that nothing blurred reaches. A pixel of the thin lens whose own footprint is a point
+// (blur under kPointFootprintPx) lands at its own centre, where the splat's tent gives it all to its
+// own pixel and none to its neighbours; if no other source's footprint reaches the pixel, the
+// scatter gives it back exactly as it came in, covering its pixel fully (nothing behind it shows,
+// and nothing in front reaches it). Such pixels are marked `copied`: they keep their place among
+// the depth layers' pixels (the hidden-surface extension reads them as before), but are not
+// planned, deposited or composited, and the renderer writes them to the result as they are. The
+// picture is the same (tests/render/bokeh_renderer_test.cpp); a frame with large sharp areas
+// renders faster (docs/performance.md: the portrait focused on its wall at 5 m, 61 % copied).
+//
+// Not from the papers: Lee, Eisemann & Seidel's layered scatter treats every pixel alike.
+#pragma once
+
+#include <cstddef>
+
+#include "lensmith/camera/aperture.h"
+#include "lensmith/camera/ray_model.h"
+#include "lensmith/render/bokeh_renderer.h"
+#include "scatter_source.h"
+
+namespace lensmith::render_detail {
+
+// Whether the renderer may copy sharp pixels with this model, aperture and options: the thin lens,
+// whose chief ray lands on the pixel's own centre, where its points are as bright as the input: an
+// ideal thin lens, or the thin model of a real lens without vignetting (with it, the real lens's
+// brightness across the frame: IlluminationTable), through an aperture that is not a picture (whose
+// transmission scales a point's light); and options that ask for it (BokehOptions::copy_sharp_pixels).
+bool copies_sharp_pixels(const RayModel& model, const Aperture& aperture, const BokehOptions& options);
+
+// Marks `copied` the pixels of `sources` (one per pixel, row-major, width x height, then any appended
+// parts: a split pixel's far part) that are sharp, whole (one part covering the pixel) and beyond
+// the reach of every other source's footprint: its blur radius plus the tent, a grid cell for merged
+// sources and half a layer spacing (`layer_spacing_px`: a nearer layer's hidden sources blur up to
+// that much more than the pixels they sit behind). Returns how many.
+std::size_t mark_sharp_pixels(ScatterSources& sources, int width, int height, double layer_spacing_px, int threads);
+
+}  // namespace lensmith::render_detail
