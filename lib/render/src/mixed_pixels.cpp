@@ -188,15 +188,16 @@ void choose_colours(const std::array<float, 3>& p, Group& near, Group& far) {
 
 // The pure pixels (not next to a depth step) on the 5 x 5 border around (x, y) whose blur `on_surface`
 // accepts: a surface sampled one ring further out where the 3 x 3 cannot tell it.
+// (`coc`: the sources' blurs packed, read before a source itself is.)
 template <class OnSurface>
-Group border_group(const ScatterSources& sources, const LargeVector<std::uint8_t>& next_to_step, int width, int height, int x, int y,
-                   OnSurface on_surface) {
+Group border_group(const ScatterSources& sources, const double* coc, const LargeVector<std::uint8_t>& next_to_step, int width, int height,
+                   int x, int y, OnSurface on_surface) {
   Group g;
   for (int qy = std::max(0, y - 2); qy <= std::min(height - 1, y + 2); ++qy) {
     for (int qx = std::max(0, x - 2); qx <= std::min(width - 1, x + 2); ++qx) {
       if (std::max(std::abs(qx - x), std::abs(qy - y)) < 2) continue;
       const std::size_t q = static_cast<std::size_t>(qy) * width + qx;
-      if (!next_to_step[q] && on_surface(sources[q].coc_px)) g.add(sources[q]);
+      if (!next_to_step[q] && on_surface(coc[q])) g.add(sources[q]);
     }
   }
   return g;
@@ -236,7 +237,9 @@ bool spans_step_at(const double* coc, int width, int height, int x, int y) {
   return hi - lo >= kMinBlurDifferencePx;
 }
 
-Decision decide(const ScatterSources& sources, const LargeVector<std::uint8_t>& next_to_step, int width, int height,
+// (`coc`: the sources' blurs packed: the neighbourhoods are scanned for them, and only the
+// neighbours that stand for a surface are read whole.)
+Decision decide(const ScatterSources& sources, const double* coc, const LargeVector<std::uint8_t>& next_to_step, int width, int height,
                 int x, int y) {
   const ScatterSource& p = sources[static_cast<std::size_t>(y) * width + x];
   Decision d;
@@ -246,7 +249,7 @@ Decision decide(const ScatterSources& sources, const LargeVector<std::uint8_t>& 
   const int y0 = std::max(0, y - 1), y1 = std::min(height - 1, y + 1);
   for (int qy = y0; qy <= y1; ++qy) {
     for (int qx = x0; qx <= x1; ++qx) {
-      const double c = sources[static_cast<std::size_t>(qy) * width + qx].coc_px;
+      const double c = coc[static_cast<std::size_t>(qy) * width + qx];
       lo = std::min(lo, c);
       hi = std::max(hi, c);
     }
@@ -263,13 +266,12 @@ Decision decide(const ScatterSources& sources, const LargeVector<std::uint8_t>& 
     for (int qx = x0; qx <= x1; ++qx) {
       if (qx == x && qy == y) continue;
       const std::size_t q = static_cast<std::size_t>(qy) * width + qx;
-      const ScatterSource& s = sources[q];
-      if (s.coc_px >= hi - tolerance) {
-        near.add(s);
-        if (!next_to_step[q]) near_pure.add(s);
-      } else if (s.coc_px <= lo + tolerance) {
-        far.add(s);
-        if (!next_to_step[q]) far_pure.add(s);
+      if (coc[q] >= hi - tolerance) {
+        near.add(sources[q]);
+        if (!next_to_step[q]) near_pure.add(sources[q]);
+      } else if (coc[q] <= lo + tolerance) {
+        far.add(sources[q]);
+        if (!next_to_step[q]) far_pure.add(sources[q]);
       }
     }
   }
@@ -279,7 +281,7 @@ Decision decide(const ScatterSources& sources, const LargeVector<std::uint8_t>& 
   // bright dots on the bar). Where the 3 x 3's near pixels are more than kExcessBrightness times as
   // bright as the pure ones on the 5 x 5 border, the border's stand for the near surface.
   if (near_pure.count == 0 && near.count > 0) {
-    const Group ring = border_group(sources, next_to_step, width, height, x, y, [&](double c) { return c >= hi - tolerance; });
+    const Group ring = border_group(sources, coc, next_to_step, width, height, x, y, [&](double c) { return c >= hi - tolerance; });
     // (Sums of colours: their means compared.)
     if (ring.count > 0 && brightness(near.rgb) / near.count > kExcessBrightness * brightness(ring.rgb) / ring.count) near_pure = ring;
   }
@@ -297,7 +299,7 @@ Decision decide(const ScatterSources& sources, const LargeVector<std::uint8_t>& 
   // moved 0.06 dB closer to its path-traced reference in the depth-edge band (a 2 % threshold here
   // cost it 0.04 dB).
   if (const double own = contrast(near, far); own < kSameSurfaceContrast && p.coc_px <= lo + tolerance) {
-    Group far_ring = border_group(sources, next_to_step, width, height, x, y, [&](double c) { return c <= lo + tolerance; });
+    Group far_ring = border_group(sources, coc, next_to_step, width, height, x, y, [&](double c) { return c <= lo + tolerance; });
     if (far_ring.count > 0) {
       far_ring.finish();
       if (contrast(near, far_ring) >= kColourContrastHigh) far = far_ring;
@@ -431,7 +433,7 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
         while (k < before.size() && before[k].first < x) ++k;
         // (A pixel whose neighbourhood is unchanged spanned a step then too: its spans flag did not change.)
         const bool known = unchanged[row_start + x] && k < before.size() && before[k].first == x;
-        row.emplace_back(x, known ? before[k].second : decide(sources, next_to_step, width, height, x, y));
+        row.emplace_back(x, known ? before[k].second : decide(sources, coc.data(), next_to_step, width, height, x, y));
         const Decision::Kind kind = row.back().second.kind;
         moves_decided += kind == Decision::Kind::Move ? 1 : 0;
         splits += kind == Decision::Kind::Split ? 1 : 0;
