@@ -45,6 +45,12 @@ TABLE_WALL_Y = 8.0
 # The fence scene (--scene fence): thin bars in front of a lit wall.
 FENCE_Y = 1.5
 FENCE_WALL_Y = 6.0
+# The objects scene (--scene objects): round and tilted subjects at about 1.2 m.
+OBJECTS_Y = 1.2
+OBJECTS_WALL_Y = 4.0
+OBJECTS_LIGHTS_Y = 15.0
+OBJECTS_LEAF_Y = 0.6
+OBJECTS_FLOOR_Z = -0.2
 
 
 def parse_args():
@@ -58,7 +64,7 @@ def parse_args():
     p.add_argument("--spp", type=int, required=True, help="samples per pixel for both renders (>= 1)")
     p.add_argument("--threads", type=int, default=0, help="render threads, 0 = all (also pass blender -t)")
     p.add_argument("--seed", type=int, default=0, help="Cycles seed, the same for both renders")
-    p.add_argument("--scene", choices=["street", "portrait", "table", "fence"], default="street",
+    p.add_argument("--scene", choices=["street", "portrait", "table", "fence", "objects"], default="street",
                    help="street: posts and a sign at 1.2 m, walls at 3 and 20 m, string lights (default); "
                         "portrait: a sharp striped bar, a checkered disc and a thin rod at 1 m over a "
                         "textured wall at 5 m with highlights (the sharp-subject case); "
@@ -66,7 +72,10 @@ def parse_args():
                         "blocks and a post on it at 0.7, 1.5 and 2.5 m, a wall at 8 m, highlights at "
                         "every depth (focus on the 1.5 m block); "
                         "fence: bars 1-3 px wide and a wire mesh at 1.5 m over a brick wall at 6 m with "
-                        "highlights, some just behind a bar")
+                        "highlights, some just behind a bar; "
+                        "objects: a checkered sphere, a tilted cube and a leaning card at about 1.2 m "
+                        "(depth varying along their silhouettes) on a floor, a tilted leaf at 0.6 m, a "
+                        "wall at 4 m and lights at 15 m")
     p.add_argument("--skip-pinhole", action="store_true",
                    help="render only reference.exr (reuse an existing DIR/pinhole.exr)")
     a = p.parse_args(argv)
@@ -261,7 +270,7 @@ def build_scene(args):
     for ob in list(bpy.data.objects):
         bpy.data.objects.remove(ob, do_unlink=True)
     lights, depths = {"portrait": build_portrait, "table": build_table, "fence": build_fence,
-                      "street": build_street}[args.scene](args)
+                      "street": build_street, "objects": build_objects}[args.scene](args)
     for name, centre, radius, rgb, strength in lights:
         sphere(name, centre, radius, emission("em_" + name, rgb, strength))
 
@@ -386,6 +395,64 @@ def build_fence(args):
         z = 0.35 + 0.12 * (i % 3)
         lights.append(("wall_%d" % i, (x, FENCE_WALL_Y - 0.03, z), 0.014, colours[i % 4], 120.0))
     depths = {"bars_and_wires": FENCE_Y, "wall": FENCE_WALL_Y}
+    return lights, depths
+
+
+def build_objects(args):
+    """Subjects that do not face the camera: a checkered sphere (its depth grows to the silhouette,
+    where the surface turns away), a cube turned on two axes and a card leaning back through the focus
+    (depth varying along their edges), standing on a floor that recedes through every layer; a leaf
+    tilted in depth in front of them (a blurred foreground whose own blur varies), a noise-textured
+    wall at 4 m and lights at 15 m, some just beside a subject's silhouette.
+    """
+    sky_and_sun("afternoon", (0.3, 0.33, 0.4), 3.0, 3.0, (1.0, 0.9, 0.75), 45.0, -25.0)
+    wall = diffuse("plaster", noise_colour(6.0, (0.12, 0.1, 0.09), (0.55, 0.5, 0.42)))
+    quad_xz("wall_4m", OBJECTS_WALL_Y, -3.0, 3.0, OBJECTS_FLOOR_Z, 0.25, wall)
+    far = diffuse("far", noise_colour(1.5, (0.03, 0.04, 0.06), (0.15, 0.13, 0.1)))
+    quad_xz("far_15m", OBJECTS_LIGHTS_Y + 0.5, -12.0, 12.0, OBJECTS_FLOOR_Z, 4.0, far)
+    floor = diffuse("floor", checker_colour(10.0, (0.4, 0.38, 0.33), (0.12, 0.11, 0.1)))
+    quad_xy("floor", OBJECTS_FLOOR_Z, -2.5, 2.5, 0.3, OBJECTS_WALL_Y, floor)
+    # The sphere: 10 cm radius (about 64 px at 600 px), finely tessellated so that its silhouette is
+    # round, resting on the floor with its front at the focus.
+    ball = diffuse("ball", checker_colour(25.0, (0.85, 0.12, 0.1), (0.9, 0.88, 0.8)))
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=96, ring_count=48, radius=0.1,
+                                         location=(-0.12, OBJECTS_Y + 0.1, OBJECTS_FLOOR_Z + 0.1))
+    sphere_ob = bpy.context.active_object
+    sphere_ob.name = "ball"
+    sphere_ob.data.materials.append(ball)
+    bpy.ops.object.shade_smooth()
+    # The cube: 12 cm, turned 35 deg about the vertical and 20 deg about the horizontal.
+    cube_mat = diffuse("cube", stripe_colour(60.0, (0.1, 0.3, 0.75), (0.85, 0.8, 0.5)))
+    bpy.ops.mesh.primitive_cube_add(size=0.12, location=(0.16, OBJECTS_Y + 0.06, OBJECTS_FLOOR_Z + 0.085),
+                                    rotation=(math.radians(20.0), 0.0, math.radians(35.0)))
+    cube_ob = bpy.context.active_object
+    cube_ob.name = "cube"
+    cube_ob.data.materials.append(cube_mat)
+    # A card leaning back 40 deg from upright, its foot at the focus: depth 1.2 m at its foot to 1.35 m at its top.
+    card = diffuse("card", checker_colour(45.0, (0.1, 0.45, 0.15), (0.85, 0.85, 0.8)))
+    quad("card", [(0.26, OBJECTS_Y, OBJECTS_FLOOR_Z), (0.36, OBJECTS_Y, OBJECTS_FLOOR_Z),
+                  (0.36, OBJECTS_Y + 0.15, OBJECTS_FLOOR_Z + 0.18), (0.26, OBJECTS_Y + 0.15, OBJECTS_FLOOR_Z + 0.18)], card)
+    # The leaf: a plane tilted from 0.55 to 0.7 m in the lower left of the frame (a blurred foreground
+    # whose blur varies across it).
+    leaf = diffuse("leaf", noise_colour(30.0, (0.05, 0.2, 0.03), (0.25, 0.5, 0.1)))
+    quad("leaf", [(-0.2, OBJECTS_LEAF_Y - 0.05, -0.14), (-0.1, OBJECTS_LEAF_Y - 0.05, -0.13),
+                  (-0.09, OBJECTS_LEAF_Y + 0.1, -0.06), (-0.2, OBJECTS_LEAF_Y + 0.1, -0.07)], leaf)
+    lights = []
+    colours = [(1.0, 0.75, 0.4), (0.3, 0.5, 1.0), (1.0, 0.25, 0.2), (0.4, 1.0, 0.45)]
+    for i in range(9):
+        x = -5.0 + 1.25 * i
+        z = 1.2 + 0.3 * math.sin(i)
+        lights.append(("far_%d" % i, (x, OBJECTS_LIGHTS_Y, z), 0.025, colours[i % 4], 120.0))
+    # Wall lights: one about 10 px beside the sphere's silhouette as the camera sees it, one beside the cube.
+    wall_y = OBJECTS_WALL_Y - 0.02
+    lights += [("wall_ball", (-0.611, wall_y, -0.072), 0.008, (1.0, 0.95, 0.8), 120.0),
+               ("wall_cube", (0.85, wall_y, -0.15), 0.008, (0.3, 0.6, 1.0), 150.0),
+               ("wall_free", (-1.2, wall_y, 0.1), 0.008, (1.0, 0.4, 0.3), 100.0),
+               ("ball_glint", (-0.14, OBJECTS_Y + 0.003, OBJECTS_FLOOR_Z + 0.12), 0.0014, (1.0, 1.0, 1.0), 60.0)]
+    depths = {"ball_front_m": OBJECTS_Y, "ball_silhouette_m": OBJECTS_Y + 0.1, "cube_centre_m": OBJECTS_Y + 0.06,
+              "card_m": "%.2f to %.2f" % (OBJECTS_Y, OBJECTS_Y + 0.15), "leaf_m": "0.55 to 0.70",
+              "wall": OBJECTS_WALL_Y, "lights": OBJECTS_LIGHTS_Y, "far_plane": OBJECTS_LIGHTS_Y + 0.5,
+              "floor": "z = %.2f m, from 0.3 to %.1f m" % (OBJECTS_FLOOR_Z, OBJECTS_WALL_Y)}
     return lights, depths
 
 
