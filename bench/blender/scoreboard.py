@@ -55,6 +55,14 @@ def parse_args():
     return a
 
 
+def run_tool(command):
+    """Runs a program, its output captured; a clear message where it is not there."""
+    try:
+        return subprocess.run(command, capture_output=True, text=True)
+    except FileNotFoundError:
+        sys.exit(f"scoreboard.py: {command[0]}: not found (Blender 3.4: apt-get install -y blender; or --blender PATH)")
+
+
 def score(args, picture, shot_dir):
     out = subprocess.run([args.compare, picture, os.path.join(shot_dir, "reference.exr"),
                           os.path.join(shot_dir, "pinhole.exr"), str(args.band)],
@@ -66,11 +74,11 @@ def score(args, picture, shot_dir):
 
 
 def node(args, shot_dir, fstop, focus, out):
-    r = subprocess.run([args.blender, "-b", "--factory-startup", "-t", str(args.threads), "--python",
+    r = run_tool([args.blender, "-b", "--factory-startup", "-t", str(args.threads), "--python",
                         os.path.join(ROOT, "bench", "blender", "defocus_node.py"), "--", "--image",
                         os.path.join(shot_dir, "pinhole.exr"), "--fstop", fstop, "--focus", focus, "--out", out,
                         "--threads", str(args.threads), "--repeat", str(args.node_repeat),
-                        "--execution-mode", "FULL_FRAME"], capture_output=True, text=True)
+                        "--execution-mode", "FULL_FRAME"])
     m = re.search(r"defocus_seconds=([0-9.]+)", r.stdout + r.stderr)
     if r.returncode != 0 or not m or not os.path.isfile(out):
         sys.exit(f"scoreboard.py: the Defocus node failed on {shot_dir}:\n{(r.stdout + r.stderr)[-2000:]}")
