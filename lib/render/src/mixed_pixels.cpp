@@ -411,7 +411,11 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
   // and now 19, medians of 9). Per row, every spanning pixel's decision by column. Those that change
   // something are applied after the pass: its moves in row order, the last pass's splits and moves
   // row by row in parallel.
-  std::vector<std::vector<std::pair<int, Decision>>> decided(static_cast<std::size_t>(height)), previous(decided.size());
+  // A row's decisions live in its own pool, made once and only appended to; the passes' lists name
+  // them by index (a decision kept from the previous pass is not copied: 112 bytes each, the fence's
+  // 40 thousand of them in each of three passes).
+  std::vector<std::vector<Decision>> pools(static_cast<std::size_t>(height));
+  std::vector<std::vector<std::pair<int, std::uint32_t>>> decided(pools.size()), previous(pools.size());
   LargeVector<std::uint8_t> unchanged(pixels, 0);  // since the previous pass
   std::vector<std::size_t> moved;
   // Per row, its splits (entry y + 1), made prefix sums in the last pass: where its far parts go.
@@ -424,6 +428,7 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
     for (int y = 0; y < height; ++y) {
       auto& row = decided[static_cast<std::size_t>(y)];
       const auto& before = previous[static_cast<std::size_t>(y)];
+      std::vector<Decision>& pool = pools[static_cast<std::size_t>(y)];
       row.clear();
       std::size_t k = 0;  // the previous pass's decision at or after column x
       std::size_t splits = 0;
@@ -433,8 +438,9 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
         while (k < before.size() && before[k].first < x) ++k;
         // (A pixel whose neighbourhood is unchanged spanned a step then too: its spans flag did not change.)
         const bool known = unchanged[row_start + x] && k < before.size() && before[k].first == x;
-        row.emplace_back(x, known ? before[k].second : decide(sources, coc.data(), next_to_step, width, height, x, y));
-        const Decision::Kind kind = row.back().second.kind;
+        if (!known) pool.push_back(decide(sources, coc.data(), next_to_step, width, height, x, y));
+        row.emplace_back(x, known ? before[k].second : static_cast<std::uint32_t>(pool.size() - 1));
+        const Decision::Kind kind = pool[row.back().second].kind;
         moves_decided += kind == Decision::Kind::Move ? 1 : 0;
         splits += kind == Decision::Kind::Split ? 1 : 0;
       }
@@ -451,7 +457,9 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 16) reduction(+ : splits, moves)
       for (int y = 0; y < height; ++y) {
         std::size_t far = first_far + row_splits[static_cast<std::size_t>(y)];
-        for (const auto& [x, d] : decided[static_cast<std::size_t>(y)]) {
+        const std::vector<Decision>& pool = pools[static_cast<std::size_t>(y)];
+        for (const auto& [x, at] : decided[static_cast<std::size_t>(y)]) {
+          const Decision& d = pool[at];
           ScatterSource& p = sources[static_cast<std::size_t>(y) * width + x];
           if (d.kind == Decision::Kind::Move) {
             move(p, d, camera);
@@ -469,7 +477,8 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
     // The moves of this pass (a few), in row order.
     moved.clear();
     for (int y = 0; y < height; ++y) {
-      for (const auto& [x, d] : decided[static_cast<std::size_t>(y)]) {
+      for (const auto& [x, at] : decided[static_cast<std::size_t>(y)]) {
+        const Decision& d = pools[static_cast<std::size_t>(y)][at];
         if (d.kind != Decision::Kind::Move) continue;
         const std::size_t i = static_cast<std::size_t>(y) * width + x;
         move(sources[i], d, camera);
