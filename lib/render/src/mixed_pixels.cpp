@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <memory>
+#include <span>
 
 #include "first_touch.h"
 #include "lensmith/core/units.h"
@@ -386,7 +388,9 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
   // The pixels' blurs packed, and per pixel whether it is next to a depth step and whether its
   // neighbourhood spans one. Only the pixels that span one are decided (a few per cent of a
   // frame); after each pass the flags are brought up to date around the pixels it moved.
-  LargeVector<double> coc(pixels);
+  // (The blurs written in full by the threads, not zeroed first on one.)
+  const std::unique_ptr<double[]> coc_store(new double[pixels]);
+  const std::span<double> coc(coc_store.get(), pixels);
   LargeVector<std::uint8_t> next_to_step(pixels), spans(pixels);
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (int y = 0; y < height; ++y) {
@@ -397,10 +401,27 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
   }
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * width + x;
-      next_to_step[i] = next_to_step_at(coc.data(), width, height, x, y) ? 1 : 0;
-      spans[i] = spans_step_at(coc.data(), width, height, x, y) ? 1 : 0;
+    const std::size_t row = static_cast<std::size_t>(y) * width;
+    for (const int x : {0, width - 1}) {
+      next_to_step[row + x] = next_to_step_at(coc.data(), width, height, x, y) ? 1 : 0;
+      spans[row + x] = spans_step_at(coc.data(), width, height, x, y) ? 1 : 0;
+    }
+    // Inside the first and last columns, the same tests without branches (they vectorise): a row
+    // beyond the frame stands in as the row itself, whose differences are 0 and whose extremes are
+    // the row's own.
+    const double* up = coc.data() + (y > 0 ? row - width : row);
+    const double* mid = coc.data() + row;
+    const double* down = coc.data() + (y + 1 < height ? row + width : row);
+    std::uint8_t* step = next_to_step.data() + row;
+    std::uint8_t* span = spans.data() + row;
+    for (int x = 1; x + 1 < width; ++x) {
+      const double c = mid[x];
+      const bool beside = (std::abs(c - mid[x - 1]) >= kMinBlurDifferencePx) | (std::abs(c - mid[x + 1]) >= kMinBlurDifferencePx) |
+                          (std::abs(c - up[x]) >= kMinBlurDifferencePx) | (std::abs(c - down[x]) >= kMinBlurDifferencePx);
+      const double lo = std::min({up[x - 1], up[x], up[x + 1], mid[x - 1], c, mid[x + 1], down[x - 1], down[x], down[x + 1]});
+      const double hi = std::max({up[x - 1], up[x], up[x + 1], mid[x - 1], c, mid[x + 1], down[x - 1], down[x], down[x + 1]});
+      step[x] = beside ? 1 : 0;
+      span[x] = hi - lo >= kMinBlurDifferencePx ? 1 : 0;
     }
   }
   // Each pass decides from the sources as they were at its start, so decisions do not depend on
