@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <span>
 
 #include "first_touch.h"
@@ -135,12 +136,26 @@ ScatterSources make_scatter_sources(const Image& image, const DepthMap& depth, c
   double coc_min = kInfinity, coc_max = -kInfinity;
 #pragma omp parallel for num_threads(threads) schedule(static) reduction(+ : clamped) reduction(min : coc_min) reduction(max : coc_max)
   for (int y = 0; y < h; ++y) {
+    // A depth equal to the previous pixel's (a wall facing the camera, the sky) takes its inverse
+    // depth, blur and clamp count over: the camera's blur is the dearest part of a source.
+    float last_z = std::numeric_limits<float>::quiet_NaN();
+    double last_w = 0.0, last_coc = 0.0;
+    std::size_t last_clamps = 0;
     for (int x = 0; x < w; ++x) {
       ScatterSource& s = sources[static_cast<std::size_t>(y) * w + x];
       s.x = x;
       s.y = y;
       s.rgb = {image.at(x, y, 0), image.at(x, y, 1), image.at(x, y, 2)};
-      s.inverse_depth_per_mm = clamp_inverse_depth(camera, inverse_depth_per_mm(depth.at(x, y)), options.max_blur_px, clamped, &s.coc_px);
+      const float z = depth.at(x, y);
+      if (!(z == last_z)) {
+        std::size_t clamps = 0;
+        last_w = clamp_inverse_depth(camera, inverse_depth_per_mm(z), options.max_blur_px, clamps, &last_coc);
+        last_z = z;
+        last_clamps = clamps;
+      }
+      s.inverse_depth_per_mm = last_w;
+      s.coc_px = last_coc;
+      clamped += last_clamps;
       coc_min = std::min(coc_min, s.coc_px);
       coc_max = std::max(coc_max, s.coc_px);
     }
