@@ -1,5 +1,7 @@
 #include "depth_layers.h"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -62,9 +64,21 @@ DepthLayers make_depth_layers(const ScatterSources& sources, int width, int heig
   }
   const auto n = static_cast<std::ptrdiff_t>(sources.size());
   LargeVector<std::uint16_t> layer_of(sources.size());
-#pragma omp parallel for num_threads(threads) schedule(static)
-  for (std::ptrdiff_t i = 0; i < n; ++i) {
-    layer_of[static_cast<std::size_t>(i)] = static_cast<std::uint16_t>(spacing.layer_at(sources[static_cast<std::size_t>(i)].coc_px));
+  // Each thread a contiguous share; a source blurred as the one before it (most of a row of a wall)
+  // takes its layer over.
+#pragma omp parallel num_threads(threads)
+  {
+    const std::ptrdiff_t t = omp_get_thread_num(), count = omp_get_num_threads();
+    double last_coc = std::numeric_limits<double>::quiet_NaN();
+    std::uint16_t last_layer = 0;
+    for (std::ptrdiff_t i = n * t / count; i < n * (t + 1) / count; ++i) {
+      const double coc = sources[static_cast<std::size_t>(i)].coc_px;
+      if (!(coc == last_coc)) {
+        last_layer = static_cast<std::uint16_t>(spacing.layer_at(coc));
+        last_coc = coc;
+      }
+      layer_of[static_cast<std::size_t>(i)] = last_layer;
+    }
   }
   // Parts grouped by pixel: counted, then placed (a split pixel's second part comes at the end of
   // the sources). Sources beyond the frame (the scatter's margin) are no pixel's parts: they only
