@@ -284,8 +284,9 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
 
 // Sources beyond a w x h frame over `margin` px each side, copies of the nearest edge pixel's parts
 // (every source of that pixel: a split pixel's two parts, a layered input's samples) at their own
-// positions.
-void add_margin_sources(ScatterSources& sources, int w, int h, int margin) {
+// positions. `pixels_first`: the first w x h sources are the frame's pixels in row order (a flat
+// picture's; only their edge pixels are visited, then the sources after them).
+void add_margin_sources(ScatterSources& sources, int w, int h, int margin, bool pixels_first) {
   if (margin <= 0) return;
   // Only the frame's edge pixels are copied: their sources are indexed by a slot per edge pixel
   // (top row, bottom row, left and right columns between), in source order. (Indexing every pixel
@@ -299,12 +300,27 @@ void add_margin_sources(ScatterSources& sources, int w, int h, int margin) {
   };
   const std::size_t slots = 2 * static_cast<std::size_t>(w) + 2 * static_cast<std::size_t>(h);
   std::vector<std::pair<std::uint32_t, std::uint32_t>> edge;  // (slot, source), in source order
-  for (std::size_t i = 0; i < sources.size(); ++i) {
+  auto visit = [&](std::size_t i) {
     const ScatterSource& s = sources[i];
-    if (s.x < 0 || s.y < 0 || s.x >= w || s.y >= h) continue;
+    if (s.x < 0 || s.y < 0 || s.x >= w || s.y >= h) return;
     const int slot = slot_of(s.x, s.y);
     if (slot >= 0) edge.emplace_back(static_cast<std::uint32_t>(slot), static_cast<std::uint32_t>(i));
+  };
+  const std::size_t frame = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+  std::size_t rest = 0;  // the first source not yet visited
+  if (pixels_first && sources.size() >= frame) {
+    for (int y = 0; y < h; ++y) {
+      const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
+      if (y == 0 || y == h - 1) {
+        for (int x = 0; x < w; ++x) visit(row + static_cast<std::size_t>(x));
+      } else {
+        visit(row);
+        if (w > 1) visit(row + static_cast<std::size_t>(w - 1));
+      }
+    }
+    rest = frame;
   }
+  for (std::size_t i = rest; i < sources.size(); ++i) visit(i);
   std::vector<std::uint32_t> begin(slots + 1, 0);
   for (const auto& [slot, i] : edge) ++begin[slot + 1];
   for (std::size_t k = 0; k < slots; ++k) begin[k + 1] += begin[k];
@@ -427,7 +443,7 @@ Image render_bokeh(const Image& image, const DepthMap& depth, const RayModel& mo
   if (render_detail::copies_sharp_pixels(model, aperture, options)) {
     stats.copied_pixels = render_detail::mark_sharp_pixels(sources, w, h, spacing.spacing_px, threads);
   }
-  add_margin_sources(sources, w, h, margin);
+  add_margin_sources(sources, w, h, margin, true);
   const DepthLayers layers = render_detail::make_depth_layers(sources, w, h, spacing, threads);
   return render_sources(sources, layers, w, h, margin, model, aperture, options, stats);
 }
@@ -449,7 +465,7 @@ Image render_bokeh(const DeepImage& deep, const RayModel& model, const Aperture&
   const int margin = render_detail::frame_margin_px(model, 0.5 * stats.max_abs_coc_px);
   ScatterSources sources = std::move(deep_sources.sources);
   stats.edge_gap_px = render_detail::frame_edge_gap_px(model);
-  add_margin_sources(sources, deep.width, deep.height, margin);
+  add_margin_sources(sources, deep.width, deep.height, margin, false);
   const DepthLayers layers = render_detail::make_depth_layers(sources, deep.width, deep.height, deep_sources.spacing, thread_count(options));
   return render_sources(sources, layers, deep.width, deep.height, margin, model, aperture, options, stats);
 }
