@@ -215,28 +215,30 @@ struct Decision {
   Surface near, far;
 };
 
-// Whether a 4-neighbour of pixel (x, y) differs in blur (`coc`, px per pixel) by kMinBlurDifferencePx
-// or more: such a pixel may be mixed itself, and decide() prefers neighbours that are not.
-bool next_to_step_at(const double* coc, int width, int height, int x, int y) {
-  const std::size_t i = static_cast<std::size_t>(y) * width + x;
-  const double c = coc[i];
-  return (x > 0 && std::abs(c - coc[i - 1]) >= kMinBlurDifferencePx) || (x + 1 < width && std::abs(c - coc[i + 1]) >= kMinBlurDifferencePx) ||
-         (y > 0 && std::abs(c - coc[i - width]) >= kMinBlurDifferencePx) ||
-         (y + 1 < height && std::abs(c - coc[i + width]) >= kMinBlurDifferencePx);
+// A pixel's step flags, from its own row's blurs (`mid`, px) and those of the rows above and below
+// it, at columns l, x and r (x - 1 and x + 1 inside the frame): whether a 4-neighbour differs in
+// blur by kMinBlurDifferencePx or more (such a pixel may be mixed itself, and decide() prefers
+// neighbours that are not), and whether its 3 x 3 neighbourhood's blur spans that much (only there
+// can decide() change anything). A row or column beyond the frame is given as the pixel's own,
+// whose differences are 0 and whose extremes are the neighbourhood's own. No branches: a row of
+// them vectorises.
+inline void set_step_flags(const double* up, const double* mid, const double* down, int l, int x, int r, std::uint8_t& next_to_step,
+                           std::uint8_t& spans) {
+  const double c = mid[x];
+  const bool beside = (std::abs(c - mid[l]) >= kMinBlurDifferencePx) | (std::abs(c - mid[r]) >= kMinBlurDifferencePx) |
+                      (std::abs(c - up[x]) >= kMinBlurDifferencePx) | (std::abs(c - down[x]) >= kMinBlurDifferencePx);
+  const double lo = std::min({up[l], up[x], up[r], mid[l], c, mid[r], down[l], down[x], down[r]});
+  const double hi = std::max({up[l], up[x], up[r], mid[l], c, mid[r], down[l], down[x], down[r]});
+  next_to_step = beside ? 1 : 0;
+  spans = hi - lo >= kMinBlurDifferencePx ? 1 : 0;
 }
 
-// Whether the blur of pixel (x, y)'s 3 x 3 neighbourhood spans kMinBlurDifferencePx or more: only
-// there can decide() change anything.
-bool spans_step_at(const double* coc, int width, int height, int x, int y) {
-  double lo = kInfinity, hi = -kInfinity;
-  for (int qy = std::max(0, y - 1); qy <= std::min(height - 1, y + 1); ++qy) {
-    for (int qx = std::max(0, x - 1); qx <= std::min(width - 1, x + 1); ++qx) {
-      const double c = coc[static_cast<std::size_t>(qy) * width + qx];
-      lo = std::min(lo, c);
-      hi = std::max(hi, c);
-    }
-  }
-  return hi - lo >= kMinBlurDifferencePx;
+// The step flags of pixel (x, y) of a width x height frame of blurs `coc`.
+void set_step_flags_at(const double* coc, int width, int height, int x, int y, LargeVector<std::uint8_t>& next_to_step,
+                       LargeVector<std::uint8_t>& spans) {
+  const std::size_t row = static_cast<std::size_t>(y) * width;
+  set_step_flags(coc + (y > 0 ? row - width : row), coc + row, coc + (y + 1 < height ? row + width : row), x > 0 ? x - 1 : x, x,
+                 x + 1 < width ? x + 1 : x, next_to_step[row + x], spans[row + x]);
 }
 
 // (`coc`: the sources' blurs packed: the neighbourhoods are scanned for them, and only the
@@ -402,27 +404,14 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (int y = 0; y < height; ++y) {
     const std::size_t row = static_cast<std::size_t>(y) * width;
-    for (const int x : {0, width - 1}) {
-      next_to_step[row + x] = next_to_step_at(coc.data(), width, height, x, y) ? 1 : 0;
-      spans[row + x] = spans_step_at(coc.data(), width, height, x, y) ? 1 : 0;
-    }
-    // Inside the first and last columns, the same tests without branches (they vectorise): a row
-    // beyond the frame stands in as the row itself, whose differences are 0 and whose extremes are
-    // the row's own.
+    for (const int x : {0, width - 1}) set_step_flags_at(coc.data(), width, height, x, y, next_to_step, spans);
+    // Inside the first and last columns, the columns beside are the frame's own.
     const double* up = coc.data() + (y > 0 ? row - width : row);
     const double* mid = coc.data() + row;
     const double* down = coc.data() + (y + 1 < height ? row + width : row);
     std::uint8_t* step = next_to_step.data() + row;
     std::uint8_t* span = spans.data() + row;
-    for (int x = 1; x + 1 < width; ++x) {
-      const double c = mid[x];
-      const bool beside = (std::abs(c - mid[x - 1]) >= kMinBlurDifferencePx) | (std::abs(c - mid[x + 1]) >= kMinBlurDifferencePx) |
-                          (std::abs(c - up[x]) >= kMinBlurDifferencePx) | (std::abs(c - down[x]) >= kMinBlurDifferencePx);
-      const double lo = std::min({up[x - 1], up[x], up[x + 1], mid[x - 1], c, mid[x + 1], down[x - 1], down[x], down[x + 1]});
-      const double hi = std::max({up[x - 1], up[x], up[x + 1], mid[x - 1], c, mid[x + 1], down[x - 1], down[x], down[x + 1]});
-      step[x] = beside ? 1 : 0;
-      span[x] = hi - lo >= kMinBlurDifferencePx ? 1 : 0;
-    }
+    for (int x = 1; x + 1 < width; ++x) set_step_flags(up, mid, down, x - 1, x, x + 1, step[x], span[x]);
   }
   // Each pass decides from the sources as they were at its start, so decisions do not depend on
   // the order of the pixels. A pixel's decision reads its 5 x 5 neighbourhood and their step flags
@@ -515,9 +504,7 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
       const int x = static_cast<int>(i % static_cast<std::size_t>(width)), y = static_cast<int>(i / static_cast<std::size_t>(width));
       for (int qy = std::max(0, y - 1); qy <= std::min(height - 1, y + 1); ++qy) {
         for (int qx = std::max(0, x - 1); qx <= std::min(width - 1, x + 1); ++qx) {
-          const std::size_t q = static_cast<std::size_t>(qy) * width + qx;
-          next_to_step[q] = next_to_step_at(coc.data(), width, height, qx, qy) ? 1 : 0;
-          spans[q] = spans_step_at(coc.data(), width, height, qx, qy) ? 1 : 0;
+          set_step_flags_at(coc.data(), width, height, qx, qy, next_to_step, spans);
         }
       }
       for (int qy = std::max(0, y - 3); qy <= std::min(height - 1, y + 3); ++qy) {
