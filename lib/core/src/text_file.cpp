@@ -1,5 +1,11 @@
 #include "lensmith/core/text_file.h"
 
+#include <fcntl.h>
+#include <stdio.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -160,6 +166,29 @@ std::string decode_text(std::string_view bytes, const std::string& file_name) {
   return is_valid_utf8(bytes) ? std::string(bytes) : decode_windows_1252(bytes);
 }
 
+namespace {
+
+// Puts the finished temporary file in place of an existing regular file (or symbolic link) at
+// `target` by swapping the two names in one step (renameat2's RENAME_EXCHANGE, Linux 3.15 on), then
+// removes the old file under the temporary name. A reader of `target` sees the old file or the new
+// one, never neither, as with a rename onto it; but ext4 (its auto_da_alloc default) makes a rename
+// onto an existing file write the new file's data out first, which held `lensmith bokeh` on a
+// 600 x 400 picture for 2.7 ms of its 50 (0.6 ms of it CPU; docs/performance.md): after an
+// exchange the new file is written out as a file newly made would be. Like every lensmith output
+// it is not synced to disk: a power cut soon after may lose it. False (nothing done) where there
+// is nothing to replace, the target is something else (a folder: rename refuses it, exchange would
+// not), or the file system cannot exchange; the caller then renames.
+bool replace_by_exchange(const std::filesystem::path& temp, const std::filesystem::path& target) {
+  struct stat existing{};
+  if (lstat(target.c_str(), &existing) != 0 || !(S_ISREG(existing.st_mode) || S_ISLNK(existing.st_mode))) return false;
+  if (renameat2(AT_FDCWD, temp.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) != 0) return false;
+  // The old file's name is now the temporary one: hidden, and removed at once.
+  unlink(temp.c_str());
+  return true;
+}
+
+}  // namespace
+
 void write_atomically(const std::string& path, const std::string& extension,
                       const std::function<void(const std::string& temporary_path)>& write) {
   namespace fs = std::filesystem;
@@ -182,6 +211,7 @@ void write_atomically(const std::string& path, const std::string& extension,
     fs::remove(temp, ignored);
     throw;
   }
+  if (replace_by_exchange(temp, target)) return;
   std::error_code ec;
   fs::rename(temp, target, ec);
   if (ec) {
