@@ -369,6 +369,36 @@ TEST_CASE("Through a thin lens the sharp pixels that no blur reaches are copied 
   }
 }
 
+TEST_CASE("A sharp subject in front of a blurred background is copied whole and gives the picture of every pixel scattered", "[render]") {
+  // The background's blur spreads over the subject's pixels, but its layer lies behind them: a pixel
+  // of the subject covers its pixel fully and hides it, so no blur of another layer keeps it from the
+  // copy. Every pixel of the subject is copied (edge pixels are not split here, so that none is a
+  // part of a pixel), and the picture is the scattered one to the double sums' rounding.
+  constexpr double kSamePicture = 1e-6;  // of values up to 1
+  const int w = 160, h = 96;
+  const Image img = test_pattern(w, h);
+  DepthMap depth(w, h, 20.0f);
+  int subject = 0;
+  for (int y = 20; y < 70; ++y) {
+    for (int x = 40; x < 100; ++x, ++subject) depth.at(x, y) = 2.5f;
+  }
+  const Camera cam = Camera::thin_lens(50.0, camera_options(2.5, 1.4), w, h);
+  const auto model = make_ray_model(RayModelKind::Thin, cam);
+  for (const HiddenSurfaces hidden : {HiddenSurfaces::Extend, HiddenSurfaces::Stretch}) {
+    BokehOptions o;
+    o.hidden = hidden;
+    o.split_edge_pixels = false;
+    BokehStatistics copied_stats;
+    const Image copied = render_bokeh(img, depth, *model, Aperture::circular(), o, &copied_stats);
+    o.copy_sharp_pixels = false;
+    const Image scattered = render_bokeh(img, depth, *model, Aperture::circular(), o);
+    INFO(to_string(hidden) << ", background blur " << copied_stats.max_abs_coc_px << " px");
+    CHECK(copied_stats.max_abs_coc_px > 2.0);
+    CHECK(copied_stats.copied_pixels == static_cast<std::size_t>(subject));
+    CHECK(max_abs_difference(copied, scattered) < kSamePicture);
+  }
+}
+
 TEST_CASE("Through the Biotar at f/5.6, a highlight's bokeh by the Seidel model matches the exact tracer's in place and size",
           "[render]") {
   // Tolerances: centroid within 0.1 px and RMS radius within 4 %, from the centre to 3/4 of the way

@@ -14,6 +14,7 @@
 #include <atomic>
 #include <cstdint>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <sstream>
 #include <vector>
@@ -111,7 +112,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   const std::size_t unaimed_before = model.unaimed_rays();
 
   const bool stretch = options.hidden == HiddenSurfaces::Stretch;
-  const std::size_t frame_floats = static_cast<std::size_t>(w) * h * 4;
+  const std::size_t pixel_count = static_cast<std::size_t>(w) * static_cast<std::size_t>(h), frame_floats = pixel_count * 4;
   LargeVector<float> result;
   fault_in(result, frame_floats, threads);
   result.resize(frame_floats, 0.0f);  // premultiplied RGB + coverage
@@ -131,6 +132,11 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   render_detail::WriteFirstArray<FootprintPlan> plan_store(layer.capacity());
   render_detail::WriteFirstArray<std::array<float, 2>> plan_row_store(layer.capacity());
   std::vector<std::size_t> range_begin;  // of the plan ranges of a layer
+  // Per plan range, the rows its footprints may touch (the least y_min, the largest y_max): a band
+  // passes over the ranges that do not reach it without looking at their footprints. (A layer's
+  // sources come mostly in row order, so a range spans a few rows; each of street f/4's 8 bands
+  // looked at all of its 0.24 million footprints.)
+  std::vector<std::array<float, 2>> range_rows;
   render_detail::MergeScratch merge_scratch;
   render_detail::HiddenScratch hidden_scratch;
   // Each thread's scratch space, kept from layer to layer (its caches of the table's nodes and light
@@ -141,9 +147,21 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
     const auto u = static_cast<std::size_t>(l);
     layer.clear();
     fault_in(layer, layers.members(l).size(), threads);
-    // (Copied sharp pixels stay members: the hidden surfaces read them. They are written at the end.)
+    // Copied sharp pixels stay members: the hidden surfaces read them. Each is written to the result
+    // as the scatter draws it: all its own light at its own centre, covering the pixel fully, over
+    // what the farther layers left there; nothing of this layer reaches it (sharp_pixels.h), so the
+    // layer's composite leaves it as it is, and the nearer layers are composited over it.
     for (int i : layers.members(l)) {
-      if (!sources[static_cast<std::size_t>(i)].copied) layer.push_back(sources[static_cast<std::size_t>(i)]);
+      const ScatterSource& s = sources[static_cast<std::size_t>(i)];
+      if (!s.copied) {
+        layer.push_back(s);
+      } else if (static_cast<std::size_t>(i) < pixel_count) {  // (a copied edge pixel's copies beyond the frame: nothing)
+        float* r = result.data() + 4 * static_cast<std::size_t>(i);
+        r[0] = s.rgb[0];
+        r[1] = s.rgb[1];
+        r[2] = s.rgb[2];
+        r[3] = s.coverage;
+      }
     }
     const double hidden_blur = layers.max_blur_px[u] + layers.nearer_blur_px[u];
     if (!layer.empty() && l + 1 < layers.count && hidden_blur >= kMinHiddenBlurPx) {
@@ -160,6 +178,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
     const std::span<std::array<float, 2>> plan_rows = plan_row_store.first(layer.size(), threads);
     render_detail::plan_range_starts(layer, kPlanRange, range_begin);
     const std::size_t ranges = range_begin.size() - 1;
+    range_rows.resize(ranges);
 #pragma omp parallel num_threads(threads)
     {
       FootprintScratch& scratch = scratches[static_cast<std::size_t>(omp_get_thread_num())];
@@ -167,7 +186,12 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
       for (std::size_t r = 0; r < ranges; ++r) {
         const std::size_t begin = range_begin[r], end = range_begin[r + 1];
         scatter.plan_range(layer, plans, begin, end, scratch);
-        for (std::size_t i = begin; i < end; ++i) plan_rows[i] = {plans[i].y_min, plans[i].y_max};
+        std::array<float, 2> rows{std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity()};
+        for (std::size_t i = begin; i < end; ++i) {
+          plan_rows[i] = {plans[i].y_min, plans[i].y_max};
+          rows = {std::min(rows[0], plans[i].y_min), std::max(rows[1], plans[i].y_max)};
+        }
+        range_rows[r] = rows;
       }
     }
 
@@ -188,26 +212,29 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
         for (auto& set : buffers.used) set.fill(false);
         const float band_top = static_cast<float>(row_begin) - 1.0f, band_bottom = static_cast<float>(row_end) + 1.0f;
         scratch.forget_shape();
-        for (std::size_t i = 0; i < layer.size(); ++i) {
-          if (plan_rows[i][1] < band_top || plan_rows[i][0] > band_bottom) continue;
-          const int level = plans[i].level;
-          const std::size_t set = layer[i].coverage_only ? 1 : 0, lv = static_cast<std::size_t>(level);
-          // The thread's buffer for this grid, made once and reset for each band.
-          std::optional<SplatBuffer>& slot = buffers.buffers[set][lv];
-          bool& used = buffers.used[set][lv];
-          if (!slot) {
-            SplatOptions o = options.splat;
-            o.downsample = 1 << level;
-            slot.emplace(w, row_begin, row_end, o);
-          } else if (!used) {
-            slot->reset(row_begin, row_end);
+        for (std::size_t r = 0; r < ranges; ++r) {
+          if (range_rows[r][1] < band_top || range_rows[r][0] > band_bottom) continue;
+          for (std::size_t i = range_begin[r]; i < range_begin[r + 1]; ++i) {
+            if (plan_rows[i][1] < band_top || plan_rows[i][0] > band_bottom) continue;
+            const int level = plans[i].level;
+            const std::size_t set = layer[i].coverage_only ? 1 : 0, lv = static_cast<std::size_t>(level);
+            // The thread's buffer for this grid, made once and reset for each band.
+            std::optional<SplatBuffer>& slot = buffers.buffers[set][lv];
+            bool& used = buffers.used[set][lv];
+            if (!slot) {
+              SplatOptions o = options.splat;
+              o.downsample = 1 << level;
+              slot.emplace(w, row_begin, row_end, o);
+            } else if (!used) {
+              slot->reset(row_begin, row_end);
+            }
+            used = true;
+            if (!scatter.deposit_planned_point(layer[i], plans[i], *slot)) {
+              scatter.deposit(layer[i], plans[i], i, *slot, scratch, local_triangles, local_reused);
+            }
+            // A footprint cross-faded between two group counts deposits both splits.
+            local_footprints += static_cast<std::size_t>(plans[i].groups + (plans[i].blend < 1.0f ? plans[i].groups - 1 : 0));
           }
-          used = true;
-          if (!scatter.deposit_planned_point(layer[i], plans[i], *slot)) {
-            scatter.deposit(layer[i], plans[i], i, *slot, scratch, local_triangles, local_reused);
-          }
-          // A footprint cross-faded between two group counts deposits both splits.
-          local_footprints += static_cast<std::size_t>(plans[i].groups + (plans[i].blend < 1.0f ? plans[i].groups - 1 : 0));
         }
         // The rows of the band this layer reaches are resolved and composited over the result; the
         // others are left as they are (the layer is empty there; its image is not even cleared).
@@ -260,21 +287,6 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   stats.light_images = scatter.light_images();
   stats.reused_shapes = reused;
   stats.unaimed_rays = model.unaimed_rays() - unaimed_before;
-  // The copied sharp pixels, as the scatter draws them: all their own light at their own centre,
-  // covering the pixel fully; nothing nearer reaches them (sharp_pixels.h).
-  if (stats.copied_pixels > 0) {
-    const auto pixels = static_cast<std::ptrdiff_t>(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
-#pragma omp parallel for num_threads(threads) schedule(static)
-    for (std::ptrdiff_t k = 0; k < pixels; ++k) {
-      const ScatterSource& s = sources[static_cast<std::size_t>(k)];
-      if (!s.copied) continue;
-      float* r = result.data() + 4 * static_cast<std::size_t>(k);
-      r[0] = s.rgb[0];
-      r[1] = s.rgb[1];
-      r[2] = s.rgb[2];
-      r[3] = s.coverage;
-    }
-  }
   LargeVector<render_detail::PushPullCell<5>> fill_cells;  // where some gap needs the push-pull fill
   // The lens's image circle, where some pixel is left uncovered (a fisheye's frame corners).
   const render_detail::ImageCircle circle =
@@ -441,7 +453,7 @@ Image render_bokeh(const Image& image, const DepthMap& depth, const RayModel& mo
   stats.edge_gap_px = render_detail::frame_edge_gap_px(model);
   const render_detail::LayerSpacing spacing = render_detail::layer_spacing_of(sources, options.layer_spacing_px, options.max_layers, threads);
   if (render_detail::copies_sharp_pixels(model, aperture, options)) {
-    stats.copied_pixels = render_detail::mark_sharp_pixels(sources, w, h, spacing.spacing_px, threads);
+    stats.copied_pixels = render_detail::mark_sharp_pixels(sources, w, h, spacing, threads);
   }
   add_margin_sources(sources, w, h, margin, true);
   const DepthLayers layers = render_detail::make_depth_layers(sources, w, h, spacing, threads);

@@ -1,12 +1,15 @@
-// Sharp pixels that nothing blurred reaches. A pixel of the thin lens whose own footprint is a point
-// (blur under kPointFootprintPx) lands at its own centre, where the splat's tent gives it all to its
-// own pixel and none to its neighbours; if no other source's footprint reaches the pixel, the
-// scatter gives it back exactly as it came in, covering its pixel fully (nothing behind it shows,
-// and nothing in front reaches it). Such pixels are marked `copied`: they keep their place among
-// the depth layers' pixels (the hidden-surface extension reads them as before), but are not
-// planned, deposited or composited, and the renderer writes them to the result as they are. The
-// picture is the same (tests/render/bokeh_renderer_test.cpp); a frame with large sharp areas
-// renders faster (docs/performance.md: the portrait focused on its wall at 5 m, 61 % copied).
+// Sharp pixels that nothing of their own depth layer reaches. A pixel of the thin lens whose own
+// footprint is a point (blur under kPointFootprintPx) lands at its own centre, where the splat's tent
+// gives it all to its own pixel and none to its neighbours. If no other source of its depth layer
+// (its hidden sources included) reaches the pixel, the layer there is that pixel alone, covering it
+// fully: composited over the farther layers it hides them, and the nearer layers are composited over
+// it. Such pixels are marked `copied`: they keep their place among the depth layers' pixels (the
+// hidden-surface extension reads them as before), but are not planned or deposited; the renderer
+// writes them to the result as they are at their layer's turn. The picture is the same
+// (tests/render/bokeh_renderer_test.cpp); a frame with large sharp areas renders faster
+// (docs/performance.md: the portrait focused on its wall at 5 m, 61 % copied; the fence focused on
+// its wall at 6 m behind a blurred wire mesh, 30 % and, since blurs of other layers no longer count,
+// 58 %).
 //
 // Not from the papers: Lee, Eisemann & Seidel's layered scatter treats every pixel alike.
 #pragma once
@@ -15,6 +18,7 @@
 
 #include "lensmith/camera/aperture.h"
 #include "lensmith/camera/ray_model.h"
+#include "layer_spacing.h"
 #include "lensmith/render/bokeh_renderer.h"
 #include "scatter_source.h"
 
@@ -29,9 +33,9 @@ bool copies_sharp_pixels(const RayModel& model, const Aperture& aperture, const 
 
 // Marks `copied` the pixels of `sources` (one per pixel, row-major, width x height, then any appended
 // parts: a split pixel's far part) that are sharp, whole (one part covering the pixel) and beyond
-// the reach of every other source's footprint: its blur radius plus the tent, a grid cell for merged
-// sources and half a layer spacing (`layer_spacing_px`: a nearer layer's hidden sources blur up to
-// that much more than the pixels they sit behind). Returns how many.
-std::size_t mark_sharp_pixels(ScatterSources& sources, int width, int height, double layer_spacing_px, int threads);
+// the reach of every other source of their depth layer (`spacing`: the layers' bins): its blur
+// radius plus the tent and a grid cell for merged sources; a nearer pixel may have the layer's
+// hidden sources under it, as blurred as the layer's most blurred source. Returns how many.
+std::size_t mark_sharp_pixels(ScatterSources& sources, int width, int height, const LayerSpacing& spacing, int threads);
 
 }  // namespace lensmith::render_detail
