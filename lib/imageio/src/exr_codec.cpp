@@ -536,11 +536,12 @@ bool read_exr_chunks(const fs::path& path, const Imf::MultiPartInputFile& file, 
       }
     }
   };
+  // On OpenMP's threads, each taking the next chunk, so that a thread that starts late takes fewer:
+  // the first parallel region of a process waits up to a few ms for its threads to start, which a
+  // pool of its own paid here and the renderer's first region paid again (docs/performance.md).
   const int threads = std::clamp(codec_thread_count(), 1, std::max(1, chunks));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
+#pragma omp parallel num_threads(threads)
   work();
-  for (std::thread& t : pool) t.join();
   if (error.load() != EXR_ERR_SUCCESS) throw failed(error.load());
   return true;
 }

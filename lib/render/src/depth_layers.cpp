@@ -56,6 +56,7 @@ DepthLayers make_depth_layers(const ScatterSources& sources, int width, int heig
   DepthLayers l;
   static_cast<LayerSpacing&>(l) = spacing;
   l.max_blur_px.assign(static_cast<std::size_t>(l.count), 0.0);
+  l.copied_members.assign(static_cast<std::size_t>(l.count), 0);
   const std::size_t pixel_count = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   // Each source's layer, once (threads; 2 bytes: BokehOptions::max_layers is at most 1024, and the
   // focus split adds 2); the passes below are serial, as each places in source order.
@@ -113,6 +114,7 @@ DepthLayers make_depth_layers(const ScatterSources& sources, int width, int heig
     }
     l.member_store[--member_end[k]] = static_cast<int>(i);
     l.max_blur_px[k] = std::max(l.max_blur_px[k], std::abs(s.coc_px));
+    l.copied_members[k] += s.copied ? 1 : 0;
   }
   // Now part_begin[p + 1] is where p's parts begin: each moves down one place, and the end is the total.
   std::copy(l.part_begin.begin() + 1, l.part_begin.end(), l.part_begin.begin());

@@ -38,6 +38,7 @@ struct DepthLayers : LayerSpacing {
   }
   std::vector<double> max_blur_px;           // per layer: largest |signed blur| of its sources
   std::vector<double> nearer_blur_px;        // per layer: largest |signed blur| of every nearer layer
+  std::vector<std::size_t> copied_members;   // per layer: its members marked copied (sharp_pixels.h), not scattered
 
   // Whether pixel p has a part on layer l.
   bool in(std::size_t p, int l) const {
