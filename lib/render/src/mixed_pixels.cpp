@@ -425,7 +425,14 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
   // them by index (a decision kept from the previous pass is not copied: 112 bytes each, the fence's
   // 40 thousand of them in each of three passes).
   std::vector<std::vector<Decision>> pools(static_cast<std::size_t>(height));
-  std::vector<std::vector<std::pair<int, std::uint32_t>>> decided(pools.size()), previous(pools.size());
+  // A row's list: per spanning pixel its column, its decision in the pool and that decision's kind
+  // (read by every pass's bookkeeping: from the pool, 104 bytes apart, they were a cache miss each).
+  struct Decided {
+    int x;
+    std::uint32_t at;
+    Decision::Kind kind;
+  };
+  std::vector<std::vector<Decided>> decided(pools.size()), previous(pools.size());
   LargeVector<std::uint8_t> unchanged(pixels, 0);  // since the previous pass
   std::vector<std::size_t> moved;
   // Per row, its splits (entry y + 1), made prefix sums in the last pass: where its far parts go.
@@ -443,14 +450,21 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
       std::size_t k = 0;  // the previous pass's decision at or after column x
       std::size_t splits = 0;
       const std::size_t row_start = static_cast<std::size_t>(y) * width;
+      if (pass == 0) {
+        // Room for the row's first decisions and its list at once, not grown by copies.
+        const auto spanning = static_cast<std::size_t>(std::count(spans.begin() + static_cast<std::ptrdiff_t>(row_start),
+                                                                  spans.begin() + static_cast<std::ptrdiff_t>(row_start) + width, std::uint8_t{1}));
+        pool.reserve(spanning);
+        row.reserve(spanning);
+      }
       for (int x = 0; x < width; ++x) {
         if (!spans[row_start + x]) continue;  // decide() would keep it
-        while (k < before.size() && before[k].first < x) ++k;
+        while (k < before.size() && before[k].x < x) ++k;
         // (A pixel whose neighbourhood is unchanged spanned a step then too: its spans flag did not change.)
-        const bool known = unchanged[row_start + x] && k < before.size() && before[k].first == x;
+        const bool known = unchanged[row_start + x] && k < before.size() && before[k].x == x;
         if (!known) pool.push_back(decide(sources, coc.data(), next_to_step, width, height, x, y));
-        row.emplace_back(x, known ? before[k].second : static_cast<std::uint32_t>(pool.size() - 1));
-        const Decision::Kind kind = pool[row.back().second].kind;
+        const Decision::Kind kind = known ? before[k].kind : pool.back().kind;
+        row.push_back({x, known ? before[k].at : static_cast<std::uint32_t>(pool.size() - 1), kind});
         moves_decided += kind == Decision::Kind::Move ? 1 : 0;
         splits += kind == Decision::Kind::Split ? 1 : 0;
       }
@@ -468,9 +482,10 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
       for (int y = 0; y < height; ++y) {
         std::size_t far = first_far + row_splits[static_cast<std::size_t>(y)];
         const std::vector<Decision>& pool = pools[static_cast<std::size_t>(y)];
-        for (const auto& [x, at] : decided[static_cast<std::size_t>(y)]) {
-          const Decision& d = pool[at];
-          ScatterSource& p = sources[static_cast<std::size_t>(y) * width + x];
+        for (const Decided& e : decided[static_cast<std::size_t>(y)]) {
+          if (e.kind == Decision::Kind::Keep) continue;
+          const Decision& d = pool[e.at];
+          ScatterSource& p = sources[static_cast<std::size_t>(y) * width + e.x];
           if (d.kind == Decision::Kind::Move) {
             move(p, d, camera);
             ++moves;
@@ -487,10 +502,10 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
     // The moves of this pass (a few), in row order.
     moved.clear();
     for (int y = 0; y < height; ++y) {
-      for (const auto& [x, at] : decided[static_cast<std::size_t>(y)]) {
-        const Decision& d = pools[static_cast<std::size_t>(y)][at];
-        if (d.kind != Decision::Kind::Move) continue;
-        const std::size_t i = static_cast<std::size_t>(y) * width + x;
+      for (const Decided& e : decided[static_cast<std::size_t>(y)]) {
+        if (e.kind != Decision::Kind::Move) continue;
+        const Decision& d = pools[static_cast<std::size_t>(y)][e.at];
+        const std::size_t i = static_cast<std::size_t>(y) * width + e.x;
         move(sources[i], d, camera);
         ++stats.redepthed_edge_pixels;
         moved.push_back(i);
