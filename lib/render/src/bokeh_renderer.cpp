@@ -166,7 +166,9 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
       }
     }
     const double hidden_blur = layers.max_blur_px[u] + layers.nearer_blur_px[u];
-    if (!layer.empty() && l + 1 < layers.count && hidden_blur >= kMinHiddenBlurPx) {
+    // (A layer whose pixels are all copied still has hidden sources: behind a blurred highlight in
+    // front of a sharp wall, the wall shows through the highlight's disc.)
+    if (!layers.members(l).empty() && l + 1 < layers.count && hidden_blur >= kMinHiddenBlurPx) {
       const double reach = std::min(0.5 * hidden_blur + kHiddenMarginPx, 0.5 * (w + h));
       stats.hidden_sources += render_detail::append_hidden_sources(sources, layers, l, w, h, reach, options.hidden, camera,
                                                                    threads, hidden_scratch, layer);

@@ -71,9 +71,15 @@ double least_blur_of_layer(const LayerSpacing& spacing, int l) {
   return value_of(above);
 }
 
+// A source whose footprint is a point at its pixel's centre, where the tent gives all of it to that
+// pixel: it reaches no other (a layer's hidden sources are at their pixels' centres, interpolated
+// from its pixels: such points where those are).
+bool point_at_centre(const ScatterSource& s) {
+  return std::abs(s.coc_px) < kSharpBlurPx && s.offset_x_px == 0.0f && s.offset_y_px == 0.0f;
+}
+
 bool sharp_whole(const ScatterSource& s) {
-  return std::abs(s.coc_px) < kSharpBlurPx && s.coverage == 1.0f && s.hidden == 0.0f && !s.coverage_only && s.offset_x_px == 0.0f &&
-         s.offset_y_px == 0.0f;
+  return point_at_centre(s) && s.coverage == 1.0f && s.hidden == 0.0f && !s.coverage_only;
 }
 
 }  // namespace
@@ -95,7 +101,9 @@ std::size_t mark_sharp_pixels(ScatterSources& sources, int width, int height, co
     // This layer's blurs, [lo, hi) exactly as layer_at bins them: farther ones below, nearer above.
     const double lo = least_blur_of_layer(spacing, sharp_layer), hi = least_blur_of_layer(spacing, sharp_layer + 1);
     const auto reach_of = [&](const ScatterSource& s) -> float {
-      return s.coc_px < lo ? kNothing : s.coc_px < hi ? static_cast<float>(reach_px(s.coc_px)) : kNearer;
+      if (s.coc_px < lo) return kNothing;
+      if (s.coc_px >= hi) return kNearer;
+      return point_at_centre(s) ? kNothing : static_cast<float>(reach_px(s.coc_px));
     };
     // Per pixel, how far (px) the footprints of this layer's sources there reach from its centre:
     // kCandidate for a sharp whole pixel of the layer, kNothing where none lies or can lie, kNearer
@@ -122,7 +130,7 @@ std::size_t mark_sharp_pixels(ScatterSources& sources, int width, int height, co
     }
     // A nearer pixel may have hidden sources of this layer under it, interpolated from the layer's own
     // blurs (a margin beyond the frame repeats its edge pixels' blurs).
-    const float hidden_reach = static_cast<float>(reach_px(largest_blur));
+    const float hidden_reach = largest_blur < kSharpBlurPx ? kNothing : static_cast<float>(reach_px(largest_blur));
 #pragma omp parallel for num_threads(threads) schedule(static)
     for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(pixels); ++i) {
       if (reach[static_cast<std::size_t>(i)] == kNearer) reach[static_cast<std::size_t>(i)] = hidden_reach;
