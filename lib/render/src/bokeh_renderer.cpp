@@ -460,7 +460,7 @@ Image render_bokeh(const Image& image, const DepthMap& depth, const RayModel& mo
     stats.copied_pixels = render_detail::mark_sharp_pixels(sources, w, h, spacing, threads);
   }
   add_margin_sources(sources, w, h, margin, true);
-  const DepthLayers layers = render_detail::make_depth_layers(sources, w, h, spacing, threads);
+  const DepthLayers layers = render_detail::make_depth_layers(sources, w, h, spacing, threads, true);
   return render_sources(sources, layers, w, h, margin, model, aperture, options, stats);
 }
 

@@ -52,8 +52,10 @@ int LayerSpacing::layer_at(double coc_px) const {
   return g + (coc_px < -cut ? 0 : coc_px < cut ? 1 : 2);
 }
 
-DepthLayers make_depth_layers(const ScatterSources& sources, int width, int height, const LayerSpacing& spacing, int threads) {
+DepthLayers make_depth_layers(const ScatterSources& sources, int width, int height, const LayerSpacing& spacing, int threads,
+                              bool pixels_first) {
   DepthLayers l;
+  l.pixels_first = pixels_first && sources.size() >= static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   static_cast<LayerSpacing&>(l) = spacing;
   l.max_blur_px.assign(static_cast<std::size_t>(l.count), 0.0);
   l.copied_members.assign(static_cast<std::size_t>(l.count), 0);

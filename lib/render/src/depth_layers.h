@@ -39,6 +39,7 @@ struct DepthLayers : LayerSpacing {
   std::vector<double> max_blur_px;           // per layer: largest |signed blur| of its sources
   std::vector<double> nearer_blur_px;        // per layer: largest |signed blur| of every nearer layer
   std::vector<std::size_t> copied_members;   // per layer: its members marked copied (sharp_pixels.h), not scattered
+  bool pixels_first = false;  // the first width x height sources are the pixels in raster order (a flat picture's)
 
   // Whether pixel p has a part on layer l.
   bool in(std::size_t p, int l) const {
@@ -65,7 +66,9 @@ struct DepthLayers : LayerSpacing {
 
 // The layers of `sources` (the parts of the pixels of an image `width` x `height`), farthest first,
 // at `spacing`; `threads` find each source's layer.
-DepthLayers make_depth_layers(const ScatterSources& sources, int width, int height, const LayerSpacing& spacing, int threads);
+// `pixels_first`: the first width x height sources are the pixels in raster order (a flat picture's).
+DepthLayers make_depth_layers(const ScatterSources& sources, int width, int height, const LayerSpacing& spacing, int threads,
+                              bool pixels_first = false);
 // Layers `spacing_px` apart over the sources' own range of blur (widened so there are at most
 // `max_layers`).
 LayerSpacing layer_spacing_of(const ScatterSources& sources, double spacing_px, int max_layers, int threads);
