@@ -852,6 +852,7 @@ std::optional<std::array<double, 8>> parse_chromaticities(std::string_view text)
 }
 
 void set_image_codec_threads(int threads) { codecs::codec_threads.store(std::max(0, threads)); }
+int image_codec_threads() { return std::max(1, codecs::codec_thread_count()); }
 
 int DeepRaster::channel_index(std::string_view name) const {
   for (std::size_t i = 0; i < channels.size(); ++i) {

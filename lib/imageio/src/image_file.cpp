@@ -31,9 +31,12 @@ Raster select_channels(const Decoded& decoded, std::span<const int> channels) {
   raster.channels = static_cast<int>(channels.size());
   const std::size_t pixels = static_cast<std::size_t>(raster.width) * static_cast<std::size_t>(raster.height);
   raster.samples.resize(pixels * channels.size());
-  for (std::size_t p = 0; p < pixels; ++p) {
+  const auto count = static_cast<std::ptrdiff_t>(pixels);
+#pragma omp parallel for num_threads(image_codec_threads()) schedule(static)
+  for (std::ptrdiff_t p = 0; p < count; ++p) {
+    const auto u = static_cast<std::size_t>(p);
     for (std::size_t c = 0; c < channels.size(); ++c) {
-      raster.samples[p * channels.size() + c] = decoded.samples[p * stride + static_cast<std::size_t>(channels[c])];
+      raster.samples[u * channels.size() + c] = decoded.samples[u * stride + static_cast<std::size_t>(channels[c])];
     }
   }
   return raster;

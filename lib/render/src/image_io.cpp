@@ -11,6 +11,7 @@
 #include <limits>
 #include <system_error>
 
+#include "lensmith/core/first_index.h"
 #include "lensmith/core/number_parsing.h"
 #include "lensmith/core/units.h"
 #include "lensmith/imageio/image_file.h"
@@ -103,16 +104,12 @@ OutputFormat output_format(const fs::path& path) {
 }
 
 void check_no_nan(const fs::path& path, const Image& image) {
-  for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) {
-      for (int c = 0; c < image.channels; ++c) {
-        if (std::isnan(image.at(x, y, c))) {
-          throw ComputationError(path.string() + ": the image to write has NaN at " + pixel_text(x, y) + " channel " +
-                                 std::to_string(c) + ": the computation that made it failed");
-        }
-      }
-    }
-  }
+  const std::size_t k = first_index_where(image.data.size(), image_codec_threads(), [&](std::size_t i) { return std::isnan(image.data[i]); });
+  if (k == image.data.size()) return;
+  const auto channels = static_cast<std::size_t>(image.channels), pixel = k / channels;
+  throw ComputationError(path.string() + ": the image to write has NaN at " +
+                         pixel_text(static_cast<int>(pixel % static_cast<std::size_t>(image.width)), static_cast<int>(pixel / static_cast<std::size_t>(image.width))) +
+                         " channel " + std::to_string(k % channels) + ": the computation that made it failed");
 }
 
 }  // namespace
@@ -214,13 +211,14 @@ Image read_radiance_image(const fs::path& path, const RadianceReadOptions& optio
     // Float channels are the picture as read: checked, then taken over (a copy of the frame, and
     // its fresh memory, cost the street scene's process about 2 ms).
     const std::size_t count = values.samples.size();
-    for (std::size_t k = 0; k < count; ++k) {
-      const float v = values.samples[k];
-      if (!(std::isfinite(v) && v >= 0.0f)) {
-        const std::size_t pixel = k / 3;
-        throw not_radiance(static_cast<int>(pixel % static_cast<std::size_t>(info.width)),
-                           static_cast<int>(pixel / static_cast<std::size_t>(info.width)), k % 3, v);
-      }
+    const std::size_t k = first_index_where(count, image_codec_threads(), [&](std::size_t i) {
+      const float v = values.samples[i];
+      return !(std::isfinite(v) && v >= 0.0f);
+    });
+    if (k < count) {
+      const std::size_t pixel = k / 3;
+      throw not_radiance(static_cast<int>(pixel % static_cast<std::size_t>(info.width)),
+                         static_cast<int>(pixel / static_cast<std::size_t>(info.width)), k % 3, values.samples[k]);
     }
     Image image;
     image.width = info.width;
@@ -356,23 +354,25 @@ DepthMap depth_map_from_values(std::span<const float> values, const DepthReadOpt
                          " x " + std::to_string(frame.height_px()) + " pixels: the depth map must have the picture's size");
   }
   constexpr float kFar = std::numeric_limits<float>::infinity();
+  // Each pixel's planar depth, on the codec threads (a row each); an invalid one is left NaN until
+  // the rule for it is known. z = 0 (also a depth too small for a float) is a point at the pinhole,
+  // not in front of it.
   DepthMap depth(frame.width_px(), frame.height_px(), kFar);
-  std::vector<bool> invalid(values.size(), false);
   std::size_t invalid_count = 0;
-  std::size_t first_invalid = 0;
+  std::size_t first_invalid = values.size();
   float nearest_m = kFar;
+#pragma omp parallel for num_threads(image_codec_threads()) schedule(static) reduction(+ : invalid_count) reduction(min : first_invalid, nearest_m)
   for (int y = 0; y < depth.height; ++y) {
     for (int x = 0; x < depth.width; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(depth.width) + static_cast<std::size_t>(x);
       const float z = static_cast<float>(planar_depth_m(values[i], options, frame, x, y));
-      // z = 0 (also a depth too small for a float) is a point at the pinhole, not in front of it.
       if (z > 0.0f) {
         depth.z_m[i] = z;
         nearest_m = std::min(nearest_m, z);
       } else {
-        if (invalid_count == 0) first_invalid = i;
+        depth.z_m[i] = std::numeric_limits<float>::quiet_NaN();
+        first_invalid = std::min(first_invalid, i);
         ++invalid_count;
-        invalid[i] = true;
       }
     }
   }
@@ -397,8 +397,8 @@ DepthMap depth_map_from_values(std::span<const float> values, const DepthReadOpt
     }
     replacement = nearest_m;
   }
-  for (std::size_t i = 0; i < invalid.size(); ++i) {
-    if (invalid[i]) depth.z_m[i] = replacement;
+  for (float& z : depth.z_m) {
+    if (std::isnan(z)) z = replacement;
   }
   return depth;
 }

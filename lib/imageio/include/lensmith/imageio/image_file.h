@@ -72,6 +72,9 @@ class ImageReadCache {
 // Threads the OpenEXR codec may use to decompress and compress blocks of scanlines (0: none besides
 // the caller; the default is the machine's hardware threads). Process-wide, as OpenEXR's pool is.
 void set_image_codec_threads(int threads);
+// The threads the codecs use (at least 1, counting the caller): as set, else the machine's. The
+// passes over a picture as read (picking its channels, checking its values) run on as many.
+int image_codec_threads();
 
 // The metadata of a picture file as (name, value) text, under the names OpenImageIO used:
 // OpenEXR attributes (comments as ImageDescription, capDate as DateTime, owner as Copyright, the
