@@ -550,7 +550,6 @@ Raster read_exr(const fs::path& path, const RasterInfo& info, std::span<const in
   const auto file = open_exr(path);
   const Imf::Header& header = file->header(0);
   if (is_deep(header)) throw ImageFileError(path.string() + ": a deep image; lensmith reads flat images only");
-  size_codec_pool();
   Raster raster;
   raster.width = info.width;
   raster.height = info.height;
@@ -570,6 +569,9 @@ Raster read_exr(const fs::path& path, const RasterInfo& info, std::span<const in
   }
   const bool read = read_exr_chunks(path, *file, info, first_position, raster.samples.data(), stride);
   if (!read) {
+    // OpenEXR's own pool only for its C++ reader: started for every file, its idle threads were
+    // joined at the process's end, 1-3 ms after the output was written (`lensmith bokeh`).
+    size_codec_pool();
     try {
       Imf::InputPart part(*file, 0);
       part.setFrameBuffer(frame);
