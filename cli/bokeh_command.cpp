@@ -1,5 +1,6 @@
 // `lensmith bokeh`: an all-in-focus image and its depth, photographed through a lens
 // (docs/bokeh.md). Reads the inputs, builds the camera and the ray model, renders, writes.
+#include <omp.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include <sstream>
 
 #include "commands.h"
+#include "openmp_team.h"
 #include "progress_bar.h"
 #include "lensmith/camera/camera_spec.h"
 #include "lensmith/color/color_management.h"
@@ -242,6 +244,8 @@ std::string write_bokeh_output(Image out, OutputMetadata& meta, const BokehComma
 
 int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   const auto started = std::chrono::steady_clock::now();
+  // The threads the reading, the render and the writing share, started first (openmp_team.h).
+  start_openmp_team(o.threads > 0 ? o.threads : omp_get_max_threads());
   const bool multiview = o.method == "multiview", lightfield = o.method == "lightfield", ewa = o.method == "ewa", gather = o.method == "gather";
   if (o.method != "scatter" && !o.scatter_options.empty()) {
     throw UsageError(o.scatter_options.front() + " is an option of --method scatter, not of --method " + o.method);
