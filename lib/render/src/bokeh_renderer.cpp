@@ -482,7 +482,8 @@ Image render_bokeh(const DeepImage& deep, const RayModel& model, const Aperture&
   ScatterSources sources = std::move(deep_sources.sources);
   stats.edge_gap_px = render_detail::frame_edge_gap_px(model);
   add_margin_sources(sources, deep.width, deep.height, margin, false);
-  const DepthLayers layers = render_detail::make_depth_layers(sources, deep.width, deep.height, deep_sources.spacing, thread_count(options));
+  const DepthLayers layers =
+      render_detail::make_depth_layers(sources, deep.width, deep.height, deep_sources.spacing, thread_count(options), false);
   return render_sources(sources, layers, deep.width, deep.height, margin, model, aperture, options, stats);
 }
 

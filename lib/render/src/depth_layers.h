@@ -68,7 +68,7 @@ struct DepthLayers : LayerSpacing {
 // at `spacing`; `threads` find each source's layer.
 // `pixels_first`: the first width x height sources are the pixels in raster order (a flat picture's).
 DepthLayers make_depth_layers(const ScatterSources& sources, int width, int height, const LayerSpacing& spacing, int threads,
-                              bool pixels_first = false);
+                              bool pixels_first);
 // Layers `spacing_px` apart over the sources' own range of blur (widened so there are at most
 // `max_layers`).
 LayerSpacing layer_spacing_of(const ScatterSources& sources, double spacing_px, int max_layers, int threads);
