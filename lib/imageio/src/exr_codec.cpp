@@ -670,14 +670,29 @@ void zip_filter(const std::uint8_t* raw, std::size_t n, std::uint8_t* out) {
   }
 }
 
-// Whether deflating a filtered block (zip_filter) pays (kZipWorthRatio), judged from a sample: the
-// start of each of its halves (the filter's two byte streams). `sample` and `scratch` are working space.
-bool deflate_pays(const std::vector<std::uint8_t>& filtered, std::vector<std::uint8_t>& sample, std::vector<std::uint8_t>& scratch) {
-  const std::size_t n = filtered.size(), half = (n + 1) / 2, part = half / kZipSampleParts;
+// The sample by which deflate_pays judges a block of n raw bytes: the start of each half of its
+// filtered bytes (zip_filter's two byte streams), `part` bytes of the first and up to `part` of the
+// second, filtered from the raw bytes they come from (the first 2 part, and the last even byte, which
+// the second stream's first difference is taken against) without filtering the whole block: most
+// blocks of a rendered picture are then stored as they are (kZipWorthRatio). The bytes are those
+// zip_filter would give.
+void zip_filter_sample(const std::uint8_t* raw, std::size_t n, std::size_t part, std::vector<std::uint8_t>& sample) {
+  const std::size_t half = (n + 1) / 2, second = std::min(part, n - half);
+  sample.resize(part + second);
+  const auto difference = [](int value, int previous) { return static_cast<std::uint8_t>(value - previous + (128 + 256)); };
+  for (std::size_t j = 0; j < part; ++j) sample[j] = j == 0 ? raw[0] : difference(raw[2 * j], raw[2 * j - 2]);
+  const std::size_t last_even = 2 * (half - 1);
+  for (std::size_t j = 0; j < second; ++j) {
+    sample[part + j] = difference(raw[2 * j + 1], j == 0 ? raw[last_even] : raw[2 * j - 1]);
+  }
+}
+
+// Whether deflating a block of n raw bytes (filtered by zip_filter) pays (kZipWorthRatio), judged from
+// a sample (zip_filter_sample). `sample` and `scratch` are working space.
+bool deflate_pays(const std::uint8_t* raw, std::size_t n, std::vector<std::uint8_t>& sample, std::vector<std::uint8_t>& scratch) {
+  const std::size_t half = (n + 1) / 2, part = half / kZipSampleParts;
   if (part == 0) return true;  // too small to judge: deflated, kept raw if it does not shrink
-  sample.assign(filtered.begin(), filtered.begin() + static_cast<std::ptrdiff_t>(part));
-  sample.insert(sample.end(), filtered.begin() + static_cast<std::ptrdiff_t>(half),
-                filtered.begin() + static_cast<std::ptrdiff_t>(half + std::min(part, n - half)));
+  zip_filter_sample(raw, n, part, sample);
   uLongf size = compressBound(static_cast<uLong>(sample.size()));
   scratch.resize(size);
   if (compress2(scratch.data(), &size, sample.data(), static_cast<uLong>(sample.size()), kZipLevel) != Z_OK) return true;
@@ -786,13 +801,15 @@ void write_exr_file(const fs::path& path, const std::string& file, const PixelsV
   bool deflated = true;
 #pragma omp parallel num_threads(std::max(1, codec_thread_count()))
   {
-    std::vector<std::uint8_t> raw, filtered, sample;
+    std::vector<std::uint8_t> filtered, sample, deflated_block;
 #pragma omp for schedule(dynamic, 1)
     for (int b = 0; b < blocks; ++b) {
       const int y0 = b * lines_per_block, y1 = std::min(pixels.height, y0 + lines_per_block);
       const std::size_t bytes = static_cast<std::size_t>(y1 - y0) * width * source.size() * sizeof(float);
-      raw.resize(bytes);
-      auto* line = reinterpret_cast<float*>(raw.data());
+      // The block as stored raw, packed in place; deflated where that pays.
+      std::vector<std::uint8_t>& block = packed[static_cast<std::size_t>(b)];
+      block.resize(bytes);
+      auto* line = reinterpret_cast<float*>(block.data());
       for (int y = y0; y < y1; ++y) {
         const float* row = pixels.samples.data() + static_cast<std::size_t>(y) * width * stride;
         for (const std::size_t c : source) {
@@ -800,23 +817,18 @@ void write_exr_file(const fs::path& path, const std::string& file, const PixelsV
           line += width;
         }
       }
+      if (!deflate_pays(block.data(), bytes, sample, deflated_block)) continue;
       filtered.resize(bytes);
-      zip_filter(raw.data(), bytes, filtered.data());
-      std::vector<std::uint8_t>& block = packed[static_cast<std::size_t>(b)];
-      if (!deflate_pays(filtered, sample, block)) {
-        block = raw;
-        continue;
-      }
+      zip_filter(block.data(), bytes, filtered.data());
       uLongf size = compressBound(static_cast<uLong>(bytes));
-      block.resize(size);
-      const int rc = compress2(block.data(), &size, filtered.data(), static_cast<uLong>(bytes), kZipLevel);
+      deflated_block.resize(size);
+      const int rc = compress2(deflated_block.data(), &size, filtered.data(), static_cast<uLong>(bytes), kZipLevel);
       if (rc != Z_OK) {
 #pragma omp atomic write
         deflated = false;
-      } else if (size >= bytes) {
-        block = raw;  // OpenEXR keeps a block that does not shrink as it is (its readers know it by its size)
-      } else {
-        block.resize(size);
+      } else if (size < bytes) {
+        // (A block that does not shrink stays raw, as OpenEXR keeps it: its readers know it by its size.)
+        block.assign(deflated_block.begin(), deflated_block.begin() + static_cast<std::ptrdiff_t>(size));
       }
     }
   }
