@@ -293,9 +293,9 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   stats.unaimed_rays = model.unaimed_rays() - unaimed_before;
   LargeVector<render_detail::PushPullCell<5>> fill_cells;  // where some gap needs the push-pull fill
   // The lens's image circle, where some pixel is left uncovered (a fisheye's frame corners).
-  const render_detail::ImageCircle circle =
-      render_detail::has_gaps(result) ? render_detail::ImageCircle(camera, threads) : render_detail::ImageCircle();
-  return render_detail::finish_composite(result, w, h, threads, fill_cells, hidden_scratch.push_pull, circle);
+  const bool gaps = render_detail::has_gaps(result, threads);
+  const render_detail::ImageCircle circle = gaps ? render_detail::ImageCircle(camera, threads) : render_detail::ImageCircle();
+  return render_detail::finish_composite(result, w, h, threads, gaps, fill_cells, hidden_scratch.push_pull, circle);
 }
 
 // Sources beyond a w x h frame over `margin` px each side, copies of the nearest edge pixel's parts

@@ -49,14 +49,15 @@ void composite_layer_over(const float* layer_rows, const float* hole_rows, Large
   }
 }
 
-bool has_gaps(const LargeVector<float>& result) {
-  for (std::size_t k = 3; k < result.size(); k += 4) {
-    if (result[k] < kHalfCovered) return true;
-  }
-  return false;
+bool has_gaps(const LargeVector<float>& result, int threads) {
+  const auto pixels = static_cast<std::ptrdiff_t>(result.size() / 4);
+  bool gap = false;
+#pragma omp parallel for num_threads(threads) schedule(static) reduction(|| : gap)
+  for (std::ptrdiff_t k = 0; k < pixels; ++k) gap = gap || result[4 * static_cast<std::size_t>(k) + 3] < kHalfCovered;
+  return gap;
 }
 
-Image finish_composite(const LargeVector<float>& result, int width, int height, int threads,
+Image finish_composite(const LargeVector<float>& result, int width, int height, int threads, bool gaps,
                        LargeVector<PushPullCell<5>>& fill, PushPullScratch<5>& scratch, const ImageCircle& circle) {
   const std::size_t count = static_cast<std::size_t>(width) * height;
   // Gaps beyond the lens's image circle stay dark: nothing the lens images lands there.
@@ -64,10 +65,17 @@ Image finish_composite(const LargeVector<float>& result, int width, int height, 
     return circle.reaches(static_cast<double>(k % static_cast<std::size_t>(width)) + 0.5,
                           static_cast<double>(k / static_cast<std::size_t>(width)) + 0.5);
   };
-  bool any_gap = false;
-  for (std::size_t k = 0; k < count && !any_gap; ++k) any_gap = result[4 * k + 3] < kRenormaliseCoverage && reached(k);
-  // The push-pull fill (5 floats a pixel) only where some gap is too empty to renormalise.
+  // The push-pull fill (5 floats a pixel) only where some gap is too empty to renormalise (none
+  // where no pixel is covered less than half: kRenormaliseCoverage is less).
+  static_assert(kRenormaliseCoverage < kHalfCovered);
   const auto pixels = static_cast<std::ptrdiff_t>(count);
+  bool any_gap = false;
+  if (gaps) {
+#pragma omp parallel for num_threads(threads) schedule(static) reduction(|| : any_gap)
+    for (std::ptrdiff_t k = 0; k < pixels; ++k) {
+      any_gap = any_gap || (result[4 * static_cast<std::size_t>(k) + 3] < kRenormaliseCoverage && reached(static_cast<std::size_t>(k)));
+    }
+  }
   if (any_gap) {
     fill.resize(count);  // every cell is written below
 #pragma omp parallel for num_threads(threads) schedule(static)
