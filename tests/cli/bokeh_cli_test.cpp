@@ -2,8 +2,12 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <string>
 #include <vector>
@@ -577,4 +581,86 @@ TEST_CASE("lensmith bokeh writes an anamorphic lens's picture squeezed as on the
   CHECK(again.exit_code != 0);
   CHECK_THAT(again.err, Catch::Contains("not square") && Catch::Contains("desqueeze it first"));
   CHECK_FALSE(fs::exists(scratch("ana-again.exr")));
+}
+
+namespace {
+
+// A 16-bit sRGB code's step is at most 4e-5 in linear light (at 1.0: 1/65535 x the encoding's slope of
+// 2.4); written and read back, a pixel comes within that and the rounding of the two conversions.
+constexpr double kTiffRoundTrip = 1e-4;
+
+// The little-endian TIFF of one 8-bit gray strip of `width` x `height` pixels whose data is not
+// there: enough for libtiff to read its directory.
+void write_tiff_header(const fs::path& path, std::uint32_t width, std::uint32_t height) {
+  std::vector<unsigned char> bytes{'I', 'I', 42, 0, 8, 0, 0, 0};
+  auto put16 = [&](std::uint32_t v) { bytes.insert(bytes.end(), {static_cast<unsigned char>(v), static_cast<unsigned char>(v >> 8)}); };
+  auto put32 = [&](std::uint32_t v) { put16(v & 0xffff); put16(v >> 16); };
+  const std::vector<std::array<std::uint32_t, 3>> entries{{256, 4, width}, {257, 4, height}, {258, 3, 8},   {259, 3, 1}, {262, 3, 1},
+                                                          {273, 4, 134},   {277, 3, 1},      {278, 4, height}, {279, 4, width * height}};
+  put16(static_cast<std::uint32_t>(entries.size()));
+  for (const auto& [tag, type, value] : entries) {
+    put16(tag);
+    put16(type);
+    put32(1);
+    if (type == 3) {
+      put16(value);
+      put16(0);
+    } else {
+      put32(value);
+    }
+  }
+  put32(0);
+  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+}
+
+}  // namespace
+
+TEST_CASE("lensmith bokeh writes and reads TIFF through its TIFF module and its errors reach the command as any reader's do", "[cli][bokeh]") {
+  // The command line loads libtiff from liblensmith_tiff.so when a command first needs it
+  // (lib/imageio/src/tiff_module.h); this program links the codec itself, an independent reader.
+  const std::string render = " --thin-lens --focal-length 50 --fstop 2 --focus 1.2 --quiet -o ";
+  const fs::path tif = scratch("module.tif"), exr = scratch("module.exr");
+  REQUIRE(run_lensmith("bokeh --image " + kScene + render + tif.string()).exit_code == 0);
+  REQUIRE(run_lensmith("bokeh --image " + kScene + render + exr.string()).exit_code == 0);
+  const lensmith::Image from_tiff = lensmith::read_radiance_image(tif), from_exr = lensmith::read_radiance_image(exr);
+  REQUIRE(from_tiff.data.size() == from_exr.data.size());
+  double worst = 0.0;
+  for (std::size_t i = 0; i < from_exr.data.size(); ++i) {
+    const double expected = std::clamp(static_cast<double>(from_exr.data[i]), 0.0, 1.0);
+    worst = std::max(worst, std::abs(from_tiff.data[i] - expected));
+  }
+  CHECK(worst < kTiffRoundTrip);
+  SECTION("a TIFF as input, read by the module") {
+    const fs::path out = scratch("from-tiff.exr");
+    const auto r = run_lensmith("bokeh --image " + tif.string() + " --depth " + kScene + render + out.string());
+    INFO(r.err);
+    CHECK(r.exit_code == 0);
+    CHECK(fs::exists(out));
+  }
+  SECTION("a truncated TIFF: exit 5 (IoError), naming the file") {
+    const fs::path cut = scratch("cut.tif");
+    fs::copy_file(tif, cut, fs::copy_options::overwrite_existing);
+    fs::resize_file(cut, 300);
+    const auto r = run_lensmith("bokeh --image " + cut.string() + " --depth " + kScene + render + scratch("cut.exr").string());
+    CHECK(r.exit_code == 5);
+    CHECK(r.err.find(cut.string() + ": cannot read the TIFF image") != std::string::npos);
+  }
+  SECTION("a TIFF taller than lensmith reads: exit 3 (ImageFileError), naming the file") {
+    const fs::path tall = scratch("tall.tif");
+    write_tiff_header(tall, 1, 1u << 25);
+    const auto r = run_lensmith("bokeh --image " + tall.string() + " --depth " + kScene + render + scratch("tall.exr").string());
+    CHECK(r.exit_code == 3);
+    CHECK(r.err.find(tall.string() + ": TIFF of 1 x 33554432 pixels") != std::string::npos);
+  }
+  SECTION("without the module: exit 5, saying where it looked, nothing written") {
+    const fs::path modules = scratch("no-tiff-module");
+    fs::create_directories(modules);
+    const fs::path out = scratch("nowhere.tif");
+    ::setenv("LENSMITH_MODULE_DIR", modules.c_str(), 1);
+    const auto r = run_lensmith("bokeh --image " + kScene + render + out.string());
+    ::unsetenv("LENSMITH_MODULE_DIR");
+    CHECK(r.exit_code == 5);
+    CHECK(r.err.find((modules / "liblensmith_tiff.so").string()) != std::string::npos);
+    CHECK_FALSE(fs::exists(out));
+  }
 }
