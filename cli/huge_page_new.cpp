@@ -25,12 +25,14 @@ namespace {
 // raises the threshold to its size (up to 32 MiB): from then on large blocks come from the heap,
 // where their 2 MiB ranges share page tables with small blocks already faulted in as 4 KiB pages, and
 // the kernel faults them in 4 KiB at a time whatever the advice. A threshold set by mallopt stays
-// where it is: at kHugePageFromBytes every huge-page block has a mapping of its own. The heap is
-// kept up to 64 MiB when freed (the default trims it from 128 KiB), so that freed small blocks are
-// reused, not returned and faulted in again. Street scene (docs/performance.md): 3700 -> 1600 page
+// where it is: at kHugePageFromBytes a huge-page block the heap's top cannot hold gets a mapping of
+// its own (one it can hold lies in the heap's huge pages below). The heap is kept up to
+// kTrimThresholdBytes when freed (the default trims it from 128 KiB), so that freed blocks are
+// reused, not returned and faulted in again: more than kHeapReserveBytes, or the reserve's own probe,
+// freed, would trim it before it is advised. Street scene (docs/performance.md): 3700 -> 1600 page
 // faults a process; reading 20 -> 12 ms, layering 10 -> 6 ms. Whoever sets glibc's malloc tunables
 // (GLIBC_TUNABLES, MALLOC_*_ environment variables) keeps them.
-constexpr int kTrimThresholdBytes = 64 << 20;
+constexpr int kTrimThresholdBytes = 128 << 20;
 // The small blocks themselves (the codecs' line buffers, the command line's and the renderer's
 // small vectors) come from the heap, which a process touches 4 KiB at a time: about 500 faults, half
 // of the street scene's process. So the heap's first kHeapReserveBytes are reserved at start-up from
@@ -40,8 +42,17 @@ constexpr int kTrimThresholdBytes = 64 << 20;
 // new heap memory), and the first huge page, which malloc's bookkeeping has touched as small pages
 // by the time the advice can be given, is collapsed into a huge one (MADV_COLLAPSE, Linux 6.1;
 // ignored where the kernel lacks it). Memory beyond the reserve is faulted in as before. Street
-// scene: 1155 -> 640 page faults a process (docs/performance.md).
-constexpr int kHeapReserveBytes = 32 << 20;
+// scene: 1155 -> 640 page faults a process (docs/performance.md). 64 MiB, not 32: with one arena
+// (below) a 600 x 400 render's heap outgrew 32 (the fence focused at 6 m: 1090 faults a process at
+// 32 MiB, 350 at 64).
+constexpr int kHeapReserveBytes = 64 << 20;
+// The OpenMP threads' small blocks (the renderer's per-row lists, made in parallel loops) came from
+// glibc's arena for each thread, a mapping of its own faulted in 4 KiB at a time: 890 of the fence's
+// faults a process. With one arena they come from the heap's huge pages too (their lock is taken by
+// blocks too large for the threads' caches only). With the larger reserve, the fence at 6 m: 1250 ->
+// 350 faults a process, the objects scene 2200 -> 370; 4 % of the objects scene's process time and
+// 8 % of the fence's (medians of 41, alternately). MALLOC_ARENA_MAX, where set, is kept.
+constexpr int kArenas = 1;
 constexpr int kDefaultTopPadBytes = 128 << 10;  // glibc's M_TOP_PAD
 #ifndef MADV_COLLAPSE
 constexpr int MADV_COLLAPSE = 25;  // linux/mman.h, Linux 6.1
@@ -74,6 +85,7 @@ void reserve_heap_in_huge_pages() {
   }
   mallopt(M_MMAP_THRESHOLD, static_cast<int>(lensmith::kHugePageFromBytes));
   mallopt(M_TRIM_THRESHOLD, kTrimThresholdBytes);
+  if (std::getenv("MALLOC_ARENA_MAX") == nullptr) mallopt(M_ARENA_MAX, kArenas);
   reserve_heap_in_huge_pages();
 }
 
