@@ -282,6 +282,9 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   if (o.keep_depth && !output_keeps_alpha(output)) {
     throw UsageError("--keep-depth needs an OpenEXR output (.exr): " + output.string() + " cannot hold a depth channel");
   }
+  // The picture, its alpha, passes and depth are often one file: opened and decoded once, until the
+  // depth is read.
+  std::optional<ImageReadCache> read_cache(std::in_place);
   // A deep OpenEXR is layered input: its samples carry colour, alpha and depth together.
   const bool layered = is_deep_image(o.image);
   const std::optional<ColorManagement> color = color_management(o, output, layered);
@@ -297,8 +300,6 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   read.highlight_threshold = o.highlight_threshold;
   read.validate();
   if (o.threads > 0) set_image_codec_threads(o.threads);
-  // The picture, its alpha, passes and depth are often one file: decoded once, until the depth is read.
-  std::optional<ImageReadCache> read_cache(std::in_place);
   if (layered && !o.depth.empty()) {
     throw UsageError(o.image + " is a deep image, whose samples carry their own Z: --depth is for flat pictures");
   }

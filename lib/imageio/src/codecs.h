@@ -38,6 +38,11 @@ void write_exr_file(const fs::path& path, const std::string& file, const PixelsV
                     const std::vector<std::string>& channel_names,
                     const std::vector<ImageAttribute>& attributes, const std::optional<std::pair<PixelBox, PixelBox>>& windows = {});
 
+// While an ImageReadCache is alive on a thread (its constructor begins, its destructor ends; they
+// nest), the OpenEXR files opened there are kept open and parsed once (exr_codec.cpp's open_exr).
+void begin_exr_memo();
+void end_exr_memo();
+
 // TIFF (tiff_codec.cpp).
 RasterInfo read_tiff_info(const fs::path& path);
 Decoded read_tiff(const fs::path& path);

@@ -205,9 +205,15 @@ struct ImageReadCache::Header {
   std::optional<std::vector<std::pair<std::string, std::string>>> metadata;
 };
 
-ImageReadCache::ImageReadCache() : previous_(current_read_cache) { current_read_cache = this; }
+ImageReadCache::ImageReadCache() : previous_(current_read_cache) {
+  current_read_cache = this;
+  codecs::begin_exr_memo();
+}
 
-ImageReadCache::~ImageReadCache() { current_read_cache = previous_; }
+ImageReadCache::~ImageReadCache() {
+  codecs::end_exr_memo();
+  current_read_cache = previous_;
+}
 
 namespace {
 
