@@ -403,6 +403,8 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
   const std::unique_ptr<double[]> coc_store(new double[pixels]);
   const std::span<double> coc(coc_store.get(), pixels);
   LargeVector<std::uint8_t> next_to_step(pixels), spans(pixels);
+  // Per row, where its spanning pixels start among the frame's (entry y; the count in the last).
+  std::vector<std::uint32_t> row_begin(static_cast<std::size_t>(height) + 1, 0);
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
@@ -421,7 +423,11 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
     std::uint8_t* step = next_to_step.data() + row;
     std::uint8_t* span = spans.data() + row;
     for (int x = 1; x + 1 < width; ++x) set_step_flags(up, mid, down, x - 1, x, x + 1, step[x], span[x]);
+    std::uint32_t count = 0;
+    for (int x = 0; x < width; ++x) count += span[x];
+    row_begin[static_cast<std::size_t>(y) + 1] = count;
   }
+  for (std::size_t y = 0; y < static_cast<std::size_t>(height); ++y) row_begin[y + 1] += row_begin[y];
   // Each pass decides from the sources as they were at its start, so decisions do not depend on
   // the order of the pixels. A pixel's decision reads its 5 x 5 neighbourhood and their step flags
   // (one more ring): one whose 7 x 7 neighbourhood no pass has moved a pixel of since the previous
@@ -430,18 +436,40 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
   // and now 19, medians of 9). Per row, every spanning pixel's decision by column. Those that change
   // something are applied after the pass: its moves in row order, the last pass's splits and moves
   // row by row in parallel.
-  // A row's decisions live in its own pool, made once and only appended to; the passes' lists name
-  // them by index (a decision kept from the previous pass is not copied: 112 bytes each, the fence's
-  // 40 thousand of them in each of three passes).
-  std::vector<std::vector<Decision>> pools(static_cast<std::size_t>(height));
-  // A row's list: per spanning pixel its column, its decision in the pool and that decision's kind
-  // (read by every pass's bookkeeping: from the pool, 104 bytes apart, they were a cache miss each).
+  // The first pass decides every spanning pixel: its decisions and its rows' lists lie in two
+  // frame-wide arrays, each row's at row_begin (made once, filled by the threads: as a vector per
+  // row, 800 blocks of the heap were allocated by the threads at once, the allocator's lock
+  // contended). Later passes decide a few pixels of a few rows again: those decisions are appended
+  // to their row's own pool (`later`), and a changed row's list is made in one of the row's two
+  // stores, the one its previous list is not in. Lists name decisions by index: below kLater in the
+  // first pass's array, from kLater in the row's pool (a decision kept from the previous pass is not
+  // copied: 112 bytes each, the fence's 40 thousand of them in each of three passes).
+  // A list entry: a spanning pixel's column, its decision and that decision's kind (read by every
+  // pass's bookkeeping: from the decisions, 104 bytes apart, they were a cache miss each).
   struct Decided {
     int x;
     std::uint32_t at;
     Decision::Kind kind;
   };
-  std::vector<std::vector<Decided>> decided(pools.size()), previous(pools.size());
+  constexpr std::uint32_t kLater = 1u << 31;
+  const std::size_t spanning = row_begin.back();
+  WriteFirstArray<Decision> first_pool(spanning);
+  WriteFirstArray<Decided> first_lists(spanning);
+  const std::span<Decision> first_decisions = first_pool.first(spanning, threads);
+  const std::span<Decided> first_entries = first_lists.first(spanning, threads);
+  std::vector<std::vector<Decision>> later(static_cast<std::size_t>(height));
+  const auto decision_at = [&](std::size_t y, std::uint32_t at) -> const Decision& {
+    return at < kLater ? first_decisions[at] : later[y][at - kLater];
+  };
+  struct RowList {
+    const Decided* data = nullptr;
+    std::size_t size = 0;
+    int store = -1;  // where it lies: -1 the first pass's array, 0 or 1 the row's stores
+    std::span<const Decided> entries() const { return {data, size}; }
+  };
+  std::vector<RowList> decided(static_cast<std::size_t>(height)), previous(decided.size());
+  std::array<std::vector<std::vector<Decided>>, 2> stores{std::vector<std::vector<Decided>>(decided.size()),
+                                                          std::vector<std::vector<Decided>>(decided.size())};
   LargeVector<std::uint8_t> unchanged(pixels, 0);  // since the previous pass
   std::vector<std::size_t> moved;
   // Per row, whether a pixel within 3 rows moved in the previous pass (all rows at first): a row
@@ -457,41 +485,55 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
     decided.swap(previous);
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 16) reduction(+ : moves_decided)
     for (int y = 0; y < height; ++y) {
-      auto& row = decided[static_cast<std::size_t>(y)];
-      auto& before = previous[static_cast<std::size_t>(y)];
-      std::vector<Decision>& pool = pools[static_cast<std::size_t>(y)];
+      const auto u = static_cast<std::size_t>(y);
+      RowList& row = decided[u];
+      const RowList& before = previous[u];
       std::size_t splits = 0;
-      if (!row_changed[static_cast<std::size_t>(y)]) {
-        row.swap(before);
-        for (const Decided& e : row) {
+      const auto count_kinds = [&](std::span<const Decided> entries) {
+        for (const Decided& e : entries) {
           moves_decided += e.kind == Decision::Kind::Move ? 1 : 0;
           splits += e.kind == Decision::Kind::Split ? 1 : 0;
         }
-        row_splits[static_cast<std::size_t>(y) + 1] = splits;
+      };
+      if (!row_changed[u]) {
+        row = before;
+        count_kinds(row.entries());
+        row_splits[u + 1] = splits;
         continue;
       }
-      row.clear();
-      std::size_t k = 0;  // the previous pass's decision at or after column x
-      const std::size_t row_start = static_cast<std::size_t>(y) * width;
+      const std::size_t row_start = u * static_cast<std::size_t>(width);
       if (pass == 0) {
-        // Room for the row's first decisions and its list at once, not grown by copies.
-        const auto spanning = static_cast<std::size_t>(std::count(spans.begin() + static_cast<std::ptrdiff_t>(row_start),
-                                                                  spans.begin() + static_cast<std::ptrdiff_t>(row_start) + width, std::uint8_t{1}));
-        pool.reserve(spanning);
-        row.reserve(spanning);
+        std::uint32_t at = row_begin[u];
+        for (int x = 0; x < width; ++x) {
+          if (!spans[row_start + x]) continue;  // decide() would keep it
+          first_decisions[at] = decide(sources, coc.data(), next_to_step, width, height, x, y);
+          first_entries[at] = {x, at, first_decisions[at].kind};
+          ++at;
+        }
+        row = {first_entries.data() + row_begin[u], row_begin[u + 1] - row_begin[u], -1};
+        count_kinds(row.entries());
+        row_splits[u + 1] = splits;
+        continue;
       }
+      const int store = before.store == 0 ? 1 : 0;
+      std::vector<Decided>& list = stores[static_cast<std::size_t>(store)][u];
+      list.clear();
+      const std::span<const Decided> old = before.entries();
+      std::size_t k = 0;  // the previous pass's decision at or after column x
       for (int x = 0; x < width; ++x) {
         if (!spans[row_start + x]) continue;  // decide() would keep it
-        while (k < before.size() && before[k].x < x) ++k;
+        while (k < old.size() && old[k].x < x) ++k;
         // (A pixel whose neighbourhood is unchanged spanned a step then too: its spans flag did not change.)
-        const bool known = unchanged[row_start + x] && k < before.size() && before[k].x == x;
-        if (!known) pool.push_back(decide(sources, coc.data(), next_to_step, width, height, x, y));
-        const Decision::Kind kind = known ? before[k].kind : pool.back().kind;
-        row.push_back({x, known ? before[k].at : static_cast<std::uint32_t>(pool.size() - 1), kind});
-        moves_decided += kind == Decision::Kind::Move ? 1 : 0;
-        splits += kind == Decision::Kind::Split ? 1 : 0;
+        if (unchanged[row_start + x] && k < old.size() && old[k].x == x) {
+          list.push_back(old[k]);
+        } else {
+          later[u].push_back(decide(sources, coc.data(), next_to_step, width, height, x, y));
+          list.push_back({x, kLater + static_cast<std::uint32_t>(later[u].size() - 1), later[u].back().kind});
+        }
       }
-      row_splits[static_cast<std::size_t>(y) + 1] = splits;
+      row = {list.data(), list.size(), store};
+      count_kinds(row.entries());
+      row_splits[u + 1] = splits;
     }
     if (last) {
       // The splits, row by row in parallel (each reads and writes only its own pixel): the far parts
@@ -504,10 +546,9 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 16) reduction(+ : splits, moves)
       for (int y = 0; y < height; ++y) {
         std::size_t far = first_far + row_splits[static_cast<std::size_t>(y)];
-        const std::vector<Decision>& pool = pools[static_cast<std::size_t>(y)];
-        for (const Decided& e : decided[static_cast<std::size_t>(y)]) {
+        for (const Decided& e : decided[static_cast<std::size_t>(y)].entries()) {
           if (e.kind == Decision::Kind::Keep) continue;
-          const Decision& d = pool[e.at];
+          const Decision& d = decision_at(static_cast<std::size_t>(y), e.at);
           ScatterSource& p = sources[static_cast<std::size_t>(y) * width + e.x];
           if (d.kind == Decision::Kind::Move) {
             move(p, d, camera);
@@ -525,9 +566,9 @@ void split_mixed_pixels(ScatterSources& sources, int width, int height, const Ca
     // The moves of this pass (a few), in row order.
     moved.clear();
     for (int y = 0; y < height; ++y) {
-      for (const Decided& e : decided[static_cast<std::size_t>(y)]) {
+      for (const Decided& e : decided[static_cast<std::size_t>(y)].entries()) {
         if (e.kind != Decision::Kind::Move) continue;
-        const Decision& d = pools[static_cast<std::size_t>(y)][e.at];
+        const Decision& d = decision_at(static_cast<std::size_t>(y), e.at);
         const std::size_t i = static_cast<std::size_t>(y) * width + e.x;
         move(sources[i], d, camera);
         ++stats.redepthed_edge_pixels;
