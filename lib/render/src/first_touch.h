@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include "lensmith/core/huge_page_allocator.h"
 
@@ -32,8 +33,8 @@ inline std::size_t touch_pages(void* storage, std::size_t from, std::size_t to, 
 
 // Makes room in `v` for `count` elements and faults in the pages of that room beyond its elements
 // (the storage no element lives in yet) from `threads` threads, a contiguous share each.
-template <class T>
-void fault_in(LargeVector<T>& v, std::size_t count, int threads) {
+template <class T, class Allocator>
+void fault_in(std::vector<T, Allocator>& v, std::size_t count, int threads) {
   if (count > v.capacity()) v.reserve(count);
   const std::size_t from = (v.size() * sizeof(T) + kTouchPageBytes - 1) / kTouchPageBytes * kTouchPageBytes;
   touch_pages(v.data(), from, count * sizeof(T), threads);

@@ -142,10 +142,6 @@ ScatterSources make_scatter_sources(const Image& image, const DepthMap& depth, c
     double last_w = 0.0, last_coc = 0.0;
     std::size_t last_clamps = 0;
     for (int x = 0; x < w; ++x) {
-      ScatterSource& s = sources[static_cast<std::size_t>(y) * w + x];
-      s.x = x;
-      s.y = y;
-      s.rgb = {image.at(x, y, 0), image.at(x, y, 1), image.at(x, y, 2)};
       const float z = depth.at(x, y);
       if (!(z == last_z)) {
         std::size_t clamps = 0;
@@ -153,11 +149,15 @@ ScatterSources make_scatter_sources(const Image& image, const DepthMap& depth, c
         last_z = z;
         last_clamps = clamps;
       }
-      s.inverse_depth_per_mm = last_w;
-      s.coc_px = last_coc;
+      // Written whole: the resize above constructed nothing (ScatterSources).
+      sources[static_cast<std::size_t>(y) * w + x] = ScatterSource{.x = x,
+                                                                   .y = y,
+                                                                   .rgb = {image.at(x, y, 0), image.at(x, y, 1), image.at(x, y, 2)},
+                                                                   .inverse_depth_per_mm = last_w,
+                                                                   .coc_px = last_coc};
       clamped += last_clamps;
-      coc_min = std::min(coc_min, s.coc_px);
-      coc_max = std::max(coc_max, s.coc_px);
+      coc_min = std::min(coc_min, last_coc);
+      coc_max = std::max(coc_max, last_coc);
     }
   }
   stats.source_pixels = sources.size();
