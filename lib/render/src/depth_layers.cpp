@@ -71,7 +71,7 @@ DepthLayers make_depth_layers(const ScatterSources& sources, int width, int heig
   const auto layer_count = static_cast<std::size_t>(l.count);
   // (The frame-sized arrays' fresh pages faulted in by the threads first: first_touch.h.)
   const int teams = std::max(1, threads);
-  LargeVector<std::uint16_t> layer_of;
+  UnconstructedVector<std::uint16_t> layer_of;  // (its arrays are written whole by the threads below)
   fault_in(layer_of, sources.size(), teams);
   layer_of.resize(sources.size());
   // The layers' members are placed at their final positions (grown by doubling, the lists were

@@ -25,12 +25,12 @@ struct PixelPart {
 // The layers (LayerSpacing: layer 0 is the farthest, count - 1 the nearest) and their sources.
 struct DepthLayers : LayerSpacing {
   // Per pixel (row-major) its parts: parts[part_begin[p] .. part_begin[p + 1]).
-  LargeVector<std::uint32_t> part_begin;
-  LargeVector<PixelPart> parts;
+  UnconstructedVector<std::uint32_t> part_begin;
+  UnconstructedVector<PixelPart> parts;
   // Per layer its sources' indices, in source order: member_store[member_begin[l] .. member_begin[l + 1]).
   // One block for all layers: a block per layer came from the heap in 4 KiB pages, which cost the
   // street scene's process about 3 ms of faults on one thread (docs/performance.md).
-  LargeVector<int> member_store;
+  UnconstructedVector<int> member_store;
   std::vector<std::size_t> member_begin;
   std::span<const int> members(int l) const {
     const auto u = static_cast<std::size_t>(l);

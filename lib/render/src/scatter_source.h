@@ -7,7 +7,6 @@
 #include <array>
 #include <cstddef>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "lensmith/camera/aperture.h"
@@ -37,26 +36,11 @@ struct ScatterSource {
   double coc_px = 0.0;              // signed blur diameter at the reference wavelength (Camera::signed_coc_px)
 };
 
-// HugePageAllocator, except that an element made without a value (a vector's resize(n)) is not
-// constructed: every place that grows ScatterSources by resize writes each new source whole on the
-// threads (make_scatter_sources, split_mixed_pixels' far parts, append_hidden_sources). A resize
-// that constructed them wrote the frame's 13 MB on one thread first (ScatterSource is an aggregate,
-// an implicit-lifetime type, whose objects its storage holds before they are written).
-template <class T>
-struct WrittenAfterResize : HugePageAllocator<T> {
-  WrittenAfterResize() noexcept = default;
-  template <class U>
-  WrittenAfterResize(const WrittenAfterResize<U>& /*other*/) noexcept {}
-  template <class U>
-  void construct(U* /*p*/) noexcept {}
-  template <class U, class... Args>
-  void construct(U* p, Args&&... args) {
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-  }
-};
-
-// A frame's worth of sources (huge pages: docs/performance.md).
-using ScatterSources = std::vector<ScatterSource, WrittenAfterResize<ScatterSource>>;
+// A frame's worth of sources (huge pages: docs/performance.md). Unconstructed by resize: every place
+// that grows it so writes each new source whole on the threads (make_scatter_sources,
+// split_mixed_pixels' far parts, append_hidden_sources); a resize that constructed them wrote the
+// frame's 13 MB on one thread first.
+using ScatterSources = UnconstructedVector<ScatterSource>;
 
 // Where a source's light leaves from, output px (pixel (i, j) covers [i, i+1] x [j, j+1]).
 inline PixelPoint source_centre(const ScatterSource& s) {

@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdlib>
 #include <new>
+#include <utility>
 #include <vector>
 
 #if defined(__linux__)
@@ -72,5 +73,28 @@ struct HugePageAllocator {
 // A std::vector for frame-sized data (HugePageAllocator).
 template <class T>
 using LargeVector = std::vector<T, HugePageAllocator<T>>;
+
+// HugePageAllocator, except that an element made without a value (a vector's resize(n) or count
+// constructor) is not constructed: for frame-sized arrays whose every element the threads write
+// before anything reads it. A constructing resize writes the whole array on one thread first (the
+// renderer's 13 MB of sources of a 600 x 400 frame, docs/performance.md). T must be an
+// implicit-lifetime type (a scalar, or an aggregate of them such as the renderer's sources), whose
+// objects its storage holds before they are written.
+template <class T>
+struct UnconstructedAllocator : HugePageAllocator<T> {
+  UnconstructedAllocator() noexcept = default;
+  template <class U>
+  UnconstructedAllocator(const UnconstructedAllocator<U>& /*other*/) noexcept {}
+  template <class U>
+  void construct(U* /*p*/) noexcept {}
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
+// A LargeVector whose resize(n) leaves the new elements to be written (UnconstructedAllocator).
+template <class T>
+using UnconstructedVector = std::vector<T, UnconstructedAllocator<T>>;
 
 }  // namespace lensmith
