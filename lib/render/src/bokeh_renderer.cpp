@@ -113,9 +113,12 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
 
   const bool stretch = options.hidden == HiddenSurfaces::Stretch;
   const std::size_t pixel_count = static_cast<std::size_t>(w) * static_cast<std::size_t>(h), frame_floats = pixel_count * 4;
-  LargeVector<float> result;
+  // Premultiplied RGB + coverage, zeroed by the threads (a resize to zeros wrote it on one).
+  UnconstructedVector<float> result;
   fault_in(result, frame_floats, threads);
-  result.resize(frame_floats, 0.0f);  // premultiplied RGB + coverage
+  result.resize(frame_floats);
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (int y = 0; y < h; ++y) std::fill_n(result.data() + static_cast<std::size_t>(y) * w * 4, static_cast<std::size_t>(w) * 4, 0.0f);
   const int bands = std::max(1, std::min(h, threads * (model.affine_in_pupil() ? kBandsPerThreadAffine : kBandsPerThreadMapped)));
   std::size_t done = 0;
   std::atomic<std::size_t> footprints{0}, triangles{0}, reused{0};

@@ -53,7 +53,7 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
   // dilation, rows then columns, each line independent (threads).
   const int far = std::numeric_limits<int>::max() / 4;
   auto frame_index = [w, bx0, by0](int bx, int by) { return static_cast<std::size_t>(by0 + by) * w + static_cast<std::size_t>(bx0 + bx); };
-  LargeVector<int>& row_distance = scratch.row_distance;
+  UnconstructedVector<int>& row_distance = scratch.row_distance;
   row_distance.resize(static_cast<std::size_t>(bw) * bh);  // every entry is written below
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (int y = 0; y < bh; ++y) {
@@ -64,7 +64,7 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
     last = far;
     for (int x = bw - 1; x >= 0; --x) d[x] = std::min(d[x], layers.in(row + x, layer) ? (last = 0) : (last = std::min(far, last + 1)));
   }
-  LargeVector<std::uint8_t>& within = scratch.within;
+  UnconstructedVector<std::uint8_t>& within = scratch.within;
   within.resize(static_cast<std::size_t>(bw) * bh);  // every entry is written below
   // Columns down and up, each thread a block of them walked row by row with one running distance
   // per column: walked column by column, every step jumped a row.

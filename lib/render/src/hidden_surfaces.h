@@ -26,8 +26,8 @@ namespace lensmith::render_detail {
 // Frame-sized working memory of append_hidden_sources, kept from layer to layer: fresh memory is faulted
 // in page by page, which cost more than the work itself (docs/performance.md).
 struct HiddenScratch {
-  LargeVector<int> row_distance;
-  LargeVector<std::uint8_t> within;
+  UnconstructedVector<int> row_distance;  // (written whole for each layer)
+  UnconstructedVector<std::uint8_t> within;
   std::vector<std::size_t> targets;
   std::vector<std::size_t> target_cells;  // the targets' cells in the push-pull's window
   std::vector<std::vector<std::size_t>> block_targets;  // each thread's block of rows' targets, before they join `targets`

@@ -23,7 +23,7 @@ constexpr double kHalfCovered = 0.5;
 constexpr double kGapTolerance = 1e-9;
 }  // namespace
 
-void composite_layer_over(const float* layer_rows, const float* hole_rows, LargeVector<float>& result, int width, int row_begin,
+void composite_layer_over(const float* layer_rows, const float* hole_rows, UnconstructedVector<float>& result, int width, int row_begin,
                           int row_end) {
   const std::size_t first = static_cast<std::size_t>(row_begin) * static_cast<std::size_t>(width);
   const std::size_t count = static_cast<std::size_t>(row_end - row_begin) * static_cast<std::size_t>(width);
@@ -49,7 +49,7 @@ void composite_layer_over(const float* layer_rows, const float* hole_rows, Large
   }
 }
 
-bool has_gaps(const LargeVector<float>& result, int threads) {
+bool has_gaps(const UnconstructedVector<float>& result, int threads) {
   const auto pixels = static_cast<std::ptrdiff_t>(result.size() / 4);
   bool gap = false;
 #pragma omp parallel for num_threads(threads) schedule(static) reduction(|| : gap)
@@ -57,7 +57,7 @@ bool has_gaps(const LargeVector<float>& result, int threads) {
   return gap;
 }
 
-Image finish_composite(const LargeVector<float>& result, int width, int height, int threads, bool gaps,
+Image finish_composite(const UnconstructedVector<float>& result, int width, int height, int threads, bool gaps,
                        LargeVector<PushPullCell<5>>& fill, PushPullScratch<5>& scratch, const ImageCircle& circle) {
   const std::size_t count = static_cast<std::size_t>(width) * height;
   // Gaps beyond the lens's image circle stay dark: nothing the lens images lands there.

@@ -24,18 +24,18 @@ namespace lensmith::render_detail {
 // [row_begin, row_end) over result. `layer_rows`: those rows of the layer alone (w x (row_end - row_begin)
 // x 4 floats, premultiplied RGB + coverage). `hole_rows` (HiddenSurfaces::Stretch, else null): the
 // same rows' coverage of the layer's hidden sources in channel 3; the layer's colour is renormalised over it.
-void composite_layer_over(const float* layer_rows, const float* hole_rows, LargeVector<float>& result, int width, int row_begin,
+void composite_layer_over(const float* layer_rows, const float* hole_rows, UnconstructedVector<float>& result, int width, int row_begin,
                           int row_end);
 
 // Whether some pixel of the result is covered less than half (then the image circle is measured),
 // on `threads` threads.
-bool has_gaps(const LargeVector<float>& result, int threads);
+bool has_gaps(const UnconstructedVector<float>& result, int threads);
 
 // The output picture: the result with its uncovered remainder filled, on `threads` threads, except
 // beyond the lens's image circle, where the uncovered part stays dark and the covered part's light
 // is not spread over the pixel; `gaps`: has_gaps(result); `fill` and `scratch` are working memory
 // kept by the caller (their contents are overwritten).
-Image finish_composite(const LargeVector<float>& result, int width, int height, int threads, bool gaps,
+Image finish_composite(const UnconstructedVector<float>& result, int width, int height, int threads, bool gaps,
                        LargeVector<PushPullCell<5>>& fill, PushPullScratch<5>& scratch, const ImageCircle& circle);
 
 }  // namespace lensmith::render_detail
