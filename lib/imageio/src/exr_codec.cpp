@@ -22,7 +22,13 @@
 #include <OpenEXR/ImfThreading.h>
 #include <OpenEXR/ImfVecAttribute.h>
 #include <OpenEXR/openexr.h>
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <sys/uio.h>
+#include <unistd.h>
+#include <climits>
+#include <cerrno>
+#include <cstring>
 #include <zlib.h>
 
 #include <algorithm>
@@ -727,6 +733,100 @@ bool deflate_pays(const std::uint8_t* raw, std::size_t n, std::vector<std::uint8
   return static_cast<double>(size) < kZipWorthRatio * static_cast<double>(sample.size());
 }
 
+// The bytes of a file OpenEXRCore writes (its write_fn), gathered and written to the file by one
+// pwritev at the end: the library writes each block's leader and data apart, and the kernel
+// takes one write of the whole file faster than its 50 pieces (a 2.9 MB file on this guest's ext4:
+// 0.87-1.09 ms in 50 writes, 0.46-0.60 ms in one, best of 15). `blocks` (the packed blocks, alive
+// until the flush) are referred to; anything else the library passes (the header, the leaders, the
+// chunk table) is its own buffer and copied.
+class GatheredExrFile {
+ public:
+  explicit GatheredExrFile(const std::vector<std::vector<std::uint8_t>>& blocks) : blocks_(blocks) {}
+
+  static int64_t write(exr_const_context_t /*context*/, void* self, const void* buffer, uint64_t size, uint64_t offset,
+                       exr_stream_error_func_ptr_t /*error*/) {
+    return static_cast<GatheredExrFile*>(self)->add(static_cast<const std::uint8_t*>(buffer), size, offset);
+  }
+
+  // Creates `file` and writes the gathered bytes: in one pwritev (IOV_MAX pieces a call) where they
+  // follow one another from offset 0 without a gap or an overlap, else each piece at its offset in
+  // the order written. Throws IoError naming `path`.
+  void flush(const std::string& file, const fs::path& path) const {
+    const auto fail = [&](const std::string& what) {
+      throw IoError(path.string() + ": cannot write the OpenEXR image (" + what + "): " + std::strerror(errno));
+    };
+    const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (fd < 0) fail("creating it");
+    const std::unique_ptr<int, void (*)(int*)> closer(new int(fd), [](int* f) {
+      if (*f >= 0) ::close(*f);
+      delete f;
+    });
+    std::vector<Piece> order = pieces_;
+    std::stable_sort(order.begin(), order.end(), [](const Piece& a, const Piece& b) { return a.offset < b.offset; });
+    bool contiguous = true;
+    std::uint64_t end = 0;
+    for (const Piece& p : order) {
+      contiguous = contiguous && p.offset == end;
+      end = p.offset + p.size;
+    }
+    std::size_t first = 0;  // the first piece (of `order`) not yet written whole
+    if (contiguous) {
+      std::vector<iovec> iov;
+      std::uint64_t at = 0;
+      while (first < order.size()) {
+        iov.clear();
+        std::uint64_t bytes = 0;
+        for (std::size_t k = first; k < order.size() && iov.size() < static_cast<std::size_t>(IOV_MAX); ++k) {
+          iov.push_back({const_cast<std::uint8_t*>(order[k].data), order[k].size});
+          bytes += order[k].size;
+        }
+        const ssize_t done = ::pwritev(fd, iov.data(), static_cast<int>(iov.size()), static_cast<off_t>(at));
+        if (done < 0) fail("writing it");
+        // Whole pieces written; a piece cut short is written again below, with the rest.
+        std::uint64_t left = static_cast<std::uint64_t>(done);
+        while (first < order.size() && left >= order[first].size) {
+          left -= order[first].size;
+          at += order[first].size;
+          ++first;
+        }
+        if (static_cast<std::uint64_t>(done) < bytes) break;
+      }
+    }
+    for (std::size_t k = contiguous ? first : 0; k < order.size(); ++k) {
+      const Piece& p = contiguous ? order[k] : pieces_[k];
+      for (std::size_t done = 0; done < p.size;) {
+        const ssize_t n = ::pwrite(fd, p.data + done, p.size - done, static_cast<off_t>(p.offset + done));
+        if (n <= 0) fail("writing it");
+        done += static_cast<std::size_t>(n);
+      }
+    }
+    const int f = fd;
+    *closer.get() = -1;
+    if (::close(f) != 0) fail("closing it");
+  }
+
+ private:
+  struct Piece {
+    std::uint64_t offset;
+    const std::uint8_t* data;
+    std::size_t size;
+  };
+
+  int64_t add(const std::uint8_t* bytes, uint64_t size, uint64_t offset) {
+    const bool block = std::any_of(blocks_.begin(), blocks_.end(), [&](const std::vector<std::uint8_t>& b) { return b.data() == bytes; });
+    if (!block) {
+      copies_.emplace_back(bytes, bytes + size);  // (each copy's bytes stay where they are as the list grows)
+      bytes = copies_.back().data();
+    }
+    pieces_.push_back({offset, bytes, static_cast<std::size_t>(size)});
+    return static_cast<int64_t>(size);
+  }
+
+  const std::vector<std::vector<std::uint8_t>>& blocks_;
+  std::vector<std::vector<std::uint8_t>> copies_;
+  std::vector<Piece> pieces_;
+};
+
 }  // namespace
 
 // Written with OpenEXR's C library (3.1's "core"): the blocks of 16 scanlines are packed, filtered and
@@ -748,9 +848,13 @@ void write_exr_file(const fs::path& path, const std::string& file, const PixelsV
     throw IoError(path.string() + ": cannot write the OpenEXR image (" + what + "): " + detail);
   };
   core_error.clear();
+  std::vector<std::vector<std::uint8_t>> packed;  // the blocks as stored, made below
+  GatheredExrFile gathered(packed);
   exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
   init.error_handler_fn = note_core_error;
   init.zip_level = kZipLevel;
+  init.user_data = &gathered;
+  init.write_fn = &GatheredExrFile::write;
   CoreWriteContext out;
   if (const exr_result_t rc = exr_start_write(&out.context, file.c_str(), EXR_WRITE_FILE_DIRECTLY, &init); rc != EXR_ERR_SUCCESS) {
     out.context = nullptr;
@@ -825,7 +929,7 @@ void write_exr_file(const fs::path& path, const std::string& file, const PixelsV
   if (const exr_result_t rc = exr_get_scanlines_per_chunk(ctx, part, &lines_per_block); rc != EXR_ERR_SUCCESS) fail(rc, "its blocks");
   const auto width = static_cast<std::size_t>(pixels.width), stride = static_cast<std::size_t>(pixels.channels);
   const int blocks = (pixels.height + lines_per_block - 1) / lines_per_block;
-  std::vector<std::vector<std::uint8_t>> packed(static_cast<std::size_t>(blocks));
+  packed.resize(static_cast<std::size_t>(blocks));
   bool deflated = true;
 #pragma omp parallel num_threads(std::max(1, codec_thread_count()))
   {
@@ -871,6 +975,7 @@ void write_exr_file(const fs::path& path, const std::string& file, const PixelsV
   const exr_result_t rc = exr_finish(&out.context);
   out.context = nullptr;
   if (rc != EXR_ERR_SUCCESS) fail(rc, "closing it");
+  gathered.flush(file, path);
 }
 
 void begin_exr_memo() { ++exr_memo_depth; }
