@@ -23,7 +23,7 @@ namespace lensmith {
 // 512 KiB faulted in as 128 small pages costs about 1.5 ms on that guest, as one huge page 0.1 ms.
 // But a huge page is zeroed whole when first touched, so a block of 1 MiB rounded up to one wasted
 // half of it: smaller blocks are left to operator new, which in the command line comes from a heap
-// whose first 32 MiB are huge pages already (cli/huge_page_new.cpp), packed without rounding. From
+// whose first 64 MiB are huge pages already (cli/huge_page_new.cpp), packed without rounding. From
 // 512 KiB, the street scene's thin-lens process touched 115 MB and from 2 MiB 95 MB: 138.0 -> 131.7 ms
 // at f/1.4 and 107.6 -> 101.0 ms at f/16 (docs/performance.md). Elsewhere (the Python module)
 // blocks under 2 MiB are faulted in 4 KiB at a time, as std::allocator's are.
