@@ -34,8 +34,31 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
   int bx0 = w, bx1 = -1, by0 = h, by1 = -1;
   const std::span<const int> members = layers.members(layer);
   const auto member_count = static_cast<std::ptrdiff_t>(members.size());
+  // Where the first w x h sources are the frame's pixels in raster order (a flat picture's), a member
+  // below w x h is the pixel of its index: its rows are those of the first and last such member (the
+  // members are in source order), and its columns are found without reading the sources, walked by
+  // rows, until they span the frame. (Reading every member's source, 56 bytes each, took the fence's
+  // wall at 6 m 0.3 ms.) The members after them (split pixels' far parts, the margin) are read.
+  const std::ptrdiff_t pixel_members =
+      layers.pixels_first ? std::lower_bound(members.begin(), members.end(), w * h) - members.begin() : 0;
+  if (pixel_members > 0) {
+    by0 = members.front() / w;
+    by1 = members[static_cast<std::size_t>(pixel_members) - 1] / w;
+#pragma omp parallel num_threads(threads) reduction(min : bx0) reduction(max : bx1)
+    {
+      const std::ptrdiff_t t = omp_get_thread_num(), n = omp_get_num_threads();
+      const std::ptrdiff_t first = pixel_members * t / n, last = pixel_members * (t + 1) / n;
+      int row_start = first < last ? members[static_cast<std::size_t>(first)] / w * w : 0;
+      for (std::ptrdiff_t k = first; k < last && !(bx0 == 0 && bx1 == w - 1); ++k) {
+        const int i = members[static_cast<std::size_t>(k)];
+        while (i >= row_start + w) row_start += w;
+        bx0 = std::min(bx0, i - row_start);
+        bx1 = std::max(bx1, i - row_start);
+      }
+    }
+  }
 #pragma omp parallel for num_threads(threads) schedule(static) reduction(min : bx0, by0) reduction(max : bx1, by1)
-  for (std::ptrdiff_t k = 0; k < member_count; ++k) {
+  for (std::ptrdiff_t k = pixel_members; k < member_count; ++k) {
     const ScatterSource& p = sources[static_cast<std::size_t>(members[static_cast<std::size_t>(k)])];
     if (p.x < 0 || p.y < 0 || p.x >= w || p.y >= h) continue;  // the scatter's margin
     bx0 = std::min(bx0, p.x);
