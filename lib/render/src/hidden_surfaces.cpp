@@ -85,7 +85,8 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
     int last = far;
     for (int x = 0; x < bw; ++x) d[x] = layers.in(row + x, layer) ? (last = 0) : (last = std::min(far, last + 1));
     last = far;
-    for (int x = bw - 1; x >= 0; --x) d[x] = std::min(d[x], layers.in(row + x, layer) ? (last = 0) : (last = std::min(far, last + 1)));
+    // (A pixel of the layer is one the forward pass gave 0: its parts are not walked again.)
+    for (int x = bw - 1; x >= 0; --x) d[x] = std::min(d[x], d[x] == 0 ? (last = 0) : (last = std::min(far, last + 1)));
   }
   UnconstructedVector<std::uint8_t>& within = scratch.within;
   within.resize(static_cast<std::size_t>(bw) * bh);  // every entry is written below
