@@ -755,12 +755,15 @@ class GatheredExrFile {
     const auto fail = [&](const std::string& what) {
       throw IoError(path.string() + ": cannot write the OpenEXR image (" + what + "): " + std::strerror(errno));
     };
-    const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    // The descriptor, closed on the way out where the end below does not close it.
+    struct Descriptor {
+      int fd;
+      ~Descriptor() {
+        if (fd >= 0) ::close(fd);
+      }
+    } out{::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666)};
+    const int fd = out.fd;
     if (fd < 0) fail("creating it");
-    const std::unique_ptr<int, void (*)(int*)> closer(new int(fd), [](int* f) {
-      if (*f >= 0) ::close(*f);
-      delete f;
-    });
     std::vector<Piece> order = pieces_;
     std::stable_sort(order.begin(), order.end(), [](const Piece& a, const Piece& b) { return a.offset < b.offset; });
     bool contiguous = true;
@@ -800,9 +803,8 @@ class GatheredExrFile {
         done += static_cast<std::size_t>(n);
       }
     }
-    const int f = fd;
-    *closer.get() = -1;
-    if (::close(f) != 0) fail("closing it");
+    out.fd = -1;
+    if (::close(fd) != 0) fail("closing it");
   }
 
  private:
