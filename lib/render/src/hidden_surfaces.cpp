@@ -188,14 +188,14 @@ std::size_t append_hidden_sources(const ScatterSources& sources, const DepthLaye
     std::ptrdiff_t k = target_first;
     std::size_t last_pixel = 0;
     // Members are in source order. Where the first w x h sources are the pixels in raster order (a
-    // flat picture's), the thread's rows of them are found by bisection and the rest skipped, then
-    // the parts appended after them are looked at; else every member.
+    // flat picture's), the thread's rows of them are found by bisection among the pixel members and
+    // the rest skipped, then the parts appended after them are looked at; else every member.
     auto rows_begin = members.begin(), rows_end = members.end(), appended = members.end();
     if (layers.pixels_first) {
+      appended = members.begin() + pixel_members;
       const auto below = [](int i, std::size_t v) { return static_cast<std::size_t>(i) < v; };
-      rows_begin = std::lower_bound(members.begin(), members.end(), static_cast<std::size_t>(ya) * static_cast<std::size_t>(w), below);
-      rows_end = std::lower_bound(rows_begin, members.end(), static_cast<std::size_t>(yb) * static_cast<std::size_t>(w), below);
-      appended = std::lower_bound(rows_end, members.end(), static_cast<std::size_t>(w) * static_cast<std::size_t>(h), below);
+      rows_begin = std::lower_bound(members.begin(), appended, static_cast<std::size_t>(ya) * static_cast<std::size_t>(w), below);
+      rows_end = std::lower_bound(rows_begin, appended, static_cast<std::size_t>(yb) * static_cast<std::size_t>(w), below);
     }
     for (auto it = rows_begin; it != members.end(); ++it) {
       if (it == rows_end) {
