@@ -19,6 +19,7 @@
 #include "lensmith/color/rgb_primaries.h"
 #include "lensmith/core/errors.h"
 #include "lensmith/core/number_parsing.h"
+#include "lensmith/core/stage_times.h"
 #include "lensmith/core/units.h"
 #include "lensmith/imageio/deep_raster.h"
 #include "lensmith/imageio/frame_sequence.h"
@@ -244,8 +245,11 @@ std::string write_bokeh_output(Image out, OutputMetadata& meta, const BokehComma
 
 int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   const auto started = std::chrono::steady_clock::now();
+  // Each stage's wall time, for --timings (the scatter method's).
+  StageTimes timings;
   // The threads the reading, the render and the writing share, started first (openmp_team.h).
   start_openmp_team(o.threads > 0 ? o.threads : omp_get_max_threads());
+  timings.lap("starting threads");
   const bool multiview = o.method == "multiview", lightfield = o.method == "lightfield", ewa = o.method == "ewa", gather = o.method == "gather";
   if (o.method != "scatter" && !o.scatter_options.empty()) {
     throw UsageError(o.scatter_options.front() + " is an option of --method scatter, not of --method " + o.method);
@@ -326,6 +330,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     width = flat->width;
     height = flat->height;
   }
+  timings.lap("reading the picture");
   // A transparent element (a CG layer over nothing) keeps its alpha: defocused with the same rays as
   // its (premultiplied) colour, into an RGBA OpenEXR.
   std::optional<std::vector<float>> alpha = layered ? std::nullopt : read_alpha(o.image);
@@ -531,6 +536,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
     depth.height = height;
   }
   read_cache.reset();
+  timings.lap("reading alpha, passes, metadata and depth");
   if (!o.focus_pixel.empty()) {
     // X,Y: integers inside the image.
     const std::size_t comma = o.focus_pixel.find(',');
@@ -775,6 +781,7 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   options.progress = [&bar](double f) { bar.update(f); };
   BokehStatistics stats;
   const auto render_started = std::chrono::steady_clock::now();
+  timings.lap("lens and model");
   Image out = layered ? render_bokeh(*deep, *model, aperture, options, &stats) : render_bokeh(*flat, depth, *model, aperture, options, &stats);
   const bool layered_alpha = layered && deep->max_transparency() > 1e-4;
   if (layered_alpha) note_uncovered_without_alpha(o, global);
@@ -806,6 +813,11 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   }
   const double render_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - render_started).count();
   bar.finish();
+  for (const StageTimes::Stage& stage : stats.stages.stages()) timings.add(stage.name, stage.ms);
+  // The render's checks before its first stage, and the alpha and other channels defocused after it.
+  const double rest_ms = 1000.0 * render_seconds - stats.stages.total_ms();
+  if (rest_ms > 0.05) timings.add("checks, alpha and other channels", rest_ms);
+  timings.restart();
 
   OutputMetadata meta = output_metadata(o, lens_name, kind, *cam, camera.focus_distance_m, aperture, windows);
   meta.extra.insert(meta.extra.end(), {{"hidden_surfaces", std::string(to_string(options.hidden))}, {"edge_pixels", o.edge_pixels}});
@@ -813,6 +825,8 @@ int run_bokeh(const BokehCommandOptions& o, const GlobalOptions& global) {
   // Moved, not copied: the picture and depth are frame-sized (copying them cost the street scene's
   // process 4 MB of fresh memory).
   const std::string written = write_bokeh_output(std::move(out), meta, o, std::move(depth), std::move(other), color, extras);
+  timings.lap("writing");
+  if (o.timings) std::cerr << "timings: " << timings << "\n";
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   std::ostringstream what;
   what << output.string() << " (" << written << ") in " << std::fixed << std::setprecision(2) << seconds

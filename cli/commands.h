@@ -217,6 +217,7 @@ struct BokehCommandOptions {
   bool no_shape_reuse = false;               // --no-shape-reuse (BokehOptions::reuse_shapes)
   bool rays_per_pixel = false;               // --rays-per-pixel (BokehOptions::interpolated_rays)
   bool mesh_footprints = false;              // --mesh-footprints (BokehOptions::light_images)
+  bool timings = false;                      // --timings: each stage's wall time on stderr (BokehStatistics::stages)
   int spectral_samples = 16;                 // --spectral-samples
   double highlight_gain = 1.0;               // --highlight-gain (8-bit inputs)
   double highlight_threshold = 0.98;         // --highlight-threshold

@@ -494,6 +494,8 @@ int main(int argc, char** argv) {
   bokeh_scatter_only.push_back(bokeh_cmd->add_flag("--mesh-footprints", bokeh.mesh_footprints,
                       "exact, poly: deposit every footprint's mesh triangles (about ten times slower, for checking). By default "
                       "each footprint is drawn from a light image of its table node, turned to its azimuth"));
+  bokeh_scatter_only.push_back(bokeh_cmd->add_flag("--timings", bokeh.timings,
+                      "Print the wall time of each stage (reading, the render's stages, writing) to stderr, also with --quiet"));
   bokeh_cmd->add_flag("--no-spectral", bokeh.no_spectral, "Trace every ray at 587.6 nm and keep RGB as it is (no colour fringes)");
   bokeh_cmd->add_option("--spectral-samples", bokeh.spectral_samples, "Wavelengths of the spectral quadrature (3-64, default 16)")
       ->check(range(3, 64));

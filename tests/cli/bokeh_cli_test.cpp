@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -78,6 +79,36 @@ TEST_CASE("lensmith bokeh renders the bundled scene to an EXR that says how it w
                               png.string() + " --quiet");
   CHECK(p.exit_code == 0);
   CHECK(fs::file_size(png) > 1000);
+}
+
+TEST_CASE("lensmith bokeh --timings says where its time went, also with --quiet, within the process's own wall time", "[cli][bokeh]") {
+  const fs::path out = scratch("timed.exr");
+  const auto started = std::chrono::steady_clock::now();
+  const auto r = run_lensmith("bokeh --image " + kScene + " --thin-lens --focal-length 50 --fstop 2 --focus 1.2 -o " + out.string() +
+                              " --quiet --timings");
+  const double wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  REQUIRE(r.err.rfind("timings: ", 0) == 0);
+  // The command's own stages and the renderer's, in the order they ran.
+  std::size_t at = 0;
+  for (const char* stage : {"reading the picture", "sources", "edge split", "layering", "hidden surfaces", "deposit", "finishing", "writing"}) {
+    INFO(stage);
+    const std::size_t found = r.err.find(std::string(stage) + " ", at);
+    REQUIRE(found != std::string::npos);
+    at = found;
+  }
+  // The stages' sum is measured inside the process: it cannot exceed the test's clock around it.
+  const std::size_t total = r.err.find("total ");
+  REQUIRE(total != std::string::npos);
+  const double total_ms = std::stod(r.err.substr(total + 6));
+  CHECK(total_ms > 0.0);
+  CHECK(total_ms < wall_ms);
+  // A scatter-only option.
+  const auto gather = run_lensmith("bokeh --image " + kScene + " --thin-lens --focal-length 50 --fstop 2 --focus 1.2 -o " + out.string() +
+                                   " --method gather --timings");
+  CHECK(gather.exit_code == 2);
+  CHECK(gather.err.find("--timings is an option of --method scatter") != std::string::npos);
 }
 
 TEST_CASE("lensmith bokeh refuses to overwrite its input and leaves it as it was", "[cli][bokeh]") {

@@ -119,6 +119,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   result.resize(frame_floats);
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (int y = 0; y < h; ++y) std::fill_n(result.data() + static_cast<std::size_t>(y) * w * 4, static_cast<std::size_t>(w) * 4, 0.0f);
+  stats.stages.lap("set-up");
   const int bands = std::max(1, std::min(h, threads * (model.affine_in_pupil() ? kBandsPerThreadAffine : kBandsPerThreadMapped)));
   std::size_t done = 0;
   std::atomic<std::size_t> footprints{0}, triangles{0}, reused{0};
@@ -168,6 +169,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
         r[3] = s.coverage;
       }
     }
+    stats.stages.lap("layer copies");
     const double hidden_blur = layers.max_blur_px[u] + layers.nearer_blur_px[u];
     // (A layer whose pixels are all copied still has hidden sources: behind a blurred highlight in
     // front of a sharp wall, the wall shows through the highlight's disc.)
@@ -176,10 +178,12 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
       stats.hidden_sources += render_detail::append_hidden_sources(sources, layers, l, w, h, reach, options.hidden, camera,
                                                                    threads, hidden_scratch, layer);
     }
+    stats.stages.lap("hidden surfaces");
     if (layer.empty()) continue;
     ++stats.layers;
     // Level of detail: sources whose footprints go to a coarse grid, merged by its cells.
     render_detail::merge_coarse_sources(layer, w, h, merge_scratch, margin);
+    stats.stages.lap("merging");
 
     const std::span<FootprintPlan> plans = plan_store.first(layer.size(), threads);
     const std::span<std::array<float, 2>> plan_rows = plan_row_store.first(layer.size(), threads);
@@ -201,6 +205,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
         range_rows[r] = rows;
       }
     }
+    stats.stages.lap("planning");
 
     std::atomic<int> bands_done{0};
     // Each band of rows scatters the footprints that reach it, then composites its rows of this
@@ -288,6 +293,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
     for (FootprintScratch& scratch : scratches) scratch.forget_light_images();
     done += layers.members(l).size();
     if (options.progress) options.progress(static_cast<double>(done) / static_cast<double>(sources.size()));
+    stats.stages.lap("deposit");
   }
   stats.footprints = footprints;
   stats.triangles = triangles;
@@ -298,7 +304,9 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   // The lens's image circle, where some pixel is left uncovered (a fisheye's frame corners).
   const bool gaps = render_detail::has_gaps(result, threads);
   const render_detail::ImageCircle circle = gaps ? render_detail::ImageCircle(camera, threads) : render_detail::ImageCircle();
-  return render_detail::finish_composite(result, w, h, threads, gaps, fill_cells, hidden_scratch.push_pull, circle);
+  Image out = render_detail::finish_composite(result, w, h, threads, gaps, fill_cells, hidden_scratch.push_pull, circle);
+  stats.stages.lap("finishing");
+  return out;
 }
 
 // Sources beyond a w x h frame over `margin` px each side, copies of the nearest edge pixel's parts
@@ -452,18 +460,23 @@ Image render_bokeh(const Image& image, const DepthMap& depth, const RayModel& mo
   }
   BokehStatistics local;
   BokehStatistics& stats = statistics ? *statistics : local;
+  stats.stages.restart();
   const Camera& camera = model.camera();
   const int w = image.width, h = image.height, threads = thread_count(options);
   ScatterSources sources = render_detail::make_scatter_sources(image, depth, camera, options, threads, stats);
+  stats.stages.lap("sources");
   if (options.split_edge_pixels) render_detail::split_mixed_pixels(sources, w, h, camera, threads, stats);
+  stats.stages.lap("edge split");
   const int margin = render_detail::frame_margin_px(model, 0.5 * stats.max_abs_coc_px);
   stats.edge_gap_px = render_detail::frame_edge_gap_px(model);
   const render_detail::LayerSpacing spacing = render_detail::layer_spacing_of(sources, options.layer_spacing_px, options.max_layers, threads);
   if (render_detail::copies_sharp_pixels(model, aperture, options)) {
     stats.copied_pixels = render_detail::mark_sharp_pixels(sources, w, h, spacing, threads);
   }
+  stats.stages.lap("sharp pixels");
   add_margin_sources(sources, w, h, margin, true);
   const DepthLayers layers = render_detail::make_depth_layers(sources, w, h, spacing, threads, true);
+  stats.stages.lap("layering");
   return render_sources(sources, layers, w, h, margin, model, aperture, options, stats);
 }
 
@@ -477,16 +490,19 @@ Image render_bokeh(const DeepImage& deep, const RayModel& model, const Aperture&
   }
   BokehStatistics local;
   BokehStatistics& stats = statistics ? *statistics : local;
+  stats.stages.restart();
   // Edge pixels need no split: a layered input has each surface of a pixel as its own sample.
   render_detail::DeepSources deep_sources = render_detail::make_deep_sources(deep, model.camera(), options, stats);
   stats.deep_samples = deep_sources.samples;
   stats.volume_slabs = deep_sources.volume_slabs;
+  stats.stages.lap("sources");
   const int margin = render_detail::frame_margin_px(model, 0.5 * stats.max_abs_coc_px);
   ScatterSources sources = std::move(deep_sources.sources);
   stats.edge_gap_px = render_detail::frame_edge_gap_px(model);
   add_margin_sources(sources, deep.width, deep.height, margin, false);
   const DepthLayers layers =
       render_detail::make_depth_layers(sources, deep.width, deep.height, deep_sources.spacing, thread_count(options), false);
+  stats.stages.lap("layering");
   return render_sources(sources, layers, deep.width, deep.height, margin, model, aperture, options, stats);
 }
 

@@ -30,6 +30,7 @@
 
 #include "lensmith/camera/aperture.h"
 #include "lensmith/camera/ray_model.h"
+#include "lensmith/core/stage_times.h"
 #include "lensmith/render/image.h"
 #include "lensmith/render/splat_buffer.h"
 
@@ -103,6 +104,9 @@ struct BokehStatistics {
   // How far inside the output frame the input's edge lands (output px; a tilt, shift or distortion moves
   // it): the pixels outside it are copies of the input's edge. Render the input with overscan.
   double edge_gap_px = 0.0;
+  // Wall-clock time of each stage of the render (sources, edge split, layering, each layer's copy,
+  // hidden surfaces, planning and deposit summed over the layers, finishing): `--timings`.
+  StageTimes stages;
   std::string to_string() const;
   friend std::ostream& operator<<(std::ostream& os, const BokehStatistics& s) { return os << s.to_string(); }
 };
