@@ -16,6 +16,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <span>
 #include <sstream>
 #include <vector>
 
@@ -146,27 +147,48 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
   // Each thread's scratch space, kept from layer to layer (its caches of the table's nodes and light
   // images among it).
   std::vector<FootprintScratch> scratches(static_cast<std::size_t>(threads));
+  // Per thread of a layer's copy, where its run's scattered members start in the layer (entry t).
+  std::vector<std::size_t> run_scattered(static_cast<std::size_t>(threads) + 1, 0);
 
   for (int l = 0; l < layers.count; ++l) {
     const auto u = static_cast<std::size_t>(l);
     layer.clear();
     // (Room for the members it scatters: a sharp wall's copied pixels took 11 MB of fresh memory
     // on the fence focused at 6 m.)
-    fault_in(layer, layers.members(l).size() - layers.copied_members[u], threads);
+    const std::span<const int> members = layers.members(l);
+    const std::size_t scattered = members.size() - layers.copied_members[u];
+    fault_in(layer, scattered, threads);
+    layer.resize(scattered);  // (unconstructed: every element is written below)
     // Copied sharp pixels stay members: the hidden surfaces read them. Each is written to the result
     // as the scatter draws it: all its own light at its own centre, covering the pixel fully, over
     // what the farther layers left there; nothing of this layer reaches it (sharp_pixels.h), so the
     // layer's composite leaves it as it is, and the nearer layers are composited over it.
-    for (int i : layers.members(l)) {
-      const ScatterSource& s = sources[static_cast<std::size_t>(i)];
-      if (!s.copied) {
-        layer.push_back(s);
-      } else if (static_cast<std::size_t>(i) < pixel_count) {  // (a copied edge pixel's copies beyond the frame: nothing)
-        float* r = result.data() + 4 * static_cast<std::size_t>(i);
-        r[0] = s.rgb[0];
-        r[1] = s.rgb[1];
-        r[2] = s.rgb[2];
-        r[3] = s.coverage;
+    // On the threads, each a run of the members, its scattered ones at the place the runs before
+    // leave for them (on one thread this took the fence focused at 6 m 1.7-2.5 ms, most of it the
+    // sharp wall's copies).
+#pragma omp parallel num_threads(threads)
+    {
+      const auto t = static_cast<std::size_t>(omp_get_thread_num()), team = static_cast<std::size_t>(omp_get_num_threads());
+      const std::size_t begin = members.size() * t / team, end = members.size() * (t + 1) / team;
+      std::size_t own = 0;
+      for (std::size_t k = begin; k < end; ++k) own += sources[static_cast<std::size_t>(members[k])].copied ? 0 : 1;
+      run_scattered[t + 1] = own;
+#pragma omp barrier
+#pragma omp single
+      for (std::size_t k = 0; k < team; ++k) run_scattered[k + 1] += run_scattered[k];
+      std::size_t at = run_scattered[t];
+      for (std::size_t k = begin; k < end; ++k) {
+        const auto i = static_cast<std::size_t>(members[k]);
+        const ScatterSource& s = sources[i];
+        if (!s.copied) {
+          layer[at++] = s;
+        } else if (i < pixel_count) {  // (a copied edge pixel's copies beyond the frame: nothing)
+          float* r = result.data() + 4 * i;
+          r[0] = s.rgb[0];
+          r[1] = s.rgb[1];
+          r[2] = s.rgb[2];
+          r[3] = s.coverage;
+        }
       }
     }
     stats.stages.lap("layer copies");
