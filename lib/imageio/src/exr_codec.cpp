@@ -30,6 +30,9 @@
 #include <cerrno>
 #include <cstring>
 #include <zlib.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include <algorithm>
 #include <array>
@@ -466,6 +469,77 @@ RasterInfo info_from_header(const fs::path& path, const Imf::Header& header) {
   return info;
 }
 
+// zip_filter (below) undone: the n filtered bytes (which it overwrites) back to the raw bytes in `out`, as
+// OpenEXR's reader does (internal_zip.c: a running sum of the differences less 128, then the two
+// byte streams interleaved). The running sum sixteen bytes at a time (a prefix sum within a vector
+// in four shifted adds, plus the byte before): OpenEXR 3.1's loop, a byte at a time, was a third of
+// its decoding of a ZIP block beside the inflate itself (bench/blender's 600 x 400 pictures).
+void zip_unfilter(std::uint8_t* filtered, std::size_t n, std::uint8_t* out) {
+  if (n == 0) return;
+  std::size_t i = 1;
+#if defined(__SSE2__)
+  const __m128i bias = _mm_set1_epi8(static_cast<char>(-128));
+  __m128i carry = _mm_set1_epi8(static_cast<char>(filtered[0]));  // the byte before, in every lane
+  for (; i + 16 <= n; i += 16) {
+    __m128i v = _mm_add_epi8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(filtered + i)), bias);
+    v = _mm_add_epi8(v, _mm_slli_si128(v, 1));
+    v = _mm_add_epi8(v, _mm_slli_si128(v, 2));
+    v = _mm_add_epi8(v, _mm_slli_si128(v, 4));
+    v = _mm_add_epi8(v, _mm_slli_si128(v, 8));
+    v = _mm_add_epi8(v, carry);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(filtered + i), v);
+    // The last byte, broadcast: to the top four bytes, then to all.
+    const __m128i high = _mm_unpackhi_epi8(v, v);
+    carry = _mm_shuffle_epi32(_mm_unpackhi_epi16(high, high), 0xFF);
+  }
+#endif
+  for (; i < n; ++i) filtered[i] = static_cast<std::uint8_t>(filtered[i - 1] + filtered[i] - 128);
+  // The two streams, even bytes first: out[2k] = first[k], out[2k + 1] = second[k].
+  const std::uint8_t* first = filtered;
+  const std::uint8_t* second = filtered + (n + 1) / 2;
+  std::size_t k = 0;
+  const std::size_t pairs = n / 2;
+#if defined(__SSE2__)
+  for (; k + 16 <= pairs; k += 16) {
+    const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(first + k));
+    const __m128i b = _mm_loadu_si128(reinterpret_cast<const __m128i*>(second + k));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + 2 * k), _mm_unpacklo_epi8(a, b));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + 2 * k + 16), _mm_unpackhi_epi8(a, b));
+  }
+#endif
+  for (; k < pairs; ++k) {
+    out[2 * k] = first[k];
+    out[2 * k + 1] = second[k];
+  }
+  if (n % 2 == 1) out[n - 1] = first[pairs];
+}
+
+// OpenEXRCore's decompression of a ZIP or ZIPS block (the pipeline's decompress_fn, which its
+// documentation leaves to the caller): packed_buffer's zlib stream inflated (zlib's uncompress,
+// which the command line makes libdeflate's: cli/libdeflate_zlib.cpp) and unfiltered into
+// unpacked_buffer, which exr_decoding_run has sized to the chunk's unpacked size. A block stored as
+// it is (packed as large as unpacked) is copied, as OpenEXRCore copies it; a stream that does not
+// inflate to exactly the unpacked size is a corrupt chunk, as OpenEXRCore says.
+exr_result_t decompress_zip_block(exr_decode_pipeline_t* decode) {
+  const std::size_t packed = decode->chunk.packed_size, unpacked = decode->chunk.unpacked_size;
+  if (packed == 0) return EXR_ERR_SUCCESS;
+  if (decode->packed_buffer == nullptr || decode->unpacked_buffer == nullptr) return EXR_ERR_CORRUPT_CHUNK;
+  if (packed == unpacked) {
+    if (decode->unpacked_buffer != decode->packed_buffer) std::memcpy(decode->unpacked_buffer, decode->packed_buffer, unpacked);
+    return EXR_ERR_SUCCESS;
+  }
+  thread_local std::vector<std::uint8_t> filtered;
+  if (filtered.size() < unpacked) filtered.resize(unpacked);
+  uLongf inflated = static_cast<uLongf>(unpacked);
+  if (unpacked > std::numeric_limits<uLong>::max() || packed > std::numeric_limits<uLong>::max() ||
+      uncompress(filtered.data(), &inflated, static_cast<const Bytef*>(decode->packed_buffer), static_cast<uLong>(packed)) != Z_OK ||
+      inflated != unpacked) {
+    return EXR_ERR_CORRUPT_CHUNK;
+  }
+  zip_unfilter(filtered.data(), unpacked, static_cast<std::uint8_t*>(decode->unpacked_buffer));
+  return EXR_ERR_SUCCESS;
+}
+
 }  // namespace
 
 RasterInfo read_exr_info(const fs::path& path) {
@@ -561,6 +635,10 @@ bool read_exr_chunks(const fs::path& path, const Imf::MultiPartInputFile& file, 
           ch.user_bytes_per_element = static_cast<int16_t>(sizeof(float));
         }
         code = exr_decoding_choose_default_routines(context, 0, &decoder);
+        if (code == EXR_ERR_SUCCESS && decoder.decompress_fn != nullptr &&
+            (compression == EXR_COMPRESSION_ZIP || compression == EXR_COMPRESSION_ZIPS)) {
+          decoder.decompress_fn = &decompress_zip_block;
+        }
         if (code == EXR_ERR_SUCCESS) code = exr_decoding_run(context, 0, &decoder);
       }
       exr_decoding_destroy(context, &decoder);
