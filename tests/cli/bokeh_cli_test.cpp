@@ -646,6 +646,46 @@ void write_tiff_header(const fs::path& path, std::uint32_t width, std::uint32_t 
 
 }  // namespace
 
+TEST_CASE("lensmith bokeh writes PNG and reads JPEG through its PNG and JPEG module, and says where it looked without it", "[cli][bokeh]") {
+  // The command line loads libpng and libjpeg from liblensmith_png_jpeg.so when a command first needs
+  // them (lib/imageio/src/png_jpeg_module.h); this program links the codecs itself, an independent reader.
+  const std::string render = " --thin-lens --focal-length 50 --fstop 2 --focus 1.2 --quiet -o ";
+  const fs::path png = scratch("module.png"), jpg = scratch("module.jpg"), exr = scratch("module-png.exr");
+  REQUIRE(run_lensmith("bokeh --image " + kScene + render + png.string()).exit_code == 0);
+  REQUIRE(run_lensmith("bokeh --image " + kScene + render + exr.string()).exit_code == 0);
+  // The PNG is the EXR's picture sRGB-encoded in 8 bits: read back (linear), within half a code value
+  // of the EXR's clamped to [0, 1], times the decoding curve's steepest slope, at white (IEC 61966-2-1:
+  // d/dV ((V + 0.055) / 1.055)^2.4 = 2.4 / 1.055 at V = 1), plus float rounding.
+  constexpr double kEightBitRoundTrip = 0.5 / 255.0 * 2.4 / 1.055 + 1e-6;
+  const lensmith::Image from_png = lensmith::read_radiance_image(png), from_exr = lensmith::read_radiance_image(exr);
+  REQUIRE(from_png.data.size() == from_exr.data.size());
+  double worst = 0.0;
+  for (std::size_t i = 0; i < from_exr.data.size(); ++i) {
+    worst = std::max(worst, std::abs(from_png.data[i] - std::clamp(static_cast<double>(from_exr.data[i]), 0.0, 1.0)));
+  }
+  CHECK(worst < kEightBitRoundTrip);
+  CHECK(value_of(lensmith::read_image_metadata(png), "Software").find("lensmith") != std::string::npos);  // text written by libpng
+  SECTION("a JPEG as input, decoded by the module") {
+    REQUIRE(run_lensmith("bokeh --image " + kScene + render + jpg.string()).exit_code == 0);
+    const fs::path out = scratch("from-jpeg.exr");
+    const auto r = run_lensmith("bokeh --image " + jpg.string() + " --depth " + kScene + render + out.string());
+    INFO(r.err);
+    CHECK(r.exit_code == 0);
+    CHECK(lensmith::read_radiance_image(out).width == from_exr.width);
+  }
+  SECTION("without the module: exit 5, saying where it looked, nothing written") {
+    const fs::path modules = scratch("no-png-jpeg-module");
+    fs::create_directories(modules);
+    const fs::path out = scratch("nowhere.png");
+    ::setenv("LENSMITH_MODULE_DIR", modules.c_str(), 1);
+    const auto r = run_lensmith("bokeh --image " + kScene + render + out.string());
+    ::unsetenv("LENSMITH_MODULE_DIR");
+    CHECK(r.exit_code == 5);
+    CHECK(r.err.find((modules / "liblensmith_png_jpeg.so").string()) != std::string::npos);
+    CHECK_FALSE(fs::exists(out));
+  }
+}
+
 TEST_CASE("lensmith bokeh writes and reads TIFF through its TIFF module and its errors reach the command as any reader's do", "[cli][bokeh]") {
   // The command line loads libtiff from liblensmith_tiff.so when a command first needs it
   // (lib/imageio/src/tiff_module.h); this program links the codec itself, an independent reader.
