@@ -646,6 +646,24 @@ void write_tiff_header(const fs::path& path, std::uint32_t width, std::uint32_t 
 
 }  // namespace
 
+namespace {
+
+// A render to `output` (a file name in the scratch folder) with the module folder empty: exit 5, the
+// missing module's path in the message, nothing written.
+void check_without_module(const std::string& module_file, const std::string& output, const std::string& render) {
+  const fs::path modules = scratch("no-" + module_file);
+  fs::create_directories(modules);
+  const fs::path out = scratch(output);
+  ::setenv("LENSMITH_MODULE_DIR", modules.c_str(), 1);
+  const auto r = run_lensmith("bokeh --image " + kScene + render + out.string());
+  ::unsetenv("LENSMITH_MODULE_DIR");
+  CHECK(r.exit_code == 5);
+  CHECK(r.err.find((modules / module_file).string()) != std::string::npos);
+  CHECK_FALSE(fs::exists(out));
+}
+
+}  // namespace
+
 TEST_CASE("lensmith bokeh writes PNG and reads JPEG through its PNG and JPEG module, and says where it looked without it", "[cli][bokeh]") {
   // The command line loads libpng and libjpeg from liblensmith_png_jpeg.so when a command first needs
   // them (lib/imageio/src/png_jpeg_module.h); this program links the codecs itself, an independent reader.
@@ -673,17 +691,7 @@ TEST_CASE("lensmith bokeh writes PNG and reads JPEG through its PNG and JPEG mod
     CHECK(r.exit_code == 0);
     CHECK(lensmith::read_radiance_image(out).width == from_exr.width);
   }
-  SECTION("without the module: exit 5, saying where it looked, nothing written") {
-    const fs::path modules = scratch("no-png-jpeg-module");
-    fs::create_directories(modules);
-    const fs::path out = scratch("nowhere.png");
-    ::setenv("LENSMITH_MODULE_DIR", modules.c_str(), 1);
-    const auto r = run_lensmith("bokeh --image " + kScene + render + out.string());
-    ::unsetenv("LENSMITH_MODULE_DIR");
-    CHECK(r.exit_code == 5);
-    CHECK(r.err.find((modules / "liblensmith_png_jpeg.so").string()) != std::string::npos);
-    CHECK_FALSE(fs::exists(out));
-  }
+  SECTION("without the module: exit 5, saying where it looked, nothing written") { check_without_module("liblensmith_png_jpeg.so", "nowhere.png", render); }
 }
 
 TEST_CASE("lensmith bokeh writes and reads TIFF through its TIFF module and its errors reach the command as any reader's do", "[cli][bokeh]") {
@@ -723,15 +731,5 @@ TEST_CASE("lensmith bokeh writes and reads TIFF through its TIFF module and its 
     CHECK(r.exit_code == 3);
     CHECK(r.err.find(tall.string() + ": TIFF of 1 x 33554432 pixels") != std::string::npos);
   }
-  SECTION("without the module: exit 5, saying where it looked, nothing written") {
-    const fs::path modules = scratch("no-tiff-module");
-    fs::create_directories(modules);
-    const fs::path out = scratch("nowhere.tif");
-    ::setenv("LENSMITH_MODULE_DIR", modules.c_str(), 1);
-    const auto r = run_lensmith("bokeh --image " + kScene + render + out.string());
-    ::unsetenv("LENSMITH_MODULE_DIR");
-    CHECK(r.exit_code == 5);
-    CHECK(r.err.find((modules / "liblensmith_tiff.so").string()) != std::string::npos);
-    CHECK_FALSE(fs::exists(out));
-  }
+  SECTION("without the module: exit 5, saying where it looked, nothing written") { check_without_module("liblensmith_tiff.so", "nowhere.tif", render); }
 }

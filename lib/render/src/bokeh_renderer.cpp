@@ -73,9 +73,9 @@ struct BandBuffers {
 constexpr int kBandsPerThreadAffine = 4;
 // But a layer of small footprints (blur up to kSmallBlurPx) is scattered in twice as many bands: its
 // footprints overlap the next band by a few rows at most, and a band's buffers (32 bytes a pixel of
-// its rows) stay in the processor's cache. Street f/4 (every layer under 4 px): deposit 15.50 ->
-// 14.67 ms (medians of 21, alternately); the fence at 6 m, whose bars blur 10 px, lost 0.3 ms to it
-// and keeps 4.
+// its rows) stay in the processor's cache. Street f/4 (every layer under 4 px): deposit 16.92 ->
+// 14.99 ms (medians of 21, alternately); 8 bands for every layer cost the fence at 6 m, whose bars
+// blur 10 px, 0.3 ms and the portrait at 1 m 3 ms, so larger blurs keep 4.
 constexpr int kBandsPerThreadSmallBlur = 8;
 constexpr double kSmallBlurPx = 4.0;
 constexpr int kBandsPerThreadMapped = 2;
@@ -207,7 +207,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
     const double hidden_blur = layers.max_blur_px[u] + layers.nearer_blur_px[u];
     // (A layer whose pixels are all copied still has hidden sources: behind a blurred highlight in
     // front of a sharp wall, the wall shows through the highlight's disc.)
-    if (!layers.members(l).empty() && l + 1 < layers.count && hidden_blur >= kMinHiddenBlurPx) {
+    if (!members.empty() && l + 1 < layers.count && hidden_blur >= kMinHiddenBlurPx) {
       const double reach = std::min(0.5 * hidden_blur + kHiddenMarginPx, 0.5 * (w + h));
       stats.hidden_sources += render_detail::append_hidden_sources(sources, layers, l, w, h, reach, options.hidden, camera,
                                                                    threads, hidden_scratch, layer);
@@ -312,7 +312,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
         }
         // Progress in even steps: this layer's share of the sources times the bands it has done.
         if (options.progress) {
-          const double fraction = (static_cast<double>(done) + static_cast<double>(layers.members(l).size()) *
+          const double fraction = (static_cast<double>(done) + static_cast<double>(members.size()) *
                                                                     static_cast<double>(++bands_done) / bands) /
                                   static_cast<double>(sources.size());
 #pragma omp critical(lensmith_bokeh_progress)
@@ -326,7 +326,7 @@ Image render_sources(const ScatterSources& sources, const DepthLayers& layers, i
     // This layer's light images freed (FootprintScatter::forget_light_images says why).
     scatter.forget_light_images();
     for (FootprintScratch& scratch : scratches) scratch.forget_light_images();
-    done += layers.members(l).size();
+    done += members.size();
     if (options.progress) options.progress(static_cast<double>(done) / static_cast<double>(sources.size()));
     stats.stages.lap("deposit");
   }
